@@ -1,0 +1,105 @@
+# pointing-model library: top-level build.
+#   make            build/libpm.a, build/libpm.so, build/libpmhost.a, build/pmfit
+#   make test       build and run the Check suites (ends with Check's summary line)
+#   make check-freestanding   prove the core links against nothing but libm + mem*
+#   make install PREFIX=/usr/local
+CC       ?= gcc
+CXX      ?= g++
+AR       ?= ar
+PREFIX   ?= /usr/local
+PYTHON   ?= /usr/bin/python3
+B        := build
+
+WARN     := -Wall -Wextra -Wshadow -Wconversion -Wno-sign-conversion
+OPT      ?= -O2
+# The freestanding core: no exceptions, RTTI, thread-safe statics or hosted library.
+# -ffreestanding turns the builtins off; -fbuiltin -fno-math-errno give them back for speed.
+CORE_FLAGS := -std=c++11 $(OPT) -g $(WARN) -ffreestanding -fno-exceptions -fno-rtti \
+              -fno-threadsafe-statics -fno-asynchronous-unwind-tables -fbuiltin -fno-math-errno \
+              -fPIC -Iinclude
+HOST_CXXFLAGS := -std=c++17 $(OPT) -g $(WARN) -Iinclude -Itools/lib
+TEST_CFLAGS   := -std=c99 $(OPT) -g -Wall -Wextra -Iinclude -Itools/lib
+TEST_LIBS     := $(shell pkg-config --libs check 2>/dev/null || echo -lcheck -lsubunit -lrt -lpthread) \
+                 -llapacke -llapack -lblas -lerfa -lstdc++ -lm
+
+CORE_SRC  := $(wildcard lib/*.cpp)
+CORE_OBJ  := $(CORE_SRC:lib/%.cpp=$(B)/core/%.o)
+HOST_SRC  := $(wildcard tools/lib/*.cpp)
+HOST_OBJ  := $(HOST_SRC:tools/lib/%.cpp=$(B)/host/%.o)
+TOOL_SRC  := $(wildcard tools/*.cpp)
+TOOLS     := $(TOOL_SRC:tools/%.cpp=$(B)/%)
+TEST_SRC  := $(wildcard tests/check_*.c)
+TESTS     := $(TEST_SRC:tests/%.c=$(B)/tests/%)
+
+.PHONY: all test check-freestanding check-c89 install clean bench firmware demo
+all: $(B)/libpm.a $(B)/libpm.so $(B)/libpmhost.a $(TOOLS)
+
+$(B)/core/%.o: lib/%.cpp $(wildcard include/*.h lib/*.hpp)
+	@mkdir -p $(@D)
+	$(CXX) $(CORE_FLAGS) -c $< -o $@
+
+$(B)/libpm.a: $(CORE_OBJ)
+	@rm -f $@
+	$(AR) rcs $@ $^
+
+$(B)/libpm.so: $(CORE_OBJ)
+	$(CXX) -shared -nostdlib -o $@ $^ -lm -lc
+
+$(B)/host/%.o: tools/lib/%.cpp $(wildcard include/*.h tools/lib/*.hpp tools/lib/*.h)
+	@mkdir -p $(@D)
+	$(CXX) $(HOST_CXXFLAGS) -c $< -o $@
+
+$(B)/libpmhost.a: $(HOST_OBJ)
+	@rm -f $@
+	$(AR) rcs $@ $^
+
+$(B)/%: tools/%.cpp $(B)/libpmhost.a $(B)/libpm.a
+	$(CXX) $(HOST_CXXFLAGS) $< -o $@ $(B)/libpmhost.a $(B)/libpm.a -lerfa -lm
+
+$(B)/tests/%: tests/%.c $(B)/libpmhost.a $(B)/libpm.a $(wildcard tests/*.h)
+	@mkdir -p $(@D)
+	$(CC) $(TEST_CFLAGS) $< -o $@ $(B)/libpmhost.a $(B)/libpm.a $(TEST_LIBS)
+
+# The public header must be strict ANSI C.
+check-c89: include/pm.h
+	@mkdir -p $(B)
+	printf '#include "pm.h"\nint main(void){pm_model m; (void)m; return 0;}\n' > $(B)/c89.c
+	gcc -std=c89 -pedantic -Werror -Wall -Wextra -Iinclude -c $(B)/c89.c -o $(B)/c89.o
+	@echo "check-c89: include/pm.h is clean C89"
+
+# Only libm functions and memcpy/memset may be undefined in the core.
+FREESTANDING_OK := ^(sin|cos|sincos|tan|asin|acos|atan|atan2|sqrt|fabs|floor|ceil|fmod|hypot|exp|log|pow|copysign|round|trunc|remainder|nearbyint)f?$$|^mem(cpy|set|move)$$
+# (Symbols one object of the core takes from another are not external.)
+check-freestanding: $(B)/libpm.a
+	@nm --defined-only $(B)/libpm.a | awk 'NF==3{print $$3}' | sort -u > $(B)/core.defined; \
+	nm -u $(B)/libpm.a | awk 'NF==2{print $$2}' | sort -u | comm -23 - $(B)/core.defined > $(B)/core.undefined; \
+	bad=$$(grep -Ev '$(FREESTANDING_OK)' $(B)/core.undefined); \
+	if [ -n "$$bad" ]; then echo "check-freestanding: FAIL, the core needs:"; echo "$$bad"; exit 1; fi; \
+	echo "check-freestanding: OK (external symbols: $$(tr '\n' ' ' < $(B)/core.undefined))"
+
+test: all check-c89 check-freestanding $(TESTS)
+	@$(PYTHON) -c 'import numpy' 2>/dev/null || echo "note: numpy missing; reference tables are committed, regeneration needs python3-numpy"
+	@fail=0; total_run=0; total_fail=0; \
+	for t in $(TESTS); do \
+	  out=$$(PM_DATA_DIR=$(CURDIR)/../shared/data PM_TOP=$(CURDIR) $$t 2>&1); rc=$$?; echo "$$out" | grep -v '^Running suite' ; \
+	  line=$$(echo "$$out" | grep -E '^[0-9]+%: Checks: ' | tail -1); \
+	  r=$$(echo "$$line" | sed -E 's/.*Checks: ([0-9]+).*/\1/'); f=$$(echo "$$line" | sed -E 's/.*Failures: ([0-9]+), Errors: ([0-9]+).*/\1+\2/'); \
+	  total_run=$$((total_run + $${r:-0})); total_fail=$$((total_fail + $${f:-1})); \
+	  [ $$rc -eq 0 ] || fail=1; \
+	done; \
+	pct=100; [ $$total_run -gt 0 ] && pct=$$(( (total_run - total_fail) * 100 / total_run )); \
+	echo "$$pct%: Checks: $$total_run, Failures: $$total_fail, Errors: 0"; \
+	echo "$$((total_run - total_fail)) passed, $$total_fail failed"; \
+	exit $$fail
+
+install: all
+	install -d $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(PREFIX)/lib/pkgconfig $(DESTDIR)$(PREFIX)/bin
+	install -m 644 include/pm.h $(DESTDIR)$(PREFIX)/include/
+	install -m 644 $(B)/libpm.a $(DESTDIR)$(PREFIX)/lib/
+	install -m 755 $(B)/libpm.so $(DESTDIR)$(PREFIX)/lib/
+	for t in $(TOOLS); do install -m 755 $$t $(DESTDIR)$(PREFIX)/bin/; done
+	sed -e 's|@PREFIX@|$(PREFIX)|g' tools/pm.pc.in > $(DESTDIR)$(PREFIX)/lib/pkgconfig/pm.pc
+	@echo "installed into $(DESTDIR)$(PREFIX)"
+
+clean:
+	rm -rf $(B)

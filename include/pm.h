@@ -1,0 +1,516 @@
+/*
+**  pm.h - telescope pointing model: the public ANSI C (C89) interface.
+**
+**  A freestanding, allocation-free implementation of the isotropic and
+**  anisotropic pointing models of Pal, Vida, Meszaros & Mezo,
+**  "Isotropic and anisotropic pointing models", Exp Astron (2016).
+**
+**  Conventions
+**  -----------
+**  - Angles are radians.  The two mount axes are called (ha, dec) after the
+**    equatorial case; for an alt-az mount pass azimuth as "ha" and elevation
+**    as "dec" (see docs/model.md for the sign and zero-point conventions).
+**  - "Encoder" positions are the raw axis readings; "apparent" positions are
+**    where the telescope really points (the star's observed place).
+**  - An encoder dec beyond +-pi/2 means the telescope is flipped over the
+**    pole (German equatorial mount on the other pier side).
+**  - The caller owns every struct.  All structs are fully defined here so
+**    that they can be allocated statically; their sizes depend on the
+**    capacity macros PM_MAX_L and PM_MAX_EXTRA, which must be the same when
+**    the library and the caller are compiled (PM_CHECK_CONFIG() verifies).
+**  - Every function returns a pm_status.  PM_OK is 0, positive values are
+**    warnings with a usable result, negative values are errors; on error the
+**    outputs are left unchanged.
+*/
+#ifndef PM_H
+#define PM_H
+
+#include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---------------------------------------------------------------------- */
+/* Capacities (compile-time).                                             */
+/* ---------------------------------------------------------------------- */
+
+/* Highest spherical-harmonic order L the structs can hold. */
+#ifndef PM_MAX_L
+#define PM_MAX_L 4
+#endif
+
+/* Room for terms beyond the spherical-harmonic set (reserved for the
+** physical terms: periodic error, refraction, flexure, auxiliary inputs). */
+#ifndef PM_MAX_EXTRA
+#define PM_MAX_EXTRA 16
+#endif
+
+/* Free parameters of the harmonic model of order L: 4L^2+12L+6
+** (6, 22, 46, 78, 118 for L = 0..4; Pal et al. Sec. 3.1 and 5.1). */
+#define PM_SH_TERMS(L) (4 * (L) * (L) + 12 * (L) + 6)
+
+/* Number of (l,m) harmonics up to order L: (L+1)^2. */
+#define PM_N_HARM(L) (((L) + 1) * ((L) + 1))
+
+/* Most terms a model or fit can hold. */
+#define PM_MAX_TERMS (PM_SH_TERMS(PM_MAX_L) + PM_MAX_EXTRA)
+
+/* Packed symmetric matrix of n x n: n(n+1)/2 doubles. */
+#define PM_PACKED(n) ((n) * ((n) + 1) / 2)
+
+/* Hard iteration bounds of pm_model_invert (see its Notes). */
+#define PM_INVERT_MAX_FIXED 8
+#define PM_INVERT_MAX_NEWTON 8
+
+/* Round-trip tolerance the inverse iterates to (radians). */
+#define PM_INVERT_TOL 1e-13
+
+/* ---------------------------------------------------------------------- */
+/* Status.                                                                */
+/* ---------------------------------------------------------------------- */
+
+typedef enum pm_status {
+    PM_OK = 0,
+    PM_WARN_NOT_CONVERGED = 1, /* iteration bound reached; best result returned */
+    PM_WARN_UNREACHABLE = 2,   /* target outside what the mount can point to;
+                                  the nearest reachable position is returned */
+    PM_ERR_ARG = -1,           /* NULL pointer, bad enum or index */
+    PM_ERR_NONFINITE = -2,     /* NaN or infinity in an input */
+    PM_ERR_CAPACITY = -3,      /* order or term count beyond PM_MAX_L/PM_MAX_TERMS */
+    PM_ERR_TOO_FEW = -4,       /* not enough observations: need 2N > P */
+    PM_ERR_SINGULAR = -5,      /* a term cannot be determined from the data;
+                                  pm_fit.bad_term names it */
+    PM_ERR_STATE = -6,         /* call out of order (e.g. model changed and
+                                  not re-prepared, fit not initialised) */
+    PM_ERR_CONFIG = -7,        /* caller and library built with different
+                                  capacity macros */
+    PM_ERR_DIVERGED = -8       /* the fit did not converge */
+} pm_status;
+
+/* ---------------------------------------------------------------------- */
+/* Model.                                                                 */
+/* ---------------------------------------------------------------------- */
+
+/* Mount kinds. */
+#define PM_MOUNT_EQUATORIAL 0
+#define PM_MOUNT_ALTAZ 1
+
+/* Term kinds. */
+#define PM_TERM_SH 0 /* a_klm Y_lm p_k (Pal et al. Eq. pyyexpansion) */
+
+/* Base vectors k = 1..6 of Pal et al. Eq. (tdvectexpansion). */
+#define PM_BASE_A 1 /* polar axis misalignment, a (TPOINT: ME-like)  */
+#define PM_BASE_B 2 /* polar axis misalignment, b (TPOINT: MA-like)  */
+#define PM_BASE_C 3 /* hour-angle encoder index, c' (TPOINT: IH)     */
+#define PM_BASE_D 4 /* axis non-perpendicularity, d (TPOINT: NP)     */
+#define PM_BASE_E 5 /* declination encoder index, e' (TPOINT: ID)    */
+#define PM_BASE_I 6 /* collimation, i (TPOINT: CH)                   */
+
+/* Pier sides / which solution the inverse returns. */
+#define PM_SIDE_NORMAL 0  /* encoder |dec| <= pi/2 */
+#define PM_SIDE_FLIPPED 1 /* encoder dec beyond the pole */
+
+/* One term of the model. */
+typedef struct pm_term {
+    unsigned char kind; /* PM_TERM_SH */
+    unsigned char k;    /* base vector 1..6 (PM_BASE_*) */
+    signed char l;      /* harmonic degree 0..PM_MAX_L */
+    signed char m;      /* harmonic order -l..l (m<0: sin|m|tau) */
+} pm_term;
+
+/* Per-evaluation inputs that some terms use (temperature, time, pier side,
+** slew direction).  Pass NULL where no term needs them; the harmonic terms
+** use none. */
+typedef struct pm_context {
+    double temp_c; /* ambient temperature (deg C) */
+    double time_h; /* time (hours, any zero point) */
+    int pier;      /* +1 east, -1 west, 0 unknown */
+    int dir;       /* last slew direction on axis 1: +1, -1, 0 unknown */
+} pm_context;
+
+/* A pointing model: the term list, the coefficients (radians) and derived
+** constants filled in by pm_model_prepare.  The first six terms are always
+** the isotropic ones (a, b, c', d, e', i), applied exactly as rotations;
+** the others are tangent-plane displacements (docs/model.md). */
+typedef struct pm_model {
+    int mount;                     /* PM_MOUNT_* */
+    int order;                     /* spherical-harmonic order L */
+    int n_terms;                   /* P */
+    pm_term term[PM_MAX_TERMS];
+    double coef[PM_MAX_TERMS];     /* radians */
+    /* Derived by pm_model_prepare; do not set by hand. */
+    int prepared;
+    double prep_coef[PM_MAX_TERMS]; /* coef[] when prepared (staleness check) */
+    double h[9];                   /* polar-axis rotation H, row-major */
+    double sc, cc, se, ce;         /* sin/cos of c' and e' */
+    double sd, cd, si, ci;         /* sin/cos of d and i */
+    double dense[6][PM_N_HARM(PM_MAX_L)]; /* per base vector k, per harmonic */
+} pm_model;
+
+/*
+**  pm_model_init - an empty model of the given mount and harmonic order.
+**
+**  Given:
+**     m        pm_model*   model to fill
+**     mount    int         PM_MOUNT_EQUATORIAL or PM_MOUNT_ALTAZ
+**     order    int         spherical-harmonic order L, 0..PM_MAX_L
+**  Returned (function value):
+**              pm_status   PM_OK; PM_ERR_ARG; PM_ERR_CAPACITY (order)
+**  Notes:
+**  1) The term list holds the 4L^2+12L+6 linearly independent terms
+**     a_klm Y_lm p_k, k = 1..6, l = 0..L, |m| <= l, in the order l, m, k,
+**     with the dependent ones removed (Note 2).  All coefficients are 0.
+**  2) Dropped for every L (docs/model.md derives the rule):
+**     k=6 (i) with l >= 1 and |m| <= l-1     (relations like Eq. l1lin1)
+**     k=1 (a) with l >= 1 and m >= 1         (relations like Eq. l1lin2)
+**     k=2 (b) with l >= 2 and m >= 2
+**     For L = 1 and 2 these are the paper's choices (Sec. 3.1).
+**  Reference: Pal et al., Sec. 3, Eq. (pyyexpansion).
+*/
+pm_status pm_model_init(pm_model *m, int mount, int order);
+
+/*
+**  pm_model_prepare - derive the constants used by apply/invert.
+**
+**  Given/Returned:
+**     m        pm_model*   model whose coef[] were set or changed
+**  Returned (function value):
+**              pm_status   PM_OK; PM_ERR_ARG; PM_ERR_NONFINITE; PM_ERR_CAPACITY
+**  Notes:
+**  1) pm_model_init and pm_fit_solve leave the model prepared.  After
+**     changing coef[] or term[] directly, call this again: apply, invert
+**     and the fit return PM_ERR_STATE if any coefficient differs from the
+**     ones last prepared (never a silently stale model).
+*/
+pm_status pm_model_prepare(pm_model *m);
+
+/*
+**  pm_model_find - index of a harmonic term in the model.
+**
+**  Given:
+**     m        const pm_model*  model
+**     k,l,mm   int              base vector, degree, order
+**  Returned:
+**     index    int*             index into term[]/coef[]
+**  Returned (function value):
+**              pm_status   PM_OK; PM_ERR_ARG (not in the model)
+*/
+pm_status pm_model_find(const pm_model *m, int k, int l, int mm, int *index);
+
+/*
+**  pm_term_name - a short name for a term, e.g. "c'", "d*Y(1,-1)".
+**
+**  Given:
+**     m        const pm_model*  model
+**     index    int              term index
+**     buf      char*            output buffer
+**     len      size_t           its size (>= 2)
+**  Returned (function value):
+**              pm_status   PM_OK; PM_ERR_ARG
+**  Notes:
+**  1) Isotropic terms are named a, b, c', d, e', i; harmonic terms
+**     "<base>*Y(l,m)".  The name is truncated to fit buf (always
+**     NUL-terminated).
+*/
+pm_status pm_term_name(const pm_model *m, int index, char *buf, size_t len);
+
+/*
+**  pm_model_apply - encoder position to apparent position (forward model).
+**
+**  Given:
+**     m        const pm_model*   prepared model
+**     ctx      const pm_context* per-evaluation inputs, or NULL
+**     enc_ha   double            encoder axis 1 (radians)
+**     enc_dec  double            encoder axis 2 (radians; beyond +-pi/2
+**                                when flipped over the pole)
+**  Returned:
+**     app_ha   double*           apparent axis 1, in (-pi, pi]
+**     app_dec  double*           apparent axis 2, in [-pi/2, pi/2]
+**  Returned (function value):
+**              pm_status   PM_OK; PM_ERR_ARG; PM_ERR_NONFINITE; PM_ERR_STATE
+**  Notes:
+**  1) p' = H Pt(ha+c') X(d) Pd(dec-e') T(i) w, where the rotations carry
+**     the isotropic terms exactly and w is the unit vector displaced from
+**     (1,0,0) by the anisotropic terms' tangent-plane offset (docs/model.md).
+**     To first order in the coefficients this is the paper's Eq.
+**     (pyyexpansion).
+**  2) Cost: one sin/cos pair per axis, recurrences for the harmonics, one
+**     atan2 and one asin.  No iteration.
+**  Reference: Pal et al., Sec. 2, Eq. (tdmatrices); Sec. 3, Eq. (pyyexpansion).
+*/
+pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
+                         double enc_ha, double enc_dec,
+                         double *app_ha, double *app_dec);
+
+/*
+**  pm_model_invert - apparent position to the encoder position that points
+**  there (inverse model).
+**
+**  Given:
+**     m        const pm_model*   prepared model
+**     ctx      const pm_context* per-evaluation inputs, or NULL
+**     app_ha   double            apparent axis 1 (radians)
+**     app_dec  double            apparent axis 2 (radians, |.| <= pi/2)
+**     side     int               PM_SIDE_NORMAL or PM_SIDE_FLIPPED
+**  Returned:
+**     enc_ha   double*           encoder axis 1, in (-pi, pi]
+**     enc_dec  double*           encoder axis 2: in [-pi/2, pi/2] for
+**                                PM_SIDE_NORMAL, beyond the pole for
+**                                PM_SIDE_FLIPPED (in (pi/2, 3pi/2))
+**  Returned (function value):
+**              pm_status   PM_OK; PM_WARN_NOT_CONVERGED; PM_WARN_UNREACHABLE;
+**                          PM_ERR_ARG; PM_ERR_NONFINITE; PM_ERR_STATE
+**  Notes:
+**  1) The isotropic part is inverted in closed form; the anisotropic
+**     displacement is iterated to a fixed point (at most
+**     PM_INVERT_MAX_FIXED steps), falling back to damped Newton steps (at
+**     most PM_INVERT_MAX_NEWTON) where the fixed point does not contract
+**     (within about the anisotropic amplitude of the mount's pole).  The
+**     round-trip error |apply(invert(x)) - x| is below PM_INVERT_TOL
+**     on return with PM_OK.  Worst case: PM_INVERT_MAX_FIXED +
+**     3*PM_INVERT_MAX_NEWTON + 1 evaluations of the model.
+**  2) PM_WARN_NOT_CONVERGED: the bound was reached; the best position found
+**     is returned.  PM_WARN_UNREACHABLE: the target lies in the cap around
+**     the mount's pole that the collimation and non-perpendicularity make
+**     unreachable; the nearest reachable position is returned.
+**  3) The paper (Sec. 5.2) inverts by flipping the sign of the
+**     coefficients, with an error O(a^2); docs/model.md gives the measured
+**     size of that error.
+**  Reference: Pal et al., Sec. 5.2.
+*/
+pm_status pm_model_invert(const pm_model *m, const pm_context *ctx,
+                          double app_ha, double app_dec, int side,
+                          double *enc_ha, double *enc_dec);
+
+/*
+**  pm_model_invert_near - as pm_model_invert, starting from a known encoder
+**  position (e.g. the previous tracking tick).
+**
+**  Given:
+**     start_ha, start_dec  double  encoder position to start from; its
+**                                  side of the pole selects the solution,
+**                                  and enc_ha is returned within pi of
+**                                  start_ha (no jump at +-pi when tracking)
+**  Other arguments, return values and notes as pm_model_invert.
+*/
+pm_status pm_model_invert_near(const pm_model *m, const pm_context *ctx,
+                               double app_ha, double app_dec,
+                               double start_ha, double start_dec,
+                               double *enc_ha, double *enc_dec);
+
+/*
+**  pm_model_residual - observed minus model in the tangent plane.
+**
+**  Given:
+**     m        const pm_model*   prepared model
+**     ctx      const pm_context* per-evaluation inputs, or NULL
+**     enc_ha, enc_dec  double    encoder position of an observation
+**     app_ha, app_dec  double    the observed apparent position
+**  Returned:
+**     res      double[2]         residual (radians): [0] along axis 1 on
+**                                the sky (i.e. d(ha)*cos(dec)), [1] along
+**                                axis 2, both at the model's position
+**  Returned (function value):
+**              pm_status   PM_OK; PM_ERR_ARG; PM_ERR_NONFINITE; PM_ERR_STATE
+*/
+pm_status pm_model_residual(const pm_model *m, const pm_context *ctx,
+                            double enc_ha, double enc_dec,
+                            double app_ha, double app_dec, double res[2]);
+
+/*
+**  pm_terms_eval - the term functions Y_lm(ha,dec) p_k(ha,dec) themselves.
+**
+**  Given:
+**     order    int         L, 0..PM_MAX_L
+**     ha, dec  double      encoder position (radians)
+**  Returned:
+**     out      double*     6*(L+1)^2 x 3 values: for harmonic index
+**                          j = l*l + l + m and base vector k = 1..6, the
+**                          3-D vector Y_lm p_k at out[3*(6*j + k-1) + 0..2]
+**  Returned (function value):
+**              pm_status   PM_OK; PM_ERR_ARG; PM_ERR_NONFINITE; PM_ERR_CAPACITY
+**  Notes:
+**  1) All 6(L+1)^2 products, including the linearly dependent ones the
+**     model drops, in the paper's normalisation (Y_00 = 1, Y_1,-1 =
+**     cos(dec) sin(ha), ..., Y_20 = 3 sin^2(dec) - 1; docs/model.md gives
+**     the general rule), so the paper's relations can be checked.
+**  Reference: Pal et al., Sec. 3, Table 1, Eqs. (l1lin1)-(yl2r6).
+*/
+pm_status pm_terms_eval(int order, double ha, double dec, double *out);
+
+/* ---------------------------------------------------------------------- */
+/* Fit.                                                                   */
+/* ---------------------------------------------------------------------- */
+
+/* Normal equations of a Gauss-Newton pass, in caller-owned fixed memory.
+** Size does not depend on the number of observations: about
+** 8 * (PM_MAX_TERMS^2 + ...) bytes plus one pm_model (sizeof(pm_fit) for
+** the build's PM_MAX_L; docs/model.md lists it for L = 1, 2, 4). */
+typedef struct pm_fit {
+    int state;                           /* internal */
+    int n_par;                           /* P */
+    long n_obs;                          /* N in the current pass */
+    double chi2;                         /* sum of squared residuals (rad^2) */
+    double ata[PM_PACKED(PM_MAX_TERMS)]; /* normal matrix J^T J of the
+                                            current pass, packed lower */
+    double atb[PM_MAX_TERMS];            /* J^T r */
+    double cov[PM_PACKED(PM_MAX_TERMS)]; /* after a solve: (J^T J)^-1 */
+    double scale[PM_MAX_TERMS];          /* column equilibration */
+    pm_model lin;                        /* linearisation point */
+    int bad_term;                        /* term index after PM_ERR_SINGULAR */
+    int iterations;                      /* passes solved so far */
+} pm_fit;
+
+/* What a solved pass gives besides the model. */
+typedef struct pm_fit_result {
+    long n_obs;                    /* N */
+    int n_par;                     /* P */
+    double chi2;                   /* chi^2 at the linearisation point (rad^2) */
+    double sigma;                  /* unbiased residual sqrt(chi2/(2N-P)) (rad) */
+    double err[PM_MAX_TERMS];      /* 1-sigma error of each coefficient (rad) */
+    double max_step;               /* largest |step| / error of this pass */
+    int converged;                 /* 1 when the step was negligible */
+    int iterations;                /* passes so far */
+} pm_fit_result;
+
+/*
+**  pm_fit_init - start a fit of the terms of a model.
+**
+**  Given:
+**     fit      pm_fit*          fit state to initialise
+**     start    const pm_model*  terms to fit and their starting values
+**                               (e.g. from pm_model_init: all zero)
+**  Returned (function value):
+**              pm_status   PM_OK; PM_ERR_ARG; PM_ERR_NONFINITE; PM_ERR_CAPACITY
+*/
+pm_status pm_fit_init(pm_fit *fit, const pm_model *start);
+
+/*
+**  pm_fit_add - accumulate one observation into the normal equations.
+**
+**  Given:
+**     fit      pm_fit*           initialised fit
+**     ctx      const pm_context* inputs for this observation, or NULL
+**     enc_ha, enc_dec  double    encoder position (radians)
+**     app_ha, app_dec  double    observed apparent position (radians)
+**  Returned (function value):
+**              pm_status   PM_OK; PM_ERR_ARG; PM_ERR_NONFINITE (the fit is
+**                          unchanged); PM_ERR_STATE
+**  Notes:
+**  1) Each observation gives two rows (the tangent-plane residual along both
+**     axes), linearised at fit->lin.  O(P^2) work, no memory growth.
+*/
+pm_status pm_fit_add(pm_fit *fit, const pm_context *ctx,
+                     double enc_ha, double enc_dec,
+                     double app_ha, double app_dec);
+
+/*
+**  pm_fit_solve - solve the accumulated pass and start the next one.
+**
+**  Given/Returned:
+**     fit      pm_fit*          fit with the observations of one pass
+**  Returned:
+**     out      pm_model*        the updated model (prepared)
+**     res      pm_fit_result*   statistics (may be NULL)
+**  Returned (function value):
+**              pm_status   PM_OK; PM_ERR_ARG; PM_ERR_TOO_FEW;
+**                          PM_ERR_SINGULAR (fit->bad_term names the term);
+**                          PM_ERR_STATE
+**  Notes:
+**  1) Column equilibration, then a Cholesky factorisation that stops on a
+**     pivot below 1e-11 of the equilibrated diagonal (the term is a linear
+**     combination of earlier ones for this sky coverage).
+**  2) On success fit->cov holds (J^T J)^-1 for the covariance; the next
+**     pm_fit_add starts a new pass linearised at *out.  Feed the same
+**     observations again until res->converged (Gauss-Newton); pm_fit_run
+**     does the loop for observations held in arrays.
+**  3) On error *out and *res are unchanged and the accumulated pass is kept.
+*/
+pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res);
+
+/*
+**  pm_fit_run - Gauss-Newton fit of observations held in arrays.
+**
+**  Given:
+**     fit      pm_fit*           workspace
+**     model    pm_model*         terms and starting values; on success the
+**                                fitted model
+**     ctx      const pm_context* n contexts, or NULL
+**     n        long              number of observations
+**     enc_ha, enc_dec, app_ha, app_dec  const double*  n values each
+**     max_iter int               bound on passes (e.g. 20)
+**  Returned:
+**     res      pm_fit_result*    statistics of the final pass (may be NULL)
+**  Returned (function value):
+**              pm_status   PM_OK; PM_ERR_DIVERGED (bound reached, model
+**                          unchanged); errors of pm_fit_init/add/solve
+*/
+pm_status pm_fit_run(pm_fit *fit, pm_model *model, const pm_context *ctx,
+                     long n, const double *enc_ha, const double *enc_dec,
+                     const double *app_ha, const double *app_dec,
+                     int max_iter, pm_fit_result *res);
+
+/*
+**  pm_fit_covariance - element of the coefficient covariance (rad^2).
+**
+**  Given:
+**     fit      const pm_fit*   fit after a successful pm_fit_solve
+**     res      const pm_fit_result* its result (for sigma)
+**     i, j     int             term indices
+**  Returned:
+**     cov      double*         covariance sigma^2 (J^T J)^-1_ij
+**     corr     double*         correlation coefficient (may be NULL)
+**  Returned (function value):
+**              pm_status   PM_OK; PM_ERR_ARG; PM_ERR_STATE
+*/
+pm_status pm_fit_covariance(const pm_fit *fit, const pm_fit_result *res,
+                            int i, int j, double *cov, double *corr);
+
+/*
+**  pm_fit_row - the two design-matrix rows of one observation.
+**
+**  Given:
+**     m        const pm_model*   prepared model (linearisation point)
+**     ctx      const pm_context* inputs, or NULL
+**     enc_ha, enc_dec, app_ha, app_dec  double  the observation
+**  Returned:
+**     row0, row1  double*        m->n_terms derivatives each of the model
+**                                position w.r.t. the coefficients
+**     r        double[2]         observed minus model (radians)
+**  Returned (function value):
+**              pm_status   PM_OK; PM_ERR_ARG; PM_ERR_NONFINITE; PM_ERR_STATE
+**  Notes:
+**  1) The least-squares step solves (J^T J) d = J^T r with these rows;
+**     exposed so that a caller can check the solver against another one.
+**     Both components are in the frame transported by the isotropic
+**     rotation (docs/model.md), so chi^2 is the same as in the sky frame.
+*/
+pm_status pm_fit_row(const pm_model *m, const pm_context *ctx,
+                     double enc_ha, double enc_dec,
+                     double app_ha, double app_dec,
+                     double *row0, double *row1, double r[2]);
+
+/* ---------------------------------------------------------------------- */
+/* Configuration check.                                                   */
+/* ---------------------------------------------------------------------- */
+
+/*
+**  pm_check_config - do the caller's struct sizes match the library's?
+**
+**  Returned (function value):
+**              pm_status   PM_OK; PM_ERR_CONFIG
+**  Notes:
+**  1) Call as PM_CHECK_CONFIG().  Different PM_MAX_L or PM_MAX_EXTRA in
+**     the caller and the library change the struct layouts.
+*/
+pm_status pm_check_config(size_t model_size, size_t fit_size, int max_l,
+                          int max_extra);
+#define PM_CHECK_CONFIG() \
+    pm_check_config(sizeof(pm_model), sizeof(pm_fit), PM_MAX_L, PM_MAX_EXTRA)
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PM_H */

@@ -1,0 +1,414 @@
+/*
+**  fit.cpp - least-squares fit of the pointing model: Gauss-Newton passes
+**  over observations accumulated into fixed-size normal equations, solved
+**  by an equilibrated Cholesky factorisation written out here.
+**
+**  Reference: Pal et al., Exp Astron (2016), Sec. 5.1 (linear least
+**  squares); the exact isotropic part makes the problem mildly nonlinear.
+*/
+#include "pm.h"
+#include "pm_detail.hpp"
+
+using namespace pm::detail;
+
+namespace {
+
+const int FIT_READY = 0x5046; /* fit->state after init / solve */
+
+/* Pivots below this fraction of the equilibrated diagonal mean the term is
+** (numerically) a combination of the ones before it. */
+const double PIVOT_MIN = 1e-11;
+
+inline int pidx(int i, int j) { return i * (i + 1) / 2 + j; } /* i >= j */
+
+/* Derivative of the log map at unit vector q (2 x 3). */
+void dlog(const V3<double> &q, double D[2][3], double *ly, double *lz)
+{
+    double s2 = q.y * q.y + q.z * q.z;
+    double s = m_sqrt(s2);
+    double th = m_atan2(s, q.x);
+    double f, g; /* f = th/sin th, g = f'(th)/sin th */
+    if (s2 < 1e-4 && q.x > 0) {
+        f = 1 + s2 / 6 + 3 * s2 * s2 / 40;
+        g = 1.0 / 3 + 2.0 / 15 * th * th;
+    } else {
+        f = th / s;
+        g = (s - th * q.x) / (s2 * s);
+    }
+    *ly = q.y * f;
+    *lz = q.z * f;
+    /* d(log) = f dq_yz + q_yz g (qx (qy dqy + qz dqz) - s^2 dqx) */
+    D[0][0] = -q.y * g * s2;
+    D[0][1] = f + q.y * g * q.x * q.y;
+    D[0][2] = q.y * g * q.x * q.z;
+    D[1][0] = -q.z * g * s2;
+    D[1][1] = q.z * g * q.x * q.y;
+    D[1][2] = f + q.z * g * q.x * q.z;
+}
+
+/* Two design rows (model derivatives) and the residual of one observation
+** at model m.  Residual: r = log(M^T t) - D(x), in the frame transported
+** by the isotropic rotation M (docs/model.md). */
+void rows(const pm_model *m, double enc_ha, double enc_dec, double app_ha,
+          double app_dec, double *row0, double *row1, double r[2])
+{
+    Iso<double> k;
+    iso_from_model<double>(m, &k);
+    Trig<double> g = trig_of(enc_ha, enc_dec);
+    double stp, ctp, sdp, cdp;
+    shifted<double>(k, g, &stp, &ctp, &sdp, &cdp);
+    V3<double> t = unit_of(app_ha, app_dec);
+    V3<double> s0 = mat_tmul<double>(k.h, t);
+    V3<double> s1 = rot_zt<double>(stp, ctp, s0);
+    V3<double> s2 = rot_xt<double>(k.sd, k.cd, s1);
+    V3<double> s3 = rot_dt<double>(sdp, cdp, s2);
+    V3<double> q = rot_zt<double>(k.si, k.ci, s3);
+    double D[2][3], ly, lz;
+    dlog(q, D, &ly, &lz);
+    double dt, dd;
+    aniso<double>(m, g, &dt, &dd);
+    r[0] = ly - dt;
+    r[1] = lz - dd;
+
+    /* isotropic terms: dq/dtheta, then row = -dlog * dq/dtheta */
+    const V3<double> ex = v3(1.0, 0.0, 0.0), ey = v3(0.0, 1.0, 0.0),
+                     ez = v3(0.0, 0.0, 1.0);
+    V3<double> dq[6];
+    {
+        /* right Jacobian of exp at w = (a, b, 0) */
+        double a = m->coef[0], b = m->coef[1], th2 = a * a + b * b, Bc, Cc;
+        if (th2 < 1e-8) {
+            Bc = 0.5 - th2 / 24;
+            Cc = 1.0 / 6 - th2 / 120;
+        } else {
+            double th = m_sqrt(th2);
+            Bc = (1 - m_cos(th)) / th2;
+            Cc = (th - m_sin(th)) / (th2 * th);
+        }
+        V3<double> w = v3(a, b, 0.0);
+        for (int j = 0; j < 2; j++) {
+            V3<double> e = j == 0 ? ex : ey;
+            V3<double> we = cross(w, e);
+            V3<double> wwe = cross(w, we);
+            V3<double> jr = v3(e.x - Bc * we.x + Cc * wwe.x,
+                               e.y - Bc * we.y + Cc * wwe.y,
+                               e.z - Bc * we.z + Cc * wwe.z);
+            V3<double> v = cross(s0, jr); /* -(jr x s0) */
+            v = rot_zt<double>(stp, ctp, v);
+            v = rot_xt<double>(k.sd, k.cd, v);
+            v = rot_dt<double>(sdp, cdp, v);
+            dq[j] = rot_zt<double>(k.si, k.ci, v);
+        }
+    }
+    {
+        V3<double> v = cross(s1, ez); /* -(ez x s1) */
+        v = rot_xt<double>(k.sd, k.cd, v);
+        v = rot_dt<double>(sdp, cdp, v);
+        dq[2] = rot_zt<double>(k.si, k.ci, v);
+    }
+    {
+        V3<double> v = cross(s2, ex);
+        v = rot_dt<double>(sdp, cdp, v);
+        dq[3] = rot_zt<double>(k.si, k.ci, v);
+    }
+    dq[4] = rot_zt<double>(k.si, k.ci, cross(s3, ey));
+    dq[5] = cross(q, ez);
+    for (int j = 0; j < 6; j++) {
+        row0[j] = -(D[0][0] * dq[j].x + D[0][1] * dq[j].y + D[0][2] * dq[j].z);
+        row1[j] = -(D[1][0] * dq[j].x + D[1][1] * dq[j].y + D[1][2] * dq[j].z);
+    }
+
+    /* harmonic terms: linear, row = Y_lm N_lm (u_k, v_k) */
+    double Y[PM_N_HARM(PM_MAX_L)];
+    harmonics<double>(m->order, g, Y);
+    for (int i = 6; i < m->n_terms; i++) {
+        const pm_term *tm = &m->term[i];
+        int j = tm->l * tm->l + tm->l + tm->m;
+        double y = Y[j] * norm_lm(tm->l, tm->m);
+        double u, v;
+        base_uv<double>(tm->k, g, &u, &v);
+        row0[i] = y * u;
+        row1[i] = y * v;
+    }
+}
+
+void reset_pass(pm_fit *fit)
+{
+    int P = fit->n_par;
+    for (int i = 0; i < PM_PACKED(P); i++)
+        fit->ata[i] = 0;
+    for (int i = 0; i < P; i++)
+        fit->atb[i] = 0;
+    fit->chi2 = 0;
+    fit->n_obs = 0;
+}
+
+/* Cholesky factorisation of packed lower A (n x n) in place: A = L L^T.
+** Returns -1 on success, else the index of the first pivot below PIVOT_MIN
+** (A equilibrated: unit diagonal). */
+int cholesky(double *a, int n)
+{
+    for (int j = 0; j < n; j++) {
+        double *rj = a + pidx(j, 0);
+        double d = rj[j];
+        for (int k = 0; k < j; k++)
+            d -= rj[k] * rj[k];
+        if (!(d > PIVOT_MIN))
+            return j;
+        d = m_sqrt(d);
+        rj[j] = d;
+        for (int i = j + 1; i < n; i++) {
+            double *ri = a + pidx(i, 0);
+            double s = ri[j];
+            for (int k = 0; k < j; k++)
+                s -= ri[k] * rj[k];
+            ri[j] = s / d;
+        }
+    }
+    return -1;
+}
+
+/* Solve L L^T x = b in place (L packed lower). */
+void chol_solve(const double *l, int n, double *b)
+{
+    for (int i = 0; i < n; i++) {
+        const double *ri = l + pidx(i, 0);
+        double s = b[i];
+        for (int k = 0; k < i; k++)
+            s -= ri[k] * b[k];
+        b[i] = s / ri[i];
+    }
+    for (int i = n - 1; i >= 0; i--) {
+        double s = b[i];
+        for (int k = i + 1; k < n; k++)
+            s -= l[pidx(k, i)] * b[k];
+        b[i] = s / l[pidx(i, i)];
+    }
+}
+
+/* Replace L (packed lower) by (L L^T)^-1 (packed lower), in place. */
+void chol_inverse(double *a, int n)
+{
+    /* L^-1 in place (lower triangular) */
+    for (int j = 0; j < n; j++) {
+        a[pidx(j, j)] = 1.0 / a[pidx(j, j)];
+        for (int i = j + 1; i < n; i++) {
+            double s = 0;
+            for (int k = j; k < i; k++)
+                s -= a[pidx(i, k)] * a[pidx(k, j)];
+            a[pidx(i, j)] = s / a[pidx(i, i)];
+        }
+    }
+    /* C = L^-T L^-1: C_ij = sum_{k >= i} Linv_ki Linv_kj (i >= j) */
+    for (int j = 0; j < n; j++)
+        for (int i = j; i < n; i++) {
+            double s = 0;
+            for (int k = i; k < n; k++)
+                s += a[pidx(k, i)] * a[pidx(k, j)];
+            a[pidx(i, j)] = s;
+        }
+}
+
+} /* namespace */
+
+extern "C" {
+
+pm_status pm_fit_init(pm_fit *fit, const pm_model *start)
+{
+    if (!fit || !start)
+        return PM_ERR_ARG;
+    pm_status st = model_ready(start);
+    if (st != PM_OK)
+        return st;
+    fit->lin = *start;
+    fit->n_par = start->n_terms;
+    fit->bad_term = -1;
+    fit->iterations = 0;
+    reset_pass(fit);
+    for (int i = 0; i < PM_MAX_TERMS; i++)
+        fit->scale[i] = 0;
+    fit->state = FIT_READY;
+    return PM_OK;
+}
+
+pm_status pm_fit_add(pm_fit *fit, const pm_context *ctx, double enc_ha,
+                     double enc_dec, double app_ha, double app_dec)
+{
+    (void)ctx;
+    if (!fit)
+        return PM_ERR_ARG;
+    if (fit->state != FIT_READY || fit->n_par != fit->lin.n_terms)
+        return PM_ERR_STATE;
+    if (!finite(enc_ha) || !finite(enc_dec) || !finite(app_ha) ||
+        !finite(app_dec))
+        return PM_ERR_NONFINITE;
+    if (m_fabs(app_dec) > PI / 2 + 1e-9)
+        return PM_ERR_ARG;
+    double r0[PM_MAX_TERMS], r1[PM_MAX_TERMS], r[2];
+    rows(&fit->lin, enc_ha, enc_dec, app_ha, app_dec, r0, r1, r);
+    int P = fit->n_par;
+    for (int i = 0; i < P; i++)
+        if (!finite(r0[i]) || !finite(r1[i]))
+            return PM_ERR_NONFINITE;
+    if (!finite(r[0]) || !finite(r[1]))
+        return PM_ERR_NONFINITE;
+    for (int i = 0; i < P; i++) {
+        double *ai = fit->ata + pidx(i, 0);
+        double x0 = r0[i], x1 = r1[i];
+        for (int j = 0; j <= i; j++)
+            ai[j] += x0 * r0[j] + x1 * r1[j];
+        fit->atb[i] += x0 * r[0] + x1 * r[1];
+    }
+    fit->chi2 += r[0] * r[0] + r[1] * r[1];
+    fit->n_obs++;
+    return PM_OK;
+}
+
+pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res)
+{
+    if (!fit || !out)
+        return PM_ERR_ARG;
+    if (fit->state != FIT_READY || fit->n_par != fit->lin.n_terms)
+        return PM_ERR_STATE;
+    int P = fit->n_par;
+    if (2 * fit->n_obs <= P)
+        return PM_ERR_TOO_FEW;
+
+    /* column equilibration: unit diagonal */
+    for (int j = 0; j < P; j++) {
+        double d = fit->ata[pidx(j, j)];
+        if (!(d > 0)) {
+            fit->bad_term = j;
+            return PM_ERR_SINGULAR;
+        }
+        fit->scale[j] = 1.0 / m_sqrt(d);
+    }
+    for (int i = 0; i < P; i++)
+        for (int j = 0; j <= i; j++)
+            fit->cov[pidx(i, j)] =
+                fit->ata[pidx(i, j)] * fit->scale[i] * fit->scale[j];
+    int bad = cholesky(fit->cov, P);
+    if (bad >= 0) {
+        fit->bad_term = bad;
+        return PM_ERR_SINGULAR;
+    }
+    double step[PM_MAX_TERMS];
+    for (int i = 0; i < P; i++)
+        step[i] = fit->atb[i] * fit->scale[i];
+    chol_solve(fit->cov, P, step);
+    for (int i = 0; i < P; i++)
+        step[i] *= fit->scale[i];
+    chol_inverse(fit->cov, P);
+    for (int i = 0; i < P; i++)
+        for (int j = 0; j <= i; j++)
+            fit->cov[pidx(i, j)] *= fit->scale[i] * fit->scale[j];
+
+    pm_model next = fit->lin;
+    for (int i = 0; i < P; i++)
+        next.coef[i] += step[i];
+    pm_status st = pm_model_prepare(&next);
+    if (st != PM_OK)
+        return st;
+
+    long dof = 2 * fit->n_obs - P;
+    double sigma = m_sqrt(fit->chi2 / (double)dof);
+    double max_step = 0;
+    int converged = 1;
+    double err[PM_MAX_TERMS];
+    for (int i = 0; i < P; i++) {
+        err[i] = sigma * m_sqrt(fit->cov[pidx(i, i)]);
+        double a = m_fabs(step[i]);
+        if (err[i] > 0 && a / err[i] > max_step)
+            max_step = a / err[i];
+        if (a > 1e-6 * err[i] + 1e-15)
+            converged = 0;
+    }
+    fit->iterations++;
+    if (res) {
+        res->n_obs = fit->n_obs;
+        res->n_par = P;
+        res->chi2 = fit->chi2;
+        res->sigma = sigma;
+        for (int i = 0; i < PM_MAX_TERMS; i++)
+            res->err[i] = i < P ? err[i] : 0.0;
+        res->max_step = max_step;
+        res->converged = converged;
+        res->iterations = fit->iterations;
+    }
+    *out = next;
+    fit->lin = next;
+    fit->bad_term = -1;
+    reset_pass(fit);
+    return PM_OK;
+}
+
+pm_status pm_fit_run(pm_fit *fit, pm_model *model, const pm_context *ctx,
+                     long n, const double *enc_ha, const double *enc_dec,
+                     const double *app_ha, const double *app_dec,
+                     int max_iter, pm_fit_result *res)
+{
+    if (!fit || !model || !enc_ha || !enc_dec || !app_ha || !app_dec ||
+        n < 0 || max_iter < 1)
+        return PM_ERR_ARG;
+    pm_status st = pm_fit_init(fit, model);
+    if (st != PM_OK)
+        return st;
+    pm_model cur = *model;
+    pm_fit_result r;
+    for (int it = 0; it < max_iter; it++) {
+        for (long i = 0; i < n; i++) {
+            st = pm_fit_add(fit, ctx ? ctx + i : 0, enc_ha[i], enc_dec[i],
+                            app_ha[i], app_dec[i]);
+            if (st != PM_OK)
+                return st;
+        }
+        st = pm_fit_solve(fit, &cur, &r);
+        if (st != PM_OK)
+            return st;
+        if (r.converged) {
+            *model = cur;
+            if (res)
+                *res = r;
+            return PM_OK;
+        }
+    }
+    return PM_ERR_DIVERGED;
+}
+
+pm_status pm_fit_covariance(const pm_fit *fit, const pm_fit_result *res,
+                            int i, int j, double *cov, double *corr)
+{
+    if (!fit || !res || !cov)
+        return PM_ERR_ARG;
+    if (fit->state != FIT_READY || fit->iterations < 1)
+        return PM_ERR_STATE;
+    if (i < 0 || j < 0 || i >= fit->n_par || j >= fit->n_par)
+        return PM_ERR_ARG;
+    int a = i > j ? i : j, b = i > j ? j : i;
+    double c = fit->cov[pidx(a, b)];
+    *cov = c * res->sigma * res->sigma;
+    if (corr) {
+        double d = fit->cov[pidx(a, a)] * fit->cov[pidx(b, b)];
+        *corr = d > 0 ? c / m_sqrt(d) : 0.0;
+    }
+    return PM_OK;
+}
+
+pm_status pm_fit_row(const pm_model *m, const pm_context *ctx, double enc_ha,
+                     double enc_dec, double app_ha, double app_dec,
+                     double *row0, double *row1, double r[2])
+{
+    (void)ctx;
+    pm_status st = model_ready(m);
+    if (st != PM_OK)
+        return st;
+    if (!row0 || !row1 || !r)
+        return PM_ERR_ARG;
+    if (!finite(enc_ha) || !finite(enc_dec) || !finite(app_ha) ||
+        !finite(app_dec))
+        return PM_ERR_NONFINITE;
+    rows(m, enc_ha, enc_dec, app_ha, app_dec, row0, row1, r);
+    return PM_OK;
+}
+
+} /* extern "C" */

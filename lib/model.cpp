@@ -1,0 +1,433 @@
+/*
+**  model.cpp - the pointing model: term set, forward and inverse evaluation.
+**
+**  Reference: Pal et al., Exp Astron (2016), Secs. 2, 3 and 5.
+*/
+#include "pm.h"
+#include "pm_detail.hpp"
+
+using namespace pm::detail;
+
+namespace {
+
+/* Is harmonic term (k, l, m) one of the linearly dependent ones dropped?
+** (docs/model.md: p4 Y_lm = -sin(d) Y_lm p6 ties k=6 to k=4; the identity
+** sum_i p_i (e_i x p) = 0 ties k=1,2,3.) */
+bool dropped(int k, int l, int m)
+{
+    if (l == 0)
+        return false;
+    if (k == 6 && (m < 0 ? -m : m) <= l - 1)
+        return true;
+    if (k == 1 && m >= 1)
+        return true;
+    if (k == 2 && m >= 2)
+        return true;
+    return false;
+}
+
+/* Wrap an angle into (-pi, pi]. */
+double wrap_pi(double a)
+{
+    while (a > PI)
+        a -= 2 * PI;
+    while (a <= -PI)
+        a += 2 * PI;
+    return a;
+}
+
+/* Round-trip residual of encoder trig g against target q, measured as the
+** tangent offset (radians) of q seen from the model's position. */
+double miss(const pm_model *m, const Iso<double> &k, const Trig<double> &g,
+            const V3<double> &q)
+{
+    V3<double> p = forward_vec<double>(m, k, g);
+    V3<double> c = cross<double>(p, q);
+    return m_atan2(m_sqrt(dot<double>(c, c)), dot<double>(p, q));
+}
+
+/* Damped Newton iteration on the forward model, in a frame fixed at the
+** target.  Used where the fixed point does not contract (close to the
+** mount's pole).  x = (t, d) encoder angles, updated in place. */
+pm_status newton(const pm_model *m, const Iso<double> &k, const V3<double> &q,
+                 double tq, double dq, double *t, double *d, double *err)
+{
+    /* frame at the target: e1 along increasing axis 1, e2 along axis 2 */
+    double st = m_sin(tq), ct = m_cos(tq), sd = m_sin(dq), cd = m_cos(dq);
+    V3<double> e1 = v3(-st, ct, 0.0);
+    V3<double> e2 = v3(-sd * ct, -sd * st, cd);
+    const double h = 1e-7;
+    double best = miss(m, k, trig_of(*t, *d), q);
+    for (int it = 0; it < PM_INVERT_MAX_NEWTON && best > PM_INVERT_TOL; it++) {
+        V3<double> f0 = forward_vec<double>(m, k, trig_of(*t, *d));
+        V3<double> ft = forward_vec<double>(m, k, trig_of(*t + h, *d));
+        V3<double> fd = forward_vec<double>(m, k, trig_of(*t, *d + h));
+        double F1 = dot(q, e1) - dot(f0, e1), F2 = dot(q, e2) - dot(f0, e2);
+        double a = (dot(ft, e1) - dot(f0, e1)) / h;
+        double b = (dot(fd, e1) - dot(f0, e1)) / h;
+        double c = (dot(ft, e2) - dot(f0, e2)) / h;
+        double dd = (dot(fd, e2) - dot(f0, e2)) / h;
+        /* Levenberg-damped 2x2 solve of [a b; c dd] x = F */
+        double jtj00 = a * a + c * c, jtj01 = a * b + c * dd,
+               jtj11 = b * b + dd * dd;
+        double g0 = a * F1 + c * F2, g1 = b * F1 + dd * F2;
+        double mu = 1e-12 * (jtj00 + jtj11);
+        double lam = 1.0;
+        bool improved = false;
+        for (int tries = 0; tries < 4 && !improved; tries++) {
+            double A = jtj00 + mu, B = jtj01, D = jtj11 + mu;
+            double det = A * D - B * B;
+            if (!(det > 0))
+                break;
+            double x0 = (D * g0 - B * g1) / det, x1 = (A * g1 - B * g0) / det;
+            double nt = *t + lam * x0, nd = *d + lam * x1;
+            double e = miss(m, k, trig_of(nt, nd), q);
+            if (e < best) {
+                best = e;
+                *t = nt;
+                *d = nd;
+                improved = true;
+            } else {
+                lam *= 0.25;
+            }
+        }
+        if (!improved)
+            break;
+    }
+    *err = best;
+    return best <= PM_INVERT_TOL ? PM_OK : PM_WARN_NOT_CONVERGED;
+}
+
+/* Shared inverse: side = +1/-1, or use the start position. */
+pm_status invert(const pm_model *m, double app_ha, double app_dec, int side,
+                 const double *start, double *enc_ha, double *enc_dec)
+{
+    pm_status st = model_ready(m);
+    if (st != PM_OK)
+        return st;
+    if (!enc_ha || !enc_dec)
+        return PM_ERR_ARG;
+    if (!finite(app_ha) || !finite(app_dec) ||
+        (start && (!finite(start[0]) || !finite(start[1]))))
+        return PM_ERR_NONFINITE;
+    if (m_fabs(app_dec) > PI / 2 + 1e-12)
+        return PM_ERR_ARG;
+
+    Iso<double> k;
+    iso_from_model<double>(m, &k);
+    V3<double> q = unit_of(app_ha, app_dec);
+
+    double dt_prev = 0, dd_prev = 0;
+    Trig<double> g;
+    if (start) {
+        g = trig_of(start[0], start[1]);
+        side = g.cd >= 0 ? 1 : -1;
+        aniso<double>(m, g, &dt_prev, &dd_prev);
+    }
+    bool reachable = iso_inverse<double>(k, q, dt_prev, dd_prev, side, &g);
+
+    /* Fixed point: x_{n+1} = iso_inverse(D(x_n)).  x_n misses the target
+    ** by |D(x_n) - D(x_{n-1})| (to first order), which is the test. */
+    double change = 0, last_change = 1e300;
+    bool converged = false;
+    for (int it = 0; it < PM_INVERT_MAX_FIXED; it++) {
+        double dt, dd;
+        aniso<double>(m, g, &dt, &dd);
+        change = m_sqrt((dt - dt_prev) * (dt - dt_prev) +
+                        (dd - dd_prev) * (dd - dd_prev));
+        if (change <= PM_INVERT_TOL * 0.5) {
+            converged = true;
+            break;
+        }
+        if (it > 0 && change > 0.5 * last_change)
+            break; /* not contracting: Newton takes over */
+        last_change = change;
+        dt_prev = dt;
+        dd_prev = dd;
+        reachable = iso_inverse<double>(k, q, dt, dd, side, &g);
+    }
+
+    double t = m_atan2(g.st, g.ct);
+    double d = m_atan2(g.sd, g.cd); /* in (-pi, pi] */
+    if (side < 0 && d < 0)
+        d += 2 * PI; /* beyond the pole: report in (pi/2, 3pi/2) */
+    pm_status result = PM_OK;
+    if (!converged || !reachable) {
+        double err;
+        result = newton(m, k, q, app_ha, app_dec, &t, &d, &err);
+        if (result != PM_OK && !reachable)
+            result = PM_WARN_UNREACHABLE;
+    }
+    if (start) {
+        double off = wrap_pi(t - start[0]);
+        t = start[0] + off;
+    } else {
+        t = wrap_pi(t);
+    }
+    *enc_ha = t;
+    *enc_dec = d;
+    return result;
+}
+
+} /* namespace */
+
+extern "C" {
+
+pm_status pm_model_init(pm_model *m, int mount, int order)
+{
+    if (!m)
+        return PM_ERR_ARG;
+    if (mount != PM_MOUNT_EQUATORIAL && mount != PM_MOUNT_ALTAZ)
+        return PM_ERR_ARG;
+    if (order < 0 || order > PM_MAX_L)
+        return PM_ERR_CAPACITY;
+    __builtin_memset(m, 0, sizeof *m);
+    m->mount = mount;
+    m->order = order;
+    int n = 0;
+    for (int l = 0; l <= order; l++)
+        for (int mm = -l; mm <= l; mm++)
+            for (int k = 1; k <= 6; k++) {
+                if (dropped(k, l, mm))
+                    continue;
+                m->term[n].kind = PM_TERM_SH;
+                m->term[n].k = (unsigned char)k;
+                m->term[n].l = (signed char)l;
+                m->term[n].m = (signed char)mm;
+                n++;
+            }
+    m->n_terms = n;
+    return pm_model_prepare(m);
+}
+
+pm_status pm_model_prepare(pm_model *m)
+{
+    if (!m)
+        return PM_ERR_ARG;
+    if (m->mount != PM_MOUNT_EQUATORIAL && m->mount != PM_MOUNT_ALTAZ)
+        return PM_ERR_ARG;
+    if (m->order < 0 || m->order > PM_MAX_L)
+        return PM_ERR_CAPACITY;
+    if (m->n_terms < 6 || m->n_terms > PM_MAX_TERMS)
+        return PM_ERR_CAPACITY;
+    for (int i = 0; i < m->n_terms; i++) {
+        const pm_term *t = &m->term[i];
+        if (t->kind != PM_TERM_SH || t->k < 1 || t->k > 6)
+            return PM_ERR_ARG;
+        if (i < 6 && (t->l != 0 || t->k != i + 1))
+            return PM_ERR_ARG; /* the six isotropic terms come first */
+        if (i >= 6 && (t->l < 1 || t->l > m->order || t->m < -t->l ||
+                       t->m > t->l))
+            return PM_ERR_ARG;
+        if (!finite(m->coef[i]))
+            return PM_ERR_NONFINITE;
+    }
+    /* polar-axis rotation H = exp([w]x), w = (a, b, 0) (Rodrigues) */
+    double a = m->coef[0], b = m->coef[1];
+    double th2 = a * a + b * b, A, B;
+    if (th2 < 1e-8) {
+        A = 1 - th2 / 6 + th2 * th2 / 120;
+        B = 0.5 - th2 / 24 + th2 * th2 / 720;
+    } else {
+        double th = m_sqrt(th2);
+        A = m_sin(th) / th;
+        B = (1 - m_cos(th)) / th2;
+    }
+    /* [w]x = [[0,0,b],[0,0,-a],[-b,a,0]]; [w]x^2 = w w^T - th2 I */
+    double K[9] = {0, 0, b, 0, 0, -a, -b, a, 0};
+    double W[3] = {a, b, 0};
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++) {
+            double k2 = W[r] * W[c] - (r == c ? th2 : 0.0);
+            m->h[3 * r + c] = (r == c ? 1.0 : 0.0) + A * K[3 * r + c] + B * k2;
+        }
+    m->sc = m_sin(m->coef[2]);
+    m->cc = m_cos(m->coef[2]);
+    m->sd = m_sin(m->coef[3]);
+    m->cd = m_cos(m->coef[3]);
+    m->se = m_sin(m->coef[4]);
+    m->ce = m_cos(m->coef[4]);
+    m->si = m_sin(m->coef[5]);
+    m->ci = m_cos(m->coef[5]);
+    /* harmonic coefficients per base vector, normalisation folded in */
+    __builtin_memset(m->dense, 0, sizeof m->dense);
+    for (int i = 6; i < m->n_terms; i++) {
+        const pm_term *t = &m->term[i];
+        int j = t->l * t->l + t->l + t->m;
+        m->dense[t->k - 1][j] += m->coef[i] * norm_lm(t->l, t->m);
+    }
+    for (int i = 0; i < PM_MAX_TERMS; i++)
+        m->prep_coef[i] = i < m->n_terms ? m->coef[i] : 0.0;
+    m->prepared = 1;
+    return PM_OK;
+}
+
+pm_status pm_model_find(const pm_model *m, int k, int l, int mm, int *index)
+{
+    if (!m || !index || m->n_terms > PM_MAX_TERMS)
+        return PM_ERR_ARG;
+    for (int i = 0; i < m->n_terms; i++) {
+        const pm_term *t = &m->term[i];
+        if (t->kind == PM_TERM_SH && t->k == k && t->l == l && t->m == mm) {
+            *index = i;
+            return PM_OK;
+        }
+    }
+    return PM_ERR_ARG;
+}
+
+pm_status pm_term_name(const pm_model *m, int index, char *buf, size_t len)
+{
+    if (!m || !buf || len < 2 || index < 0 || index >= m->n_terms ||
+        index >= PM_MAX_TERMS)
+        return PM_ERR_ARG;
+    const pm_term *t = &m->term[index];
+    if (t->k < 1 || t->k > 6)
+        return PM_ERR_ARG;
+    char tmp[32];
+    size_t n = 0;
+    switch (t->k) {
+    case 1: tmp[n++] = 'a'; break;
+    case 2: tmp[n++] = 'b'; break;
+    case 3: tmp[n++] = 'c'; tmp[n++] = '\''; break;
+    case 4: tmp[n++] = 'd'; break;
+    case 5: tmp[n++] = 'e'; tmp[n++] = '\''; break;
+    default: tmp[n++] = 'i'; break;
+    }
+    if (t->l > 0) {
+        const char *s = "*Y(";
+        while (*s)
+            tmp[n++] = *s++;
+        tmp[n++] = (char)('0' + t->l % 10);
+        tmp[n++] = ',';
+        int mm = t->m;
+        if (mm < 0) {
+            tmp[n++] = '-';
+            mm = -mm;
+        }
+        tmp[n++] = (char)('0' + mm % 10);
+        tmp[n++] = ')';
+    }
+    size_t i;
+    for (i = 0; i < n && i + 1 < len; i++)
+        buf[i] = tmp[i];
+    buf[i] = '\0';
+    return PM_OK;
+}
+
+pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
+                         double enc_ha, double enc_dec, double *app_ha,
+                         double *app_dec)
+{
+    (void)ctx; /* the harmonic terms use no context */
+    pm_status st = model_ready(m);
+    if (st != PM_OK)
+        return st;
+    if (!app_ha || !app_dec)
+        return PM_ERR_ARG;
+    if (!finite(enc_ha) || !finite(enc_dec))
+        return PM_ERR_NONFINITE;
+    Iso<double> k;
+    iso_from_model<double>(m, &k);
+    V3<double> p = forward_vec<double>(m, k, trig_of(enc_ha, enc_dec));
+    *app_ha = m_atan2(p.y, p.x);
+    *app_dec = m_atan2(p.z, m_sqrt(p.x * p.x + p.y * p.y));
+    return PM_OK;
+}
+
+pm_status pm_model_invert(const pm_model *m, const pm_context *ctx,
+                          double app_ha, double app_dec, int side,
+                          double *enc_ha, double *enc_dec)
+{
+    (void)ctx;
+    if (side != PM_SIDE_NORMAL && side != PM_SIDE_FLIPPED)
+        return PM_ERR_ARG;
+    return invert(m, app_ha, app_dec, side == PM_SIDE_NORMAL ? 1 : -1, 0,
+                  enc_ha, enc_dec);
+}
+
+pm_status pm_model_invert_near(const pm_model *m, const pm_context *ctx,
+                               double app_ha, double app_dec, double start_ha,
+                               double start_dec, double *enc_ha,
+                               double *enc_dec)
+{
+    (void)ctx;
+    double start[2] = {start_ha, start_dec};
+    return invert(m, app_ha, app_dec, 1, start, enc_ha, enc_dec);
+}
+
+pm_status pm_model_residual(const pm_model *m, const pm_context *ctx,
+                            double enc_ha, double enc_dec, double app_ha,
+                            double app_dec, double res[2])
+{
+    (void)ctx;
+    pm_status st = model_ready(m);
+    if (st != PM_OK)
+        return st;
+    if (!res)
+        return PM_ERR_ARG;
+    if (!finite(enc_ha) || !finite(enc_dec) || !finite(app_ha) ||
+        !finite(app_dec))
+        return PM_ERR_NONFINITE;
+    Iso<double> k;
+    iso_from_model<double>(m, &k);
+    V3<double> p = forward_vec<double>(m, k, trig_of(enc_ha, enc_dec));
+    V3<double> q = unit_of(app_ha, app_dec);
+    /* sky frame at the model position */
+    double rho = m_sqrt(p.x * p.x + p.y * p.y);
+    V3<double> e1, e2;
+    if (rho > 1e-15) {
+        e1 = v3(-p.y / rho, p.x / rho, 0.0);
+        e2 = v3(-p.z * p.x / rho, -p.z * p.y / rho, rho);
+    } else {
+        e1 = v3(0.0, 1.0, 0.0);
+        e2 = v3(-1.0, 0.0, 0.0);
+    }
+    /* log map at p: angle times direction */
+    double a = dot(q, e1), b = dot(q, e2);
+    double s = m_sqrt(a * a + b * b);
+    double f = s > 0 ? m_atan2(s, dot(p, q)) / s : 1.0;
+    res[0] = a * f;
+    res[1] = b * f;
+    return PM_OK;
+}
+
+pm_status pm_terms_eval(int order, double ha, double dec, double *out)
+{
+    if (!out)
+        return PM_ERR_ARG;
+    if (order < 0 || order > PM_MAX_L)
+        return PM_ERR_CAPACITY;
+    if (!finite(ha) || !finite(dec))
+        return PM_ERR_NONFINITE;
+    Trig<double> g = trig_of(ha, dec);
+    double Y[PM_N_HARM(PM_MAX_L)];
+    harmonics<double>(order, g, Y);
+    V3<double> et = v3(-g.st, g.ct, 0.0);
+    V3<double> ed = v3(-g.sd * g.ct, -g.sd * g.st, g.cd);
+    for (int l = 0; l <= order; l++)
+        for (int mm = -l; mm <= l; mm++) {
+            int j = l * l + l + mm;
+            double y = Y[j] * norm_lm(l, mm);
+            for (int k = 1; k <= 6; k++) {
+                double u, v;
+                base_uv<double>(k, g, &u, &v);
+                double *o = out + 3 * (6 * j + k - 1);
+                o[0] = y * (u * et.x + v * ed.x);
+                o[1] = y * (u * et.y + v * ed.y);
+                o[2] = y * (u * et.z + v * ed.z);
+            }
+        }
+    return PM_OK;
+}
+
+pm_status pm_check_config(size_t model_size, size_t fit_size, int max_l,
+                          int max_extra)
+{
+    if (model_size != sizeof(pm_model) || fit_size != sizeof(pm_fit) ||
+        max_l != PM_MAX_L || max_extra != PM_MAX_EXTRA)
+        return PM_ERR_CONFIG;
+    return PM_OK;
+}
+
+} /* extern "C" */

@@ -1,0 +1,370 @@
+/*
+**  pm_detail.hpp - internals of the pointing-model core (freestanding C++).
+**
+**  Templates over the scalar type so that one source serves double and
+**  (later) float builds.  No heap, no exceptions, no globals.
+*/
+#ifndef PM_DETAIL_HPP
+#define PM_DETAIL_HPP
+
+#include "pm.h"
+
+namespace pm {
+namespace detail {
+
+/* Math through the compiler builtins: the library stays freestanding and
+** the calls resolve to libm (or to instructions). */
+inline double m_sin(double x) { return __builtin_sin(x); }
+inline double m_cos(double x) { return __builtin_cos(x); }
+inline double m_atan2(double y, double x) { return __builtin_atan2(y, x); }
+inline double m_sqrt(double x) { return __builtin_sqrt(x); }
+inline double m_fabs(double x) { return __builtin_fabs(x); }
+inline float m_sin(float x) { return __builtin_sinf(x); }
+inline float m_cos(float x) { return __builtin_cosf(x); }
+inline float m_atan2(float y, float x) { return __builtin_atan2f(y, x); }
+inline float m_sqrt(float x) { return __builtin_sqrtf(x); }
+inline float m_fabs(float x) { return __builtin_fabsf(x); }
+
+inline bool finite(double x) { return x - x == 0.0; }
+
+const double PI = 3.14159265358979323846;
+
+template <typename T> struct V3 {
+    T x, y, z;
+};
+
+template <typename T> inline V3<T> v3(T x, T y, T z)
+{
+    V3<T> r;
+    r.x = x;
+    r.y = y;
+    r.z = z;
+    return r;
+}
+
+template <typename T> inline T dot(const V3<T> &a, const V3<T> &b)
+{
+    return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+
+template <typename T> inline V3<T> cross(const V3<T> &a, const V3<T> &b)
+{
+    return v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z,
+              a.x * b.y - a.y * b.x);
+}
+
+/* Rotations of the model, written out (Pal et al. Sec. 2):
+**   Pt(t) = Rz(t), Pd(d) = Ry(-d), X(d) = Rx(d), T(i) = Rz(i).
+** s, c are the sine and cosine of the angle. */
+template <typename T> inline V3<T> rot_z(T s, T c, const V3<T> &v)
+{
+    return v3(c * v.x - s * v.y, s * v.x + c * v.y, v.z);
+}
+template <typename T> inline V3<T> rot_zt(T s, T c, const V3<T> &v)
+{
+    return v3(c * v.x + s * v.y, -s * v.x + c * v.y, v.z);
+}
+template <typename T> inline V3<T> rot_x(T s, T c, const V3<T> &v)
+{
+    return v3(v.x, c * v.y - s * v.z, s * v.y + c * v.z);
+}
+template <typename T> inline V3<T> rot_xt(T s, T c, const V3<T> &v)
+{
+    return v3(v.x, c * v.y + s * v.z, -s * v.y + c * v.z);
+}
+/* Pd(d) = Ry(-d): (x,y,z) -> (c x - s z, y, s x + c z). */
+template <typename T> inline V3<T> rot_d(T s, T c, const V3<T> &v)
+{
+    return v3(c * v.x - s * v.z, v.y, s * v.x + c * v.z);
+}
+template <typename T> inline V3<T> rot_dt(T s, T c, const V3<T> &v)
+{
+    return v3(c * v.x + s * v.z, v.y, -s * v.x + c * v.z);
+}
+template <typename T> inline V3<T> mat_mul(const T *h, const V3<T> &v)
+{
+    return v3(h[0] * v.x + h[1] * v.y + h[2] * v.z,
+              h[3] * v.x + h[4] * v.y + h[5] * v.z,
+              h[6] * v.x + h[7] * v.y + h[8] * v.z);
+}
+template <typename T> inline V3<T> mat_tmul(const T *h, const V3<T> &v)
+{
+    return v3(h[0] * v.x + h[3] * v.y + h[6] * v.z,
+              h[1] * v.x + h[4] * v.y + h[7] * v.z,
+              h[2] * v.x + h[5] * v.y + h[8] * v.z);
+}
+
+/* Sine and cosine of one encoder position. */
+template <typename T> struct Trig {
+    T st, ct; /* axis 1 */
+    T sd, cd; /* axis 2 (cd signed: negative beyond the pole) */
+};
+
+/*
+** Raw harmonics: for j = l*l + l + m,
+**   Y[j] = P_l^|m|(sin d) * (cos m t  if m >= 0,  sin |m| t  if m < 0)
+** with P_l^m the associated Legendre function without the Condon-Shortley
+** phase and with (1-x^2)^(m/2) taken as cos(d)^m (signed), so that
+** Y(t+pi, pi-d) = Y(t, d) (Pal et al. Sec. 5.4).  The paper's normalisation
+** multiplies by norm_lm() (folded into the coefficients).  Recurrences
+** only: no trigonometric call.
+*/
+template <typename T> inline void harmonics(int L, const Trig<T> &g, T *Y)
+{
+    T cm = 1, sm = 0;  /* cos(m t), sin(m t) */
+    T pmm = 1;         /* P_m^m */
+    for (int m = 0; m <= L; m++) {
+        if (m > 0) {
+            T c2 = cm * g.ct - sm * g.st;
+            sm = sm * g.ct + cm * g.st;
+            cm = c2;
+            pmm = pmm * (T)(2 * m - 1) * g.cd;
+        }
+        T p2 = 0, p1 = pmm; /* P_{l-2}^m, P_{l-1}^m */
+        for (int l = m; l <= L; l++) {
+            T p;
+            if (l == m)
+                p = pmm;
+            else if (l == m + 1)
+                p = (T)(2 * m + 1) * g.sd * pmm;
+            else
+                p = ((T)(2 * l - 1) * g.sd * p1 - (T)(l + m - 1) * p2) /
+                    (T)(l - m);
+            if (l > m) {
+                p2 = p1;
+                p1 = p;
+            }
+            int j = l * l + l;
+            Y[j + m] = p * cm;
+            if (m > 0)
+                Y[j - m] = p * sm;
+        }
+    }
+}
+
+/* Normalisation N_lm reproducing the paper's Y_lm for l <= 2:
+** 1/(2l-1)!! for m != 0 (so Y_ll = cos^l d cos l t), and for m = 0:
+** 1 for l <= 1, 2 for l >= 2 (Y_20 = 3 sin^2 d - 1). */
+inline double norm_lm(int l, int m)
+{
+    if (m == 0)
+        return l >= 2 ? 2.0 : 1.0;
+    double f = 1.0;
+    for (int k = 2 * l - 1; k > 1; k -= 2)
+        f *= (double)k;
+    return 1.0 / f;
+}
+
+/* Tangent-plane components (along increasing axis 1 on the sky, along
+** increasing axis 2) of the paper's base vectors p_k at (t, d):
+**   p1 = x^p = (-sd ct, st)    p2 = y^p = (-sd st, -ct)    p3 = z^p = (cd, 0)
+**   p4 = (-sd, 0)              p5 = (0, -1)                p6 = (1, 0)
+** (Pal et al. Eq. tdvectexpansion, projected on e_t = (-st, ct, 0) and
+** e_d = (-sd ct, -sd st, cd)). */
+template <typename T>
+inline void base_uv(int k, const Trig<T> &g, T *u, T *v)
+{
+    switch (k) {
+    case 1: *u = -g.sd * g.ct; *v = g.st; break;
+    case 2: *u = -g.sd * g.st; *v = -g.ct; break;
+    case 3: *u = g.cd; *v = 0; break;
+    case 4: *u = -g.sd; *v = 0; break;
+    case 5: *u = 0; *v = -1; break;
+    default: *u = 1; *v = 0; break;
+    }
+}
+
+/* Unit vector displaced from (1,0,0) by the tangent offset (a, b) along y
+** and z: the exponential map.  Series below 1e-2 (error < 1e-15). */
+template <typename T> inline V3<T> expmap(T a, T b)
+{
+    T r2 = a * a + b * b;
+    T c, s;
+    if (r2 < (T)1e-4) {
+        c = 1 - r2 / 2 + r2 * r2 / 24 - r2 * r2 * r2 / 720;
+        s = 1 - r2 / 6 + r2 * r2 / 120 - r2 * r2 * r2 / 5040;
+    } else {
+        T r = m_sqrt(r2);
+        c = m_cos(r);
+        s = m_sin(r) / r;
+    }
+    return v3(c, a * s, b * s);
+}
+
+/* Inverse of expmap: tangent offset of unit vector q as seen from (1,0,0). */
+template <typename T> inline void logmap(const V3<T> &q, T *a, T *b)
+{
+    T s2 = q.y * q.y + q.z * q.z;
+    T f;
+    if (s2 < (T)1e-4 && q.x > 0) {
+        /* theta/sin(theta) as a series in sin^2 */
+        f = 1 + s2 / 6 + (T)3 * s2 * s2 / 40 + (T)5 * s2 * s2 * s2 / 112;
+    } else {
+        T s = m_sqrt(s2);
+        f = s > 0 ? m_atan2(s, q.x) / s : (T)1;
+    }
+    *a = q.y * f;
+    *b = q.z * f;
+}
+
+/* Is the model ready for evaluation: prepared, and no coefficient changed
+** since (a stale model would be silently wrong). */
+inline pm_status model_ready(const pm_model *m)
+{
+    if (!m)
+        return PM_ERR_ARG;
+    if (m->prepared != 1 || m->n_terms < 6 || m->n_terms > PM_MAX_TERMS)
+        return PM_ERR_STATE;
+    for (int i = 0; i < m->n_terms; i++)
+        if (m->coef[i] != m->prep_coef[i])
+            return PM_ERR_STATE;
+    return PM_OK;
+}
+
+/* Model constants in working precision. */
+template <typename T> struct Iso {
+    T h[9];
+    T sc, cc, se, ce, sd, cd, si, ci;
+};
+
+template <typename T> inline void iso_from_model(const pm_model *m, Iso<T> *o)
+{
+    for (int i = 0; i < 9; i++)
+        o->h[i] = (T)m->h[i];
+    o->sc = (T)m->sc;
+    o->cc = (T)m->cc;
+    o->se = (T)m->se;
+    o->ce = (T)m->ce;
+    o->sd = (T)m->sd;
+    o->cd = (T)m->cd;
+    o->si = (T)m->si;
+    o->ci = (T)m->ci;
+}
+
+/* Anisotropic displacement (tangent components in the transported frame)
+** at encoder trig g: sum over the model's harmonic terms with l >= 1. */
+template <typename T>
+inline void aniso(const pm_model *m, const Trig<T> &g, T *dt, T *dd)
+{
+    T Y[PM_N_HARM(PM_MAX_L)];
+    T S[6] = {0, 0, 0, 0, 0, 0};
+    int nh = PM_N_HARM(m->order);
+    if (m->order > 0) {
+        harmonics<T>(m->order, g, Y);
+        for (int k = 0; k < 6; k++) {
+            const double *row = m->dense[k];
+            T acc = 0;
+            for (int j = 1; j < nh; j++)
+                acc += (T)row[j] * Y[j];
+            S[k] = acc;
+        }
+    }
+    /* sum_k S_k (u_k, v_k), written out */
+    *dt = -g.sd * (S[0] * g.ct + S[1] * g.st + S[3]) + g.cd * S[2] + S[5];
+    *dd = S[0] * g.st - S[1] * g.ct - S[4];
+}
+
+/* sin/cos of axis angles shifted by the index terms. */
+template <typename T>
+inline void shifted(const Iso<T> &k, const Trig<T> &g, T *stp, T *ctp, T *sdp,
+                    T *cdp)
+{
+    *stp = g.st * k.cc + g.ct * k.sc; /* t' = t + c' */
+    *ctp = g.ct * k.cc - g.st * k.sc;
+    *sdp = g.sd * k.ce - g.cd * k.se; /* d' = d - e' */
+    *cdp = g.cd * k.ce + g.sd * k.se;
+}
+
+/* Forward model as a unit vector: p' = H Pt(t') X(d) Pd(d') T(i) w. */
+template <typename T>
+inline V3<T> forward_vec(const pm_model *m, const Iso<T> &k, const Trig<T> &g)
+{
+    T dt, dd, stp, ctp, sdp, cdp;
+    aniso<T>(m, g, &dt, &dd);
+    shifted<T>(k, g, &stp, &ctp, &sdp, &cdp);
+    V3<T> w = expmap<T>(dt, dd);
+    w = rot_z<T>(k.si, k.ci, w);
+    w = rot_d<T>(sdp, cdp, w);
+    w = rot_x<T>(k.sd, k.cd, w);
+    w = rot_z<T>(stp, ctp, w);
+    return mat_mul<T>(k.h, w);
+}
+
+template <typename T> inline Trig<T> trig_of(T t, T d)
+{
+    Trig<T> g;
+    g.st = m_sin(t);
+    g.ct = m_cos(t);
+    g.sd = m_sin(d);
+    g.cd = m_cos(d);
+    return g;
+}
+
+template <typename T> inline V3<T> unit_of(T t, T d)
+{
+    T cd = m_cos(d);
+    return v3(cd * m_cos(t), cd * m_sin(t), m_sin(d));
+}
+
+/* Normalise (s, c) in place to a unit pair; returns false for (0,0). */
+template <typename T> inline bool unit_pair(T *s, T *c)
+{
+    T r = m_sqrt(*s * *s + *c * *c);
+    if (!(r > 0))
+        return false;
+    *s /= r;
+    *c /= r;
+    return true;
+}
+
+/*
+** Closed-form inverse of the isotropic part for a fixed anisotropic
+** displacement (dt, dd): the encoder trig g with
+**   H Pt(t+c') X(d) Pd(d-e') T(i) expmap(dt, dd) = q.
+** side: +1 normal branch, -1 beyond the pole.  Returns true if reachable;
+** if not, the nearest reachable point (branch boundary) is returned.
+*/
+template <typename T>
+inline bool iso_inverse(const Iso<T> &k, const V3<T> &q, T dt, T dd, int side,
+                        Trig<T> *g)
+{
+    V3<T> q0 = mat_tmul<T>(k.h, q);
+    V3<T> v = rot_z<T>(k.si, k.ci, expmap<T>(dt, dd));
+    /* With g = Pd(d') v and u = X(d) g: u_z = q0_z fixes g3, then u_y,
+    ** and |u_xy| = |q0_xy| fixes g1 up to the side. */
+    T g3 = (q0.z - k.sd * v.y) / k.cd;
+    T uy = k.cd * v.y - k.sd * g3;
+    T rho2 = q0.x * q0.x + q0.y * q0.y;
+    T disc = rho2 - uy * uy;
+    bool ok = true;
+    if (disc < 0) {
+        disc = 0;
+        ok = false;
+    }
+    T g1 = (T)side * m_sqrt(disc);
+    /* (g1 + i g3) = (vx + i vz) exp(i d'): d' = arg(g1 + i g3) - arg(v) */
+    T sdp = g3 * v.x - g1 * v.z;
+    T cdp = g1 * v.x + g3 * v.z;
+    if (!unit_pair<T>(&sdp, &cdp)) {
+        sdp = 0;
+        cdp = 1;
+    }
+    /* t' = arg(q0_xy) - arg(u_xy), u_x = g1 */
+    T stp = q0.y * g1 - q0.x * uy;
+    T ctp = q0.x * g1 + q0.y * uy;
+    if (!unit_pair<T>(&stp, &ctp)) {
+        stp = 0;
+        ctp = 1;
+    }
+    /* undo the index shifts: t = t' - c', d = d' + e' */
+    g->st = stp * k.cc - ctp * k.sc;
+    g->ct = ctp * k.cc + stp * k.sc;
+    g->sd = sdp * k.ce + cdp * k.se;
+    g->cd = cdp * k.ce - sdp * k.se;
+    return ok;
+}
+
+} /* namespace detail */
+} /* namespace pm */
+
+#endif
