@@ -31,7 +31,7 @@ TOOLS     := $(TOOL_SRC:tools/%.cpp=$(B)/%)
 TEST_SRC  := $(wildcard tests/check_*.c)
 TESTS     := $(TEST_SRC:tests/%.c=$(B)/tests/%)
 
-.PHONY: all test check-freestanding check-c89 install clean bench firmware demo
+.PHONY: all test test-run deps check-freestanding check-c89 check-example install clean bench firmware demo
 all: $(B)/libpm.a $(B)/libpm.so $(B)/libpmhost.a $(TOOLS)
 
 $(B)/core/%.o: lib/%.cpp $(wildcard include/*.h lib/*.hpp)
@@ -77,7 +77,22 @@ check-freestanding: $(B)/libpm.a
 	if [ -n "$$bad" ]; then echo "check-freestanding: FAIL, the core needs:"; echo "$$bad"; exit 1; fi; \
 	echo "check-freestanding: OK (external symbols: $$(tr '\n' ' ' < $(B)/core.undefined))"
 
-test: all check-c89 check-freestanding $(TESTS)
+# The README's commands install missing Debian packages first (tools/deps.sh).
+deps:
+	@sh tools/deps.sh
+
+test: deps
+	@$(MAKE) --no-print-directory test-run
+
+# The README's C example, compiled as strict C89 and run on a synthetic run.
+check-example: $(B)/libpm.a
+	@mkdir -p $(B)
+	$(CC) -std=c89 -pedantic -Werror -Wall -Wextra -Iinclude -c examples/fit_and_apply.c -o $(B)/fit_and_apply.o
+	$(CC) -std=c99 -Iinclude examples/fit_and_apply_main.c $(B)/fit_and_apply.o $(B)/libpm.a -lm -o $(B)/fit_and_apply
+	$(B)/fit_and_apply > $(B)/fit_and_apply.out
+	@echo "check-example: README example builds as C89 and runs"
+
+test-run: all check-c89 check-freestanding check-example $(TESTS)
 	@$(PYTHON) -c 'import numpy' 2>/dev/null || echo "note: numpy missing; reference tables are committed, regeneration needs python3-numpy"
 	@fail=0; total_run=0; total_fail=0; \
 	for t in $(TESTS); do \

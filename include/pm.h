@@ -358,6 +358,11 @@ typedef struct pm_fit {
     double cov[PM_PACKED(PM_MAX_TERMS)]; /* after a solve: (J^T J)^-1 */
     double scale[PM_MAX_TERMS];          /* column equilibration */
     pm_model lin;                        /* linearisation point */
+    double base_coef[PM_MAX_TERMS];      /* last accepted point */
+    double step[PM_MAX_TERMS];           /* step taken from it */
+    double base_chi2;                    /* chi^2 at the accepted point */
+    double base_pred;                    /* chi^2 decrease its step predicted */
+    int halvings;                        /* step halvings since then */
     int bad_term;                        /* term index after PM_ERR_SINGULAR */
     int iterations;                      /* passes solved so far */
 } pm_fit;
@@ -370,6 +375,7 @@ typedef struct pm_fit_result {
     double sigma;                  /* unbiased residual sqrt(chi2/(2N-P)) (rad) */
     double err[PM_MAX_TERMS];      /* 1-sigma error of each coefficient (rad) */
     double max_step;               /* largest |step| / error of this pass */
+    int accepted;                  /* 0: chi^2 rose, the step was halved */
     int converged;                 /* 1 when the step was negligible */
     int iterations;                /* passes so far */
 } pm_fit_result;
@@ -425,7 +431,16 @@ pm_status pm_fit_add(pm_fit *fit, const pm_context *ctx,
 **     pm_fit_add starts a new pass linearised at *out.  Feed the same
 **     observations again until res->converged (Gauss-Newton); pm_fit_run
 **     does the loop for observations held in arrays.
-**  3) On error *out and *res are unchanged and the accumulated pass is kept.
+**  3) Convergence: every step below 1e-6 of its 1-sigma error (or 1e-15
+**     rad), or a predicted chi^2 decrease s^T J^T r below 1e-12 of chi^2.
+**  4) Damping (Armijo): a pass whose chi^2 did not fall by at least 1e-4 of
+**     what the step predicted is rejected: the step is halved, *out is the
+**     new trial point and res->accepted is 0 (the other fields of *res are
+**     left as they were).  After 40 halvings the accepted point is returned
+**     as converged.  So chi^2 never increases, which matters when terms are
+**     nearly degenerate (one pier side only, narrow sky) and residuals
+**     large, where undamped Gauss-Newton can oscillate.
+**  5) On error *out and *res are unchanged and the accumulated pass is kept.
 */
 pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res);
 

@@ -224,6 +224,11 @@ pm_status pm_fit_init(pm_fit *fit, const pm_model *start)
     fit->n_par = start->n_terms;
     fit->bad_term = -1;
     fit->iterations = 0;
+    fit->base_chi2 = 0;
+    fit->base_pred = 0;
+    fit->halvings = 0;
+    for (int i = 0; i < PM_MAX_TERMS; i++)
+        fit->base_coef[i] = fit->step[i] = 0;
     reset_pass(fit);
     for (int i = 0; i < PM_MAX_TERMS; i++)
         fit->scale[i] = 0;
@@ -274,6 +279,37 @@ pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res)
     if (2 * fit->n_obs <= P)
         return PM_ERR_TOO_FEW;
 
+    /* Damping (Armijo): the step s from the accepted point predicted a
+    ** decrease s^T J^T r of chi^2; a pass that did not realise at least 1e-4
+    ** of it (for the current step fraction) is rejected and s halved. */
+    double frac = 1.0;
+    for (int h = 0; h < fit->halvings; h++)
+        frac *= 0.5;
+    if (fit->iterations > 0 &&
+        fit->chi2 > fit->base_chi2 - 1e-4 * frac * fit->base_pred) {
+        pm_model next = fit->lin;
+        bool give_up = fit->halvings >= 40;
+        for (int i = 0; i < P; i++) {
+            if (!give_up)
+                fit->step[i] *= 0.5;
+            next.coef[i] = fit->base_coef[i] + (give_up ? 0.0 : fit->step[i]);
+        }
+        pm_status st = pm_model_prepare(&next);
+        if (st != PM_OK)
+            return st;
+        fit->halvings++;
+        fit->iterations++;
+        if (res) {
+            res->accepted = 0;
+            res->converged = give_up ? 1 : 0;
+            res->iterations = fit->iterations;
+        }
+        *out = next;
+        fit->lin = next;
+        reset_pass(fit);
+        return PM_OK;
+    }
+
     /* column equilibration: unit diagonal */
     for (int j = 0; j < P; j++) {
         double d = fit->ata[pidx(j, j)];
@@ -304,16 +340,24 @@ pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res)
             fit->cov[pidx(i, j)] *= fit->scale[i] * fit->scale[j];
 
     pm_model next = fit->lin;
-    for (int i = 0; i < P; i++)
+    for (int i = 0; i < P; i++) {
+        fit->base_coef[i] = fit->lin.coef[i];
+        fit->step[i] = step[i];
         next.coef[i] += step[i];
+    }
     pm_status st = pm_model_prepare(&next);
     if (st != PM_OK)
         return st;
 
     long dof = 2 * fit->n_obs - P;
     double sigma = m_sqrt(fit->chi2 / (double)dof);
-    double max_step = 0;
-    int converged = 1;
+    double max_step = 0, pred = 0;
+    for (int i = 0; i < P; i++)
+        pred += step[i] * fit->atb[i]; /* predicted chi^2 decrease */
+    /* Converged: every step negligible against its error, or the predicted
+    ** decrease of chi^2 below rounding-level relevance. */
+    int converged = pred <= 1e-12 * fit->chi2 ? 1 : 0;
+    int small = 1;
     double err[PM_MAX_TERMS];
     for (int i = 0; i < P; i++) {
         err[i] = sigma * m_sqrt(fit->cov[pidx(i, i)]);
@@ -321,10 +365,15 @@ pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res)
         if (err[i] > 0 && a / err[i] > max_step)
             max_step = a / err[i];
         if (a > 1e-6 * err[i] + 1e-15)
-            converged = 0;
+            small = 0;
     }
+    converged = converged || small;
     fit->iterations++;
+    fit->base_chi2 = fit->chi2;
+    fit->base_pred = pred;
+    fit->halvings = 0;
     if (res) {
+        res->accepted = 1;
         res->n_obs = fit->n_obs;
         res->n_par = P;
         res->chi2 = fit->chi2;
@@ -355,6 +404,7 @@ pm_status pm_fit_run(pm_fit *fit, pm_model *model, const pm_context *ctx,
         return st;
     pm_model cur = *model;
     pm_fit_result r;
+    __builtin_memset(&r, 0, sizeof r);
     for (int it = 0; it < max_iter; it++) {
         for (long i = 0; i < n; i++) {
             st = pm_fit_add(fit, ctx ? ctx + i : 0, enc_ha[i], enc_dec[i],

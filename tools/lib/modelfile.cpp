@@ -1,0 +1,288 @@
+// modelfile.cpp - text model files and C-header emission (host side).
+#include "modelfile.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cctype>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+void set_err(char *err, size_t len, const std::string &msg)
+{
+    if (err && len) {
+        std::snprintf(err, len, "%s", msg.c_str());
+    }
+}
+
+std::string name_of(const pm_model *m, int i)
+{
+    char buf[32];
+    pm_term_name(m, i, buf, sizeof buf);
+    return buf;
+}
+
+// Write text to path through a temporary file and a rename.
+int write_atomic(const char *path, const std::string &text, char *err, size_t errlen)
+{
+    std::string tmp = std::string(path) + ".tmp";
+    FILE *f = std::fopen(tmp.c_str(), "w");
+    if (!f) {
+        set_err(err, errlen, std::string(path) + ": cannot write: " + std::strerror(errno));
+        return -1;
+    }
+    bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
+    ok = (std::fclose(f) == 0) && ok;
+    if (!ok || std::rename(tmp.c_str(), path) != 0) {
+        std::remove(tmp.c_str());
+        set_err(err, errlen, std::string(path) + ": cannot write: " + std::strerror(errno));
+        return -1;
+    }
+    return 0;
+}
+
+void comment_lines(std::string &out, const char *comment, const char *lead)
+{
+    if (!comment)
+        return;
+    std::istringstream in(comment);
+    std::string line;
+    while (std::getline(in, line))
+        out += std::string(lead) + line + "\n";
+}
+
+bool parse_double(const std::string &s, double *v)
+{
+    if (s.empty())
+        return false;
+    char *end = nullptr;
+    errno = 0;
+    double x = std::strtod(s.c_str(), &end);
+    if (*end || errno == ERANGE || !std::isfinite(x))
+        return false;
+    *v = x;
+    return true;
+}
+
+bool parse_int(const std::string &s, long lo, long hi, long *v)
+{
+    if (s.empty())
+        return false;
+    char *end = nullptr;
+    long x = std::strtol(s.c_str(), &end, 10);
+    if (*end || x < lo || x > hi)
+        return false;
+    *v = x;
+    return true;
+}
+
+} // namespace
+
+extern "C" int pmmodel_save(const char *path, const pm_model *m, const char *comment,
+                            char *err, size_t errlen)
+{
+    if (!path || !m || m->n_terms < 6 || m->n_terms > PM_MAX_TERMS) {
+        set_err(err, errlen, "pmmodel_save: invalid arguments");
+        return -1;
+    }
+    std::string out;
+    comment_lines(out, comment, "# ");
+    out += "pm-model 1\n";
+    out += std::string("mount ") + (m->mount == PM_MOUNT_ALTAZ ? "altaz" : "equatorial") + "\n";
+    out += "order " + std::to_string(m->order) + "\n";
+    out += "terms " + std::to_string(m->n_terms) + "\n";
+    out += "# name k l m value_rad\n";
+    for (int i = 0; i < m->n_terms; i++) {
+        char buf[128];
+        std::snprintf(buf, sizeof buf, "term %s %d %d %d %.17g\n", name_of(m, i).c_str(),
+                      m->term[i].k, m->term[i].l, m->term[i].m, m->coef[i]);
+        out += buf;
+    }
+    out += "end\n";
+    return write_atomic(path, out, err, errlen);
+}
+
+extern "C" int pmmodel_load(const char *path, pm_model *out, char *err, size_t errlen)
+{
+    if (!path || !out) {
+        set_err(err, errlen, "pmmodel_load: invalid arguments");
+        return -1;
+    }
+    std::ifstream in(path, std::ios::binary);
+    if (!in) {
+        set_err(err, errlen, std::string(path) + ": cannot open: " + std::strerror(errno));
+        return -1;
+    }
+    const size_t MAX_LINE = 4096;
+    std::string line;
+    int lineno = 0;
+    auto fail = [&](const std::string &msg) {
+        set_err(err, errlen, std::string(path) + ":" + std::to_string(lineno) + ": " + msg);
+        return -1;
+    };
+    enum { HEADER, MOUNT, ORDER, TERMS, BODY, DONE } state = HEADER;
+    int mount = 0;
+    long order = 0, nterms = 0;
+    pm_model m;
+    std::memset(&m, 0, sizeof m);
+    int got = 0;
+    while (std::getline(in, line)) {
+        lineno++;
+        if (line.size() > MAX_LINE)
+            return fail("line longer than " + std::to_string(MAX_LINE) + " bytes");
+        if (line.find('\0') != std::string::npos)
+            return fail("binary data (NUL byte); expected a text model file");
+        if (!line.empty() && line.back() == '\r')
+            line.pop_back();
+        std::istringstream ls(line);
+        std::vector<std::string> tok;
+        std::string t;
+        while (ls >> t)
+            tok.push_back(t);
+        if (tok.empty() || tok[0][0] == '#')
+            continue;
+        switch (state) {
+        case HEADER:
+            if (tok.size() != 2 || tok[0] != "pm-model")
+                return fail("expected 'pm-model 1' (is this a pm model file?)");
+            if (tok[1] != "1")
+                return fail("model file version '" + tok[1] + "' not supported (expected 1)");
+            state = MOUNT;
+            break;
+        case MOUNT:
+            if (tok.size() != 2 || tok[0] != "mount" || (tok[1] != "equatorial" && tok[1] != "altaz"))
+                return fail("expected 'mount equatorial' or 'mount altaz'");
+            mount = tok[1] == "altaz" ? PM_MOUNT_ALTAZ : PM_MOUNT_EQUATORIAL;
+            state = ORDER;
+            break;
+        case ORDER:
+            if (tok.size() != 2 || tok[0] != "order" || !parse_int(tok[1], 0, 1000, &order))
+                return fail("expected 'order L' with an integer L >= 0");
+            if (order > PM_MAX_L)
+                return fail("model order " + std::to_string(order) +
+                            " exceeds this build's PM_MAX_L = " + std::to_string(PM_MAX_L) +
+                            " (rebuild with -DPM_MAX_L=" + std::to_string(order) + ")");
+            state = TERMS;
+            break;
+        case TERMS:
+            if (tok.size() != 2 || tok[0] != "terms" || !parse_int(tok[1], 6, 100000, &nterms))
+                return fail("expected 'terms P' with an integer P >= 6");
+            if (nterms > PM_MAX_TERMS)
+                return fail(std::to_string(nterms) + " terms exceed this build's capacity of " +
+                            std::to_string(PM_MAX_TERMS));
+            m.mount = mount;
+            m.order = (int)order;
+            m.n_terms = (int)nterms;
+            state = BODY;
+            break;
+        case BODY: {
+            if (tok.size() == 1 && tok[0] == "end") {
+                if (got != nterms)
+                    return fail("'end' after " + std::to_string(got) + " terms; the header says " +
+                                std::to_string(nterms));
+                state = DONE;
+                break;
+            }
+            long k, l, mm;
+            double v;
+            if (tok.size() != 6 || tok[0] != "term")
+                return fail("expected 'term NAME k l m value' or 'end'");
+            if (got >= nterms)
+                return fail("more terms than the header's " + std::to_string(nterms));
+            if (!parse_int(tok[2], 1, 6, &k) || !parse_int(tok[3], 0, order, &l) ||
+                !parse_int(tok[4], -l, l, &mm))
+                return fail("bad term indices '" + tok[2] + " " + tok[3] + " " + tok[4] +
+                            "' (expected k in 1..6, l in 0..order, |m| <= l)");
+            if (!parse_double(tok[5], &v))
+                return fail("bad value '" + tok[5] + "' (expected a finite number, radians)");
+            m.term[got].kind = PM_TERM_SH;
+            m.term[got].k = (unsigned char)k;
+            m.term[got].l = (signed char)l;
+            m.term[got].m = (signed char)mm;
+            m.coef[got] = v;
+            got++;
+            break;
+        }
+        case DONE:
+            return fail("text after 'end'");
+        }
+    }
+    if (in.bad())
+        return fail("read error");
+    if (state != DONE) {
+        lineno++;
+        return fail(state == HEADER ? "empty file; expected a pm model file"
+                                    : "file ends before 'end' (truncated?)");
+    }
+    pm_status st = pm_model_prepare(&m);
+    if (st != PM_OK) {
+        set_err(err, errlen, std::string(path) + ": the terms do not form a valid model "
+                             "(the six isotropic terms a b c' d e' i must come first, in order)");
+        return -1;
+    }
+    *out = m;
+    return 0;
+}
+
+extern "C" int pmmodel_emit_c(const char *path, const pm_model *m, const char *prefix,
+                              const char *comment, char *err, size_t errlen)
+{
+    if (!path || !m || !prefix || m->n_terms < 6 || m->n_terms > PM_MAX_TERMS) {
+        set_err(err, errlen, "pmmodel_emit_c: invalid arguments");
+        return -1;
+    }
+    std::string p = prefix;
+    std::string guard;
+    for (char c : p)
+        guard += (char)std::toupper((unsigned char)c);
+    guard += "_MODEL_H";
+    std::string o = "/*\n** Pointing model as constant data, written by pmfit --emit-c.\n";
+    comment_lines(o, comment, "** ");
+    o += "**\n** Use:  pm_model m;  if (" + p + "_load(&m) != PM_OK) ...\n*/\n";
+    o += "#ifndef " + guard + "\n#define " + guard + "\n\n#include \"pm.h\"\n\n";
+    o += "#if PM_MAX_L < " + std::to_string(m->order) + "\n#error \"this model needs PM_MAX_L >= " +
+         std::to_string(m->order) + "\"\n#endif\n\n";
+    o += "#define " + guard.substr(0, guard.size() - 2) + "_MOUNT " +
+         (m->mount == PM_MOUNT_ALTAZ ? "PM_MOUNT_ALTAZ" : "PM_MOUNT_EQUATORIAL") + "\n";
+    o += "#define " + guard.substr(0, guard.size() - 2) + "_ORDER " + std::to_string(m->order) + "\n";
+    o += "#define " + guard.substr(0, guard.size() - 2) + "_NTERMS " + std::to_string(m->n_terms) +
+         "\n\n";
+    o += "/* coefficients (radians) */\nstatic const double " + p + "_coef[" +
+         std::to_string(m->n_terms) + "] = {\n";
+    for (int i = 0; i < m->n_terms; i++) {
+        char buf[96];
+        std::snprintf(buf, sizeof buf, "    %.17g%s /* %s */\n", m->coef[i],
+                      i + 1 < m->n_terms ? "," : "", name_of(m, i).c_str());
+        o += buf;
+    }
+    o += "};\n\n/* terms: base vector k, degree l, order m */\nstatic const signed char " + p +
+         "_terms[" + std::to_string(m->n_terms) + "][3] = {\n";
+    for (int i = 0; i < m->n_terms; i++) {
+        char buf[64];
+        std::snprintf(buf, sizeof buf, "    {%d, %d, %d}%s\n", m->term[i].k, m->term[i].l,
+                      m->term[i].m, i + 1 < m->n_terms ? "," : "");
+        o += buf;
+    }
+    std::string G = guard.substr(0, guard.size() - 2);
+    o += "};\n\n"
+         "/* Fill *m with this model (term list checked against the library's). */\n"
+         "static pm_status " + p + "_load(pm_model *m)\n{\n"
+         "    int i;\n"
+         "    pm_status s = pm_model_init(m, " + G + "_MOUNT, " + G + "_ORDER);\n"
+         "    if (s != PM_OK)\n        return s;\n"
+         "    if (m->n_terms != " + G + "_NTERMS)\n        return PM_ERR_CONFIG;\n"
+         "    for (i = 0; i < " + G + "_NTERMS; i++) {\n"
+         "        if (m->term[i].k != " + p + "_terms[i][0] || m->term[i].l != " + p + "_terms[i][1] ||\n"
+         "            m->term[i].m != " + p + "_terms[i][2])\n"
+         "            return PM_ERR_CONFIG;\n"
+         "        m->coef[i] = " + p + "_coef[i];\n"
+         "    }\n"
+         "    return pm_model_prepare(m);\n}\n\n#endif\n";
+    return write_atomic(path, o, err, errlen);
+}
