@@ -356,6 +356,7 @@ typedef struct pm_fit {
                                             current pass, packed lower */
     double atb[PM_MAX_TERMS];            /* J^T r */
     double cov[PM_PACKED(PM_MAX_TERMS)]; /* after a solve: (J^T J)^-1 */
+    int cov_valid;                       /* cov belongs to the last solve */
     double scale[PM_MAX_TERMS];          /* column equilibration */
     pm_model lin;                        /* linearisation point */
     double base_coef[PM_MAX_TERMS];      /* last accepted point */
@@ -388,7 +389,9 @@ typedef struct pm_fit_result {
 **     start    const pm_model*  terms to fit and their starting values
 **                               (e.g. from pm_model_init: all zero)
 **  Returned (function value):
-**              pm_status   PM_OK; PM_ERR_ARG; PM_ERR_NONFINITE; PM_ERR_CAPACITY
+**              pm_status   PM_OK; PM_ERR_ARG; PM_ERR_STATE (start is not
+**                          prepared, or changed since: pm_model_prepare
+**                          reports what is wrong with it)
 */
 pm_status pm_fit_init(pm_fit *fit, const pm_model *start);
 
@@ -440,7 +443,9 @@ pm_status pm_fit_add(pm_fit *fit, const pm_context *ctx,
 **     as converged.  So chi^2 never increases, which matters when terms are
 **     nearly degenerate (one pier side only, narrow sky) and residuals
 **     large, where undamped Gauss-Newton can oscillate.
-**  5) On error *out and *res are unchanged and the accumulated pass is kept.
+**  5) On error *out and *res are unchanged and the accumulated pass is kept
+**     (more observations can be added and the solve retried); the
+**     covariance of the previous solve is no longer available.
 */
 pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res);
 
@@ -477,7 +482,9 @@ pm_status pm_fit_run(pm_fit *fit, pm_model *model, const pm_context *ctx,
 **     cov      double*         covariance sigma^2 (J^T J)^-1_ij
 **     corr     double*         correlation coefficient (may be NULL)
 **  Returned (function value):
-**              pm_status   PM_OK; PM_ERR_ARG; PM_ERR_STATE
+**              pm_status   PM_OK; PM_ERR_ARG; PM_ERR_STATE (no successful
+**                          solve yet, or the last solve failed: its
+**                          factorisation overwrote the covariance)
 */
 pm_status pm_fit_covariance(const pm_fit *fit, const pm_fit_result *res,
                             int i, int j, double *cov, double *corr);

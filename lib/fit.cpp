@@ -224,6 +224,7 @@ pm_status pm_fit_init(pm_fit *fit, const pm_model *start)
     fit->n_par = start->n_terms;
     fit->bad_term = -1;
     fit->iterations = 0;
+    fit->cov_valid = 0;
     fit->base_chi2 = 0;
     fit->base_pred = 0;
     fit->halvings = 0;
@@ -310,6 +311,10 @@ pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res)
         return PM_OK;
     }
 
+    /* From here fit->cov is overwritten: it is valid again only when this
+    ** solve succeeds (pm_fit_covariance checks). */
+    fit->cov_valid = 0;
+
     /* column equilibration: unit diagonal */
     for (int j = 0; j < P; j++) {
         double d = fit->ata[pidx(j, j)];
@@ -369,6 +374,7 @@ pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res)
     }
     converged = converged || small;
     fit->iterations++;
+    fit->cov_valid = 1;
     fit->base_chi2 = fit->chi2;
     fit->base_pred = pred;
     fit->halvings = 0;
@@ -430,7 +436,7 @@ pm_status pm_fit_covariance(const pm_fit *fit, const pm_fit_result *res,
 {
     if (!fit || !res || !cov)
         return PM_ERR_ARG;
-    if (fit->state != FIT_READY || fit->iterations < 1)
+    if (fit->state != FIT_READY || fit->iterations < 1 || !fit->cov_valid)
         return PM_ERR_STATE;
     if (i < 0 || j < 0 || i >= fit->n_par || j >= fit->n_par)
         return PM_ERR_ARG;
