@@ -31,7 +31,7 @@ TOOLS     := $(TOOL_SRC:tools/%.cpp=$(B)/%)
 TEST_SRC  := $(wildcard tests/check_*.c)
 TESTS     := $(TEST_SRC:tests/%.c=$(B)/tests/%)
 
-.PHONY: all test test-run deps check-freestanding check-c89 check-example install clean bench firmware demo
+.PHONY: all test test-run demo-run deps check-freestanding check-c89 check-example install clean bench firmware demo
 all: $(B)/libpm.a $(B)/libpm.so $(B)/libpmhost.a $(TOOLS)
 
 $(B)/core/%.o: lib/%.cpp $(wildcard include/*.h lib/*.hpp)
@@ -83,6 +83,26 @@ deps:
 
 test: deps
 	@$(MAKE) --no-print-directory test-run
+
+# The README's main job: fit the bundled example run at L=0,1,2 and, when
+# ../shared/data is there, the real recorded runs.
+DATA ?= ../shared/data
+demo: deps
+	@$(MAKE) --no-print-directory demo-run
+
+demo-run: all
+	@echo "== bundled example: a simulated German equatorial mount (examples/sim_gem.dat)"
+	$(B)/pmfit fit examples/sim_gem.dat --order 1 --residuals $(B)/sim_gem.res --save $(B)/sim_gem.pm
+	@for L in 0 2; do printf 'order %s: ' $$L; $(B)/pmfit fit examples/sim_gem.dat --order $$L --json | \
+	  sed -E 's/.*"n_params": ([0-9]+).*"sigma_arcsec": ([0-9.]+).*/P = \1, sigma = \2 arcsec/'; done
+	@if [ -d $(DATA) ]; then \
+	  echo "== real runs in $(DATA)"; \
+	  $(B)/pmfit fit $(DATA)/mmt/k_and_e.dat --order 1; \
+	  for f in mmt/k_and_e.dat celestial/gem-28.dat celestial/cgx-l-data.dat; do for L in 0 1 2; do \
+	    printf '%s order %s: ' $$f $$L; $(B)/pmfit fit $(DATA)/$$f --order $$L --json 2>&1 | \
+	    sed -E 's/.*"n_params": ([0-9]+).*"sigma_arcsec": ([0-9.]+).*/P = \1, sigma = \2 arcsec/'; \
+	  done; done; \
+	else echo "(no $(DATA): the real recorded runs are skipped)"; fi
 
 # The README's C example, compiled as strict C89 and run on a synthetic run.
 check-example: $(B)/libpm.a

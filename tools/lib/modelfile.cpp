@@ -1,5 +1,6 @@
 // modelfile.cpp - text model files and C-header emission (host side).
 #include "modelfile.h"
+#include "hostutil.hpp"
 
 #include <cerrno>
 #include <cmath>
@@ -14,37 +15,14 @@
 
 namespace {
 
-void set_err(char *err, size_t len, const std::string &msg)
-{
-    if (err && len) {
-        std::snprintf(err, len, "%s", msg.c_str());
-    }
-}
+using pmhost::set_err;
+using pmhost::write_atomic;
 
 std::string name_of(const pm_model *m, int i)
 {
     char buf[32];
     pm_term_name(m, i, buf, sizeof buf);
     return buf;
-}
-
-// Write text to path through a temporary file and a rename.
-int write_atomic(const char *path, const std::string &text, char *err, size_t errlen)
-{
-    std::string tmp = std::string(path) + ".tmp";
-    FILE *f = std::fopen(tmp.c_str(), "w");
-    if (!f) {
-        set_err(err, errlen, std::string(path) + ": cannot write: " + std::strerror(errno));
-        return -1;
-    }
-    bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-    ok = (std::fclose(f) == 0) && ok;
-    if (!ok || std::rename(tmp.c_str(), path) != 0) {
-        std::remove(tmp.c_str());
-        set_err(err, errlen, std::string(path) + ": cannot write: " + std::strerror(errno));
-        return -1;
-    }
-    return 0;
 }
 
 void comment_lines(std::string &out, const char *comment, const char *lead)

@@ -1,0 +1,232 @@
+/*
+**  check_pmfit.c - the pmfit program end to end: acceptance numbers on the
+**  real recorded runs (skipped without ../shared/data), the simulate/fit
+**  loop, model files, and command-line errors.
+*/
+#define _POSIX_C_SOURCE 200809L
+#include <check.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "pm.h"
+#include "modelfile.h"
+#include "testutil.h"
+
+/* MMT k_and_e.dat: an independent reference fit gets 0.747" (L=1) and
+** 0.560" (L=2); the issue's acceptance bounds are 0.76" and 0.57". */
+#define MMT_SIGMA_MAX_L1 0.76
+#define MMT_SIGMA_MAX_L2 0.57
+
+static char tmpdir[256];
+static char out[1 << 20];
+
+static void make_tmpdir(void)
+{
+    strcpy(tmpdir, "/tmp/pm_pmfit_XXXXXX");
+    ck_assert_ptr_nonnull(mkdtemp(tmpdir));
+}
+
+static const char *pmfit(void)
+{
+    static char path[512];
+    const char *top = getenv("PM_TOP");
+    snprintf(path, sizeof path, "%s/build/pmfit", top ? top : ".");
+    return path;
+}
+
+/* Run a shell command, capture stdout+stderr into out; return exit code. */
+static int run(const char *fmt, const char *a, const char *b)
+{
+    char cmd[4096];
+    FILE *p;
+    size_t n;
+    int st;
+    snprintf(cmd, sizeof cmd, fmt, pmfit(), a ? a : "", b ? b : "");
+    strncat(cmd, " 2>&1", sizeof cmd - strlen(cmd) - 1);
+    p = popen(cmd, "r");
+    ck_assert_ptr_nonnull(p);
+    n = fread(out, 1, sizeof out - 1, p);
+    out[n] = 0;
+    st = pclose(p);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+/* A number after "key": in the JSON output. */
+static double json_num(const char *json, const char *key)
+{
+    char pat[128];
+    const char *p;
+    snprintf(pat, sizeof pat, "\"%s\": ", key);
+    p = strstr(json, pat);
+    ck_assert_msg(p != NULL, "no %s in: %.300s", key, json);
+    return atof(p + strlen(pat));
+}
+
+static int have_data(const char *rel, char *path, size_t len)
+{
+    const char *d = tu_data_dir();
+    if (!d)
+        return 0;
+    snprintf(path, len, "%s/%s", d, rel);
+    if (access(path, R_OK) != 0)
+        return 0;
+    return 1;
+}
+
+START_TEST(test_pmfit_mmt_sigma)
+{
+    char path[512];
+    double s1, s2;
+    if (!have_data("mmt/k_and_e.dat", path, sizeof path)) {
+        printf("skipped: ../shared/data/mmt/k_and_e.dat absent\n");
+        return;
+    }
+    ck_assert_int_eq(run("%s fit %s --order 1 --json", path, NULL), 0);
+    s1 = json_num(out, "sigma_arcsec");
+    ck_assert_int_eq((int)json_num(out, "n_obs"), 80);
+    ck_assert_int_eq((int)json_num(out, "n_params"), 22);
+    ck_assert_int_eq(run("%s fit %s --order 2 --json", path, NULL), 0);
+    s2 = json_num(out, "sigma_arcsec");
+    ck_assert_int_eq((int)json_num(out, "n_params"), 46);
+    printf("MMT k_and_e: sigma L=1 %.4f\" (ref 0.747), L=2 %.4f\" (ref 0.560)\n", s1, s2);
+    ck_assert_double_le(s1, MMT_SIGMA_MAX_L1);
+    ck_assert_double_le(s2, MMT_SIGMA_MAX_L2);
+}
+END_TEST
+
+/* The GEM runs converge from zero despite a ~5 deg raw HA offset; the fitted
+** HA index must be of that size (the reader's median offset), at every order,
+** joint and split by pier side (where the split fit can separate its terms). */
+START_TEST(test_pmfit_gem_converges)
+{
+    const char *files[2] = {"celestial/gem-28.dat", "celestial/cgx-l-data.dat"};
+    int f, L;
+    for (f = 0; f < 2; f++) {
+        char path[512];
+        if (!have_data(files[f], path, sizeof path)) {
+            printf("skipped: ../shared/data/%s absent\n", files[f]);
+            continue;
+        }
+        for (L = 0; L <= 2; L++) {
+            char opt[64];
+            const char *p;
+            double cp;
+            snprintf(opt, sizeof opt, "--order %d --json", L);
+            ck_assert_msg(run("%s fit %s %s", path, opt) == 0, "%s L=%d: %s", files[f], L, out);
+            p = strstr(out, "\"name\": \"c'\", \"value_arcsec\": ");
+            ck_assert_ptr_nonnull(p);
+            cp = atof(p + strlen("\"name\": \"c'\", \"value_arcsec\": "));
+            printf("%s L=%d joint: sigma %.2f\", c' = %.3f deg\n", files[f], L,
+                   json_num(out, "sigma_arcsec"), cp / 3600);
+            ck_assert_double_gt(fabs(cp) / 3600, 2.0);  /* degrees, not arcseconds */
+            ck_assert_double_lt(fabs(cp) / 3600, 10.0);
+        }
+        /* split at L=0 and L=1 converges on both runs */
+        for (L = 0; L <= 1; L++) {
+            char opt[64];
+            snprintf(opt, sizeof opt, "--order %d --pier split --json", L);
+            ck_assert_msg(run("%s fit %s %s", path, opt) == 0, "%s L=%d split: %s", files[f], L,
+                          out);
+            ck_assert_ptr_nonnull(strstr(out, "\"east\""));
+            ck_assert_ptr_nonnull(strstr(out, "\"west\""));
+        }
+    }
+}
+END_TEST
+
+/* simulate -> fit recovers the injected isotropic terms; --save writes a
+** model file that reads back; --emit-c writes a header. */
+START_TEST(test_pmfit_simulate_fit_roundtrip)
+{
+    char run_path[300], model_path[300], hdr_path[300], args[1024];
+    pm_model m;
+    char err[512];
+    int i;
+    make_tmpdir();
+    snprintf(run_path, sizeof run_path, "%s/sim.dat", tmpdir);
+    snprintf(model_path, sizeof model_path, "%s/fit.pm", tmpdir);
+    snprintf(hdr_path, sizeof hdr_path, "%s/fit.h", tmpdir);
+    ck_assert_int_eq(run("%s simulate %s --n 600 --seed 9 --noise 0.5 --term \"c'=900\" "
+                         "--term \"e'=-300\" --term a=60 --term i=40 %s",
+                         run_path, ""), 0);
+    snprintf(args, sizeof args, "%s --order 1 --save %s --emit-c %s --json", run_path,
+             model_path, hdr_path);
+    ck_assert_msg(run("%s fit %s%s", args, "") == 0, "%s", out);
+    ck_assert_double_lt(fabs(json_num(out, "sigma_arcsec") - 0.5), 0.05);
+    ck_assert_int_eq(pmmodel_load(model_path, &m, err, sizeof err), 0);
+    ck_assert_int_eq(m.order, 1);
+    /* c' within 1 arcsec (its error is ~0.05") */
+    ck_assert_double_lt(fabs(m.coef[2] * 206264.806 - 900), 1.0);
+    ck_assert_double_lt(fabs(m.coef[4] * 206264.806 + 300), 1.0);
+    ck_assert_double_lt(fabs(m.coef[0] * 206264.806 - 60), 1.0);
+    for (i = 6; i < m.n_terms; i++)
+        ck_assert_double_lt(fabs(m.coef[i]) * 206264.806, 1.0);
+    ck_assert_int_eq(access(hdr_path, R_OK), 0);
+}
+END_TEST
+
+START_TEST(test_pmfit_cli_errors)
+{
+    char bad[300], res[300];
+    FILE *f;
+    make_tmpdir();
+    ck_assert_int_eq(run("%s%s%s", "", ""), 2);
+    ck_assert_int_eq(run("%s frobnicate%s%s", "", ""), 2);
+    ck_assert_ptr_nonnull(strstr(out, "unknown command"));
+    ck_assert_int_eq(run("%s fit%s%s", "", ""), 2);
+    ck_assert_ptr_nonnull(strstr(out, "no run file"));
+    ck_assert_int_eq(run("%s fit x.dat --order 99%s%s", "", ""), 2);
+    ck_assert_ptr_nonnull(strstr(out, "--order"));
+    ck_assert_int_eq(run("%s fit x.dat --pier sideways%s%s", "", ""), 2);
+    ck_assert_int_eq(run("%s fit x.dat --bogus%s%s", "", ""), 2);
+    ck_assert_ptr_nonnull(strstr(out, "unknown option"));
+    ck_assert_int_eq(run("%s fit /nonexistent/run.dat%s%s", "", ""), 1);
+    /* a malformed record: file:line in the message, no residual file left */
+    snprintf(bad, sizeof bad, "%s/bad.dat", tmpdir);
+    snprintf(res, sizeof res, "%s/res.txt", tmpdir);
+    f = fopen(bad, "w");
+    ck_assert_ptr_nonnull(f);
+    fputs("# tau delta T D\n10 20 10.1 20.1\n11 21 eleven 21.1\n", f);
+    fclose(f);
+    ck_assert_int_eq(run("%s fit %s --residuals %s", bad, res), 1);
+    ck_assert_msg(strstr(out, "bad.dat:3:") != NULL, "%s", out);
+    ck_assert_int_ne(access(res, F_OK), 0);
+    /* too few points for the order: a clear error, exit 1, nothing written */
+    f = fopen(bad, "w");
+    ck_assert_ptr_nonnull(f);
+    fputs("# tau delta T D\n10 20 10.1 20.1\n11 21 11.1 21.1\n40 50 40.1 50.1\n", f);
+    fclose(f);
+    ck_assert_int_eq(run("%s fit %s --order 1 --residuals %s", bad, res), 1);
+    ck_assert_msg(strstr(out, "too few") != NULL, "%s", out);
+    ck_assert_int_ne(access(res, F_OK), 0);
+}
+END_TEST
+
+static Suite *suite(void)
+{
+    Suite *s = suite_create("pmfit");
+    TCase *tc = tcase_create("realdata");
+    tcase_add_test(tc, test_pmfit_mmt_sigma);
+    tcase_add_test(tc, test_pmfit_gem_converges);
+    tcase_set_timeout(tc, 120);
+    suite_add_tcase(s, tc);
+    tc = tcase_create("tool");
+    tcase_add_test(tc, test_pmfit_simulate_fit_roundtrip);
+    tcase_add_test(tc, test_pmfit_cli_errors);
+    tcase_set_timeout(tc, 60);
+    suite_add_tcase(s, tc);
+    return s;
+}
+
+int main(void)
+{
+    SRunner *sr = srunner_create(suite());
+    int failed;
+    srunner_run_all(sr, CK_NORMAL);
+    failed = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+}

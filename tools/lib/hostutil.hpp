@@ -1,0 +1,20 @@
+// hostutil.hpp - small helpers shared by the host-side tools (C++).
+#ifndef PM_HOSTUTIL_HPP
+#define PM_HOSTUTIL_HPP
+
+#include <cstddef>
+#include <string>
+
+namespace pmhost {
+
+// Write text to path through "path.tmp" and a rename, so that a failure
+// never leaves a half-written file.  Returns 0, or -1 with a message in err
+// ("path: cannot write: reason").
+int write_atomic(const std::string &path, const std::string &text, char *err, size_t errlen);
+
+// Copy msg into err (truncated, NUL-terminated) if err is not NULL.
+void set_err(char *err, size_t errlen, const std::string &msg);
+
+} // namespace pmhost
+
+#endif

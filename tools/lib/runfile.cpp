@@ -1,0 +1,507 @@
+// runfile.cpp - the C API of the pointing-run reader (runfile.h): options,
+// accessors, the bounded line reader, format detection and the shared
+// helpers (messages, tokens, strict numbers).
+#include "runfile_internal.hpp"
+
+#include <cerrno>
+#include <charconv>
+#include <climits>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <new>
+
+namespace pmrun_detail {
+
+double nan() { return std::numeric_limits<double>::quiet_NaN(); }
+
+// ---------------------------------------------------------------- messages
+
+std::string vformat(const char *fmt, va_list ap)
+{
+    char small[512];
+    va_list ap2;
+    va_copy(ap2, ap);
+    int n = std::vsnprintf(small, sizeof small, fmt, ap2);
+    va_end(ap2);
+    if (n < 0) return std::string(fmt);
+    if (static_cast<size_t>(n) < sizeof small) return std::string(small, static_cast<size_t>(n));
+    std::string big(static_cast<size_t>(n) + 1, '\0');
+    std::vsnprintf(&big[0], big.size(), fmt, ap);
+    big.resize(static_cast<size_t>(n));
+    return big;
+}
+
+std::string format(const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    std::string s = vformat(fmt, ap);
+    va_end(ap);
+    return s;
+}
+
+Context::Context(const char *path, const pmrun_options &opt, pmrun *run)
+    : path_(path), opt_(opt), run_(run)
+{
+}
+
+std::string Context::where(int line) const
+{
+    if (line > 0) return path_ + ":" + std::to_string(line) + ": ";
+    return path_ + ": ";
+}
+
+bool Context::fail(int line, const char *fmt, ...)
+{
+    if (!failed()) {
+        va_list ap;
+        va_start(ap, fmt);
+        error_ = where(line) + vformat(fmt, ap);
+        va_end(ap);
+        status_ = PMRUN_ERR_FORMAT;
+    }
+    return false;
+}
+
+bool Context::fail_with(int status, int line, const char *fmt, ...)
+{
+    if (!failed()) {
+        va_list ap;
+        va_start(ap, fmt);
+        error_ = where(line) + vformat(fmt, ap);
+        va_end(ap);
+        status_ = status;
+    }
+    return false;
+}
+
+void Context::add_warning(const std::string &msg)
+{
+    if (run_->warnings.size() < PMRUN_MAX_MESSAGES)
+        run_->warnings.push_back(msg);
+    else
+        ++warnings_dropped_;
+}
+
+void Context::warn(int line, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    std::string msg = where(line) + vformat(fmt, ap);
+    va_end(ap);
+    add_warning(msg);
+}
+
+bool Context::bad_record(int line, const std::string &why)
+{
+    if (!opt_.skip_bad) return fail(line, "%s", why.c_str());
+    std::string msg = where(line) + "skipped: " + why;
+    if (run_->skipped.size() < PMRUN_MAX_MESSAGES) run_->skipped.push_back(msg);
+    ++run_->n_skipped;
+    add_warning(msg);
+    return true;
+}
+
+void Context::finish_messages()
+{
+    if (warnings_dropped_ > 0)
+        run_->warnings.push_back(where(0) + format("%ld more warnings not kept (at most %d are)",
+                                                   warnings_dropped_, PMRUN_MAX_MESSAGES));
+}
+
+// ------------------------------------------------------------------ text
+
+static bool is_space(char c)
+{
+    return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+}
+
+std::vector<std::string> tokens(const std::string &s)
+{
+    std::vector<std::string> out;
+    size_t i = 0, n = s.size();
+    while (i < n) {
+        while (i < n && is_space(s[i])) ++i;
+        size_t b = i;
+        while (i < n && !is_space(s[i])) ++i;
+        if (i > b) out.emplace_back(s, b, i - b);
+    }
+    return out;
+}
+
+std::string trim(const std::string &s)
+{
+    size_t b = 0, e = s.size();
+    while (b < e && is_space(s[b])) ++b;
+    while (e > b && is_space(s[e - 1])) --e;
+    return s.substr(b, e - b);
+}
+
+std::string lower(const std::string &s)
+{
+    std::string r(s);
+    for (char &c : r)
+        if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+    return r;
+}
+
+std::string strip_comment(const std::string &s, char c)
+{
+    for (size_t i = 0; i < s.size(); ++i)
+        if (s[i] == c && (i == 0 || is_space(s[i - 1]))) return trim(s.substr(0, i));
+    return s;
+}
+
+std::string excerpt(const std::string &s, size_t max)
+{
+    std::string r;
+    for (size_t i = 0; i < s.size() && r.size() < max; ++i) {
+        unsigned char c = static_cast<unsigned char>(s[i]);
+        if (c >= 0x20 && c < 0x7f)
+            r += static_cast<char>(c);
+        else
+            r += format("\\x%02x", c);
+    }
+    if (r.size() >= max && s.size() > max) r += "...";
+    return r;
+}
+
+// --------------------------------------------------------------- numbers
+
+static bool digits(const std::string &s, size_t &i)
+{
+    size_t b = i;
+    while (i < s.size() && s[i] >= '0' && s[i] <= '9') ++i;
+    return i > b;
+}
+
+static bool number_syntax(const std::string &s)
+{
+    size_t i = 0;
+    if (i < s.size() && (s[i] == '+' || s[i] == '-')) ++i;
+    bool intpart = digits(s, i);
+    bool frac = false;
+    if (i < s.size() && s[i] == '.') {
+        ++i;
+        frac = digits(s, i);
+    }
+    if (!intpart && !frac) return false;
+    if (i < s.size() && (s[i] == 'e' || s[i] == 'E')) {
+        ++i;
+        if (i < s.size() && (s[i] == '+' || s[i] == '-')) ++i;
+        if (!digits(s, i)) return false;
+    }
+    return i == s.size();
+}
+
+bool is_number(const std::string &tok)
+{
+    double v;
+    std::string why;
+    return parse_number(tok, v, why);
+}
+
+bool parse_number(const std::string &tok, double &v, std::string &why)
+{
+    std::string l = lower(tok);
+    std::string body = (!l.empty() && (l[0] == '+' || l[0] == '-')) ? l.substr(1) : l;
+    if (body == "nan" || body.compare(0, 4, "nan(") == 0 || body == "inf" || body == "infinity") {
+        why = "NaN/Inf is not accepted, expected a finite number";
+        return false;
+    }
+    if (!number_syntax(tok)) {
+        why = "not a number, expected a decimal number";
+        return false;
+    }
+    const char *b = tok.data();
+    const char *e = b + tok.size();
+    if (*b == '+') ++b;
+    double x = 0;
+    std::from_chars_result r = std::from_chars(b, e, x);
+    if (r.ec == std::errc::result_out_of_range || !std::isfinite(x)) {
+        why = "number out of range, expected a finite double";
+        return false;
+    }
+    if (r.ec != std::errc() || r.ptr != e) {
+        why = "not a number, expected a decimal number";
+        return false;
+    }
+    v = x;
+    return true;
+}
+
+double standard_pressure_hpa(double height_m) { return 1013.25 * std::exp(-height_m / 8434.5); }
+
+// ----------------------------------------------------------- line reader
+
+namespace {
+
+// Reads lines of at most PMRUN_MAX_LINE bytes through a fixed buffer; a
+// longer line is consumed to its end without being stored.
+class LineReader {
+public:
+    enum Result { kLine, kEof, kTooLong, kIoError };
+
+    explicit LineReader(std::FILE *f) : f_(f), buf_(1 << 16) {}
+
+    Result next(std::string &line, bool &nul)
+    {
+        line.clear();
+        nul = false;
+        bool too_long = false, any = false;
+        for (;;) {
+            if (pos_ == len_ && !fill()) {
+                if (err_) return kIoError;
+                if (!any) return kEof;
+                break;
+            }
+            any = true;
+            const char *start = buf_.data() + pos_;
+            size_t avail = len_ - pos_;
+            const char *nl = static_cast<const char *>(std::memchr(start, '\n', avail));
+            size_t n = nl ? static_cast<size_t>(nl - start) : avail;
+            if (!too_long) {
+                // +1: room for the CR of a CRLF line end.
+                if (line.size() + n > static_cast<size_t>(PMRUN_MAX_LINE) + 1) {
+                    too_long = true;
+                    std::string().swap(line);
+                } else {
+                    line.append(start, n);
+                }
+            }
+            pos_ += n;
+            if (nl) {
+                ++pos_;
+                break;
+            }
+        }
+        if (number_ == INT_MAX) return kIoError;
+        ++number_;
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        if (too_long || line.size() > static_cast<size_t>(PMRUN_MAX_LINE)) return kTooLong;
+        nul = std::memchr(line.data(), '\0', line.size()) != nullptr;
+        return kLine;
+    }
+
+    int number() const { return number_; }
+    bool io_error() const { return err_; }
+
+private:
+    bool fill()
+    {
+        if (eof_) return false;
+        len_ = std::fread(buf_.data(), 1, buf_.size(), f_);
+        pos_ = 0;
+        if (len_ == 0) {
+            eof_ = true;
+            err_ = std::ferror(f_) != 0;
+            return false;
+        }
+        return true;
+    }
+
+    std::FILE *f_;
+    std::vector<char> buf_;
+    size_t pos_ = 0, len_ = 0;
+    bool eof_ = false, err_ = false;
+    int number_ = 0;
+};
+
+struct FileCloser {
+    void operator()(std::FILE *f) const { std::fclose(f); }
+};
+
+const char *kExpectedAny =
+    "expected a pointing run: four numbers 'tau delta T D' per line, '#' comments and a "
+    "'# tau delta T D ...' column header, or a TPOINT file (caption, '!' comments, ':' "
+    "options, run line, records)";
+
+// Picks the format from the first non-blank line (docs/formats.md,
+// "Detection").
+std::unique_ptr<FormatParser> detect(Context &ctx, int n, const std::string &line)
+{
+    std::string t = trim(line);
+    if (t[0] == '#') return make_column_parser(ctx);
+    if (t[0] == '!' || t[0] == ':') return make_tpoint_parser(ctx);
+    std::vector<std::string> tok = tokens(strip_comment(t, '#'));
+    if (!tok.empty() && is_number(tok[0])) {
+        size_t nums = 0;
+        for (const std::string &s : tok) nums += is_number(s) ? 1 : 0;
+        if (nums == tok.size() && tok.size() == 4) return make_column_parser(ctx);
+        ctx.fail(n, "cannot tell the format: the first line '%s' starts with a number but is not "
+                    "four numbers 'tau delta T D' (a TPOINT caption must not start with a number); %s",
+                 excerpt(t).c_str(), kExpectedAny);
+        return nullptr;
+    }
+    return make_tpoint_parser(ctx);
+}
+
+int read_file(Context &ctx)
+{
+    std::FILE *raw = std::fopen(ctx.path().c_str(), "rb");
+    if (!raw) {
+        int e = errno;
+        ctx.fail_with(PMRUN_ERR_IO, 0, "cannot open: %s", std::strerror(e));
+        return ctx.status();
+    }
+    std::unique_ptr<std::FILE, FileCloser> f(raw);
+    LineReader rd(raw);
+    std::unique_ptr<FormatParser> parser;
+    std::string line;
+    bool nul = false;
+    bool any_text = false;
+    for (;;) {
+        LineReader::Result r = rd.next(line, nul);
+        if (r == LineReader::kEof) break;
+        if (r == LineReader::kIoError) {
+            if (rd.io_error())
+                ctx.fail_with(PMRUN_ERR_IO, rd.number() + 1, "read error: %s", std::strerror(errno));
+            else
+                ctx.fail(rd.number(), "too many lines: expected fewer than %d", INT_MAX);
+            return ctx.status();
+        }
+        int n = rd.number();
+        if (n == 1 && line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);  // UTF-8 BOM
+        std::string why;
+        if (r == LineReader::kTooLong)
+            why = format("line too long (more than %d bytes), expected at most %d bytes per line",
+                         PMRUN_MAX_LINE, PMRUN_MAX_LINE);
+        else if (nul)
+            why = "NUL byte in the line (binary data?), expected text";
+        any_text = true;
+        if (!parser) {
+            if (!why.empty()) {
+                ctx.fail(n, "%s; cannot tell the format", why.c_str());
+                return ctx.status();
+            }
+            if (trim(line).empty()) continue;
+            parser = detect(ctx, n, line);
+            if (!parser) return ctx.status();
+        }
+        bool ok = why.empty() ? parser->line(n, line) : parser->unreadable(n, why);
+        if (!ok) return ctx.status();
+    }
+    if (!parser) {
+        if (!any_text)
+            ctx.fail(0, "empty file: %s", kExpectedAny);
+        else
+            ctx.fail(rd.number(), "no records: the file holds only blank lines; %s", kExpectedAny);
+        return ctx.status();
+    }
+    if (!parser->finish(rd.number())) return ctx.status();
+    ctx.finish_messages();
+    return PMRUN_OK;
+}
+
+void set_error(char *err, size_t errlen, const std::string &msg)
+{
+    if (!err || errlen == 0) return;
+    size_t n = msg.size() < errlen - 1 ? msg.size() : errlen - 1;
+    std::memcpy(err, msg.data(), n);
+    err[n] = '\0';
+}
+
+}  // namespace
+}  // namespace pmrun_detail
+
+using namespace pmrun_detail;
+
+extern "C" {
+
+void pmrun_options_default(pmrun_options *opt)
+{
+    if (!opt) return;
+    opt->refraction = 1;
+    opt->skip_bad = 0;
+    opt->pressure_hpa = nan();
+    opt->temp_c = nan();
+    opt->humidity = nan();
+    opt->wavelength_um = nan();
+}
+
+int pmrun_read(const char *path, const pmrun_options *opt, pmrun **out, char *err, size_t errlen)
+{
+    if (out) *out = nullptr;
+    set_error(err, errlen, "");
+    if (!path || !out) {
+        set_error(err, errlen, "pmrun_read: NULL path or out pointer, expected both");
+        return PMRUN_ERR_ARG;
+    }
+    try {
+        pmrun_options o;
+        if (opt)
+            o = *opt;
+        else
+            pmrun_options_default(&o);
+        std::unique_ptr<pmrun> run(new pmrun);
+        pmrun_site &site = run->site;
+        site.latitude_rad = site.height_m = site.pressure_hpa = site.temp_c = nan();
+        site.humidity = site.wavelength_um = site.lapse_k_per_m = nan();
+        site.year = site.month = site.day = 0;
+        Context ctx(path, o, run.get());
+        int st = read_file(ctx);
+        if (st != PMRUN_OK) {
+            set_error(err, errlen, ctx.error());
+            return st;
+        }
+        *out = run.release();
+        return PMRUN_OK;
+    } catch (const std::bad_alloc &) {
+        set_error(err, errlen, std::string(path) + ": out of memory");
+        return PMRUN_ERR_NOMEM;
+    } catch (...) {
+        set_error(err, errlen, std::string(path) + ": out of memory (container limit)");
+        return PMRUN_ERR_NOMEM;
+    }
+}
+
+void pmrun_free(pmrun *run) { delete run; }
+
+size_t pmrun_count(const pmrun *run) { return run ? run->obs.size() : 0; }
+
+const pmrun_obs *pmrun_get(const pmrun *run, size_t i)
+{
+    if (!run || i >= run->obs.size()) return nullptr;
+    return &run->obs[i];
+}
+
+int pmrun_mount(const pmrun *run) { return run ? run->mount : -1; }
+
+int pmrun_format(const pmrun *run) { return run ? run->format : -1; }
+
+double pmrun_latitude_rad(const pmrun *run) { return run ? run->site.latitude_rad : nan(); }
+
+int pmrun_get_site(const pmrun *run, pmrun_site *site)
+{
+    if (!run || !site) return PMRUN_ERR_ARG;
+    *site = run->site;
+    return PMRUN_OK;
+}
+
+int pmrun_n_aux(const pmrun *run) { return run ? static_cast<int>(run->aux_names.size()) : 0; }
+
+const char *pmrun_aux_name(const pmrun *run, int i)
+{
+    if (!run || i < 0 || static_cast<size_t>(i) >= run->aux_names.size()) return nullptr;
+    return run->aux_names[static_cast<size_t>(i)].c_str();
+}
+
+int pmrun_n_warnings(const pmrun *run) { return run ? static_cast<int>(run->warnings.size()) : 0; }
+
+const char *pmrun_warning(const pmrun *run, int i)
+{
+    if (!run || i < 0 || static_cast<size_t>(i) >= run->warnings.size()) return nullptr;
+    return run->warnings[static_cast<size_t>(i)].c_str();
+}
+
+int pmrun_n_skipped(const pmrun *run) { return run ? run->n_skipped : 0; }
+
+const char *pmrun_skipped(const pmrun *run, int i)
+{
+    if (!run || i < 0 || static_cast<size_t>(i) >= run->skipped.size()) return nullptr;
+    return run->skipped[static_cast<size_t>(i)].c_str();
+}
+
+}  // extern "C"

@@ -1,0 +1,343 @@
+// runfile_columns.cpp - the four-column format ("tau delta T D", Pal et al.
+// 2016) and the named-column format ("# tau delta T D pier temp ..." header
+// plus "# key: value" metadata).  docs/formats.md, sections 1 and 2.
+#include "runfile_internal.hpp"
+
+#include <cmath>
+#include <cstring>
+
+namespace pmrun_detail {
+namespace {
+
+enum class Col { kTau, kDelta, kT, kD, kPier, kTemp, kTime, kDir, kAux };
+
+struct Column {
+    Col kind;
+    std::string name;   // as written in the header
+    int aux = -1;       // index into aux[] for kAux
+};
+
+// Largest |axis 1| accepted (degrees): room for cable wraps, not garbage.
+constexpr double kMaxAxis1Deg = 720.0;
+
+bool known_column(const std::string &lname, Col &kind)
+{
+    static const struct {
+        const char *name;
+        Col kind;
+    } kNames[] = {{"tau", Col::kTau},   {"delta", Col::kDelta}, {"t", Col::kT},
+                  {"d", Col::kD},       {"pier", Col::kPier},   {"temp", Col::kTemp},
+                  {"time", Col::kTime}, {"dir", Col::kDir}};
+    for (const auto &k : kNames)
+        if (lname == k.name) {
+            kind = k.kind;
+            return true;
+        }
+    return false;
+}
+
+bool valid_aux_name(const std::string &s)
+{
+    if (s.empty()) return false;
+    char c0 = s[0];
+    if (!((c0 >= 'A' && c0 <= 'Z') || (c0 >= 'a' && c0 <= 'z') || c0 == '_')) return false;
+    for (char c : s)
+        if (!((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') ||
+              c == '_' || c == '.' || c == '-'))
+            return false;
+    return true;
+}
+
+class ColumnParser : public FormatParser {
+public:
+    explicit ColumnParser(Context &ctx) : ctx_(ctx) {}
+
+    bool line(int n, const std::string &text) override
+    {
+        std::string t = trim(text);
+        if (t.empty()) return true;
+        if (t[0] == '#') return comment(n, t.substr(1));
+        if (t[0] == '!' || t[0] == ':')
+            return ctx_.fail(n,
+                             "TPOINT %s line '%s' in a '#' column file: mixed formats? expected "
+                             "'#' comments and records '%s'",
+                             t[0] == '!' ? "comment" : "option", excerpt(t).c_str(),
+                             column_list().c_str());
+        if (first_data_ == 0) {
+            first_data_ = n;
+            if (cols_.empty()) {
+                cols_ = {{Col::kTau, "tau"}, {Col::kDelta, "delta"}, {Col::kT, "T"}, {Col::kD, "D"}};
+                has_[static_cast<int>(Col::kTau)] = has_[static_cast<int>(Col::kDelta)] = true;
+            }
+        }
+        return record(n, tokens(strip_comment(t, '#')));
+    }
+
+    bool unreadable(int n, const std::string &why) override
+    {
+        if (first_data_ == 0) first_data_ = n;
+        return ctx_.bad_record(n, why);
+    }
+
+    bool finish(int last_line) override
+    {
+        pmrun *run = ctx_.run();
+        if (run->obs.empty()) {
+            if (run->n_skipped > 0)
+                return ctx_.fail(last_line, "no records left: all %d records were bad and skipped",
+                                 run->n_skipped);
+            return ctx_.fail(last_line,
+                             "no records: the file ends at line %d without one, expected lines "
+                             "of '%s' (degrees)",
+                             last_line, column_list().c_str());
+        }
+        run->format = header_line_ ? PMRUN_FORMAT_NAMED : PMRUN_FORMAT_FOUR_COLUMN;
+        run->mount = mount_;
+        run->site.latitude_rad = latitude_deg_ * kDeg;
+        for (const Column &c : cols_)
+            if (c.kind == Col::kAux) run->aux_names.push_back(c.name);
+        return true;
+    }
+
+private:
+    std::string column_list() const
+    {
+        if (cols_.empty()) return "tau delta T D";
+        std::string s;
+        for (const Column &c : cols_) s += (s.empty() ? "" : " ") + c.name;
+        return s;
+    }
+
+    bool comment(int n, const std::string &body)
+    {
+        // A header: starts with a known column name, names tau delta T D,
+        // and every word is a column name (docs/formats.md, "Detection").
+        std::vector<std::string> tok = tokens(body);
+        int found = 0;
+        bool names = true;
+        for (const std::string &s : tok) {
+            std::string l = lower(s);
+            found |= (l == "tau" ? 1 : 0) | (l == "delta" ? 2 : 0) | (l == "t" ? 4 : 0) |
+                     (l == "d" ? 8 : 0);
+            names = names && valid_aux_name(s);
+        }
+        Col first;
+        if (found == 15 && names && known_column(lower(tok[0]), first)) return header(n, tok);
+        std::string b = trim(body);
+        size_t colon = b.find(':');
+        if (colon != std::string::npos && colon > 0) {
+            std::string key = trim(b.substr(0, colon));
+            if (valid_aux_name(key)) return metadata(n, lower(key), trim(b.substr(colon + 1)));
+        }
+        return true;   // a plain comment
+    }
+
+    bool header(int n, const std::vector<std::string> &tok)
+    {
+        if (header_line_)
+            return ctx_.fail(n, "second column header (the first is at line %d), expected one header",
+                             header_line_);
+        if (first_data_)
+            return ctx_.fail(n,
+                             "column header after the first record (line %d): mixed formats? "
+                             "expected the header before the records",
+                             first_data_);
+        header_line_ = n;
+        int naux = 0;
+        for (const std::string &name : tok) {
+            Column c{Col::kAux, name};
+            std::string l = lower(name);
+            if (known_column(l, c.kind)) {
+                if (has_[static_cast<int>(c.kind)])
+                    return ctx_.fail(n, "column '%s' named twice, expected each column once",
+                                     excerpt(name).c_str());
+                has_[static_cast<int>(c.kind)] = true;
+            } else {
+                for (const Column &o : cols_)
+                    if (o.kind == Col::kAux && lower(o.name) == l)
+                        return ctx_.fail(n, "column '%s' named twice, expected each column once",
+                                         excerpt(name).c_str());
+                if (naux == PMRUN_MAX_AUX)
+                    return ctx_.fail(n,
+                                     "more than %d auxiliary columns ('%s'), expected at most %d "
+                                     "besides tau delta T D pier temp time dir",
+                                     PMRUN_MAX_AUX, excerpt(name).c_str(), PMRUN_MAX_AUX);
+                c.aux = naux++;
+            }
+            cols_.push_back(c);
+        }
+        return true;
+    }
+
+    bool metadata(int n, const std::string &key, const std::string &value)
+    {
+        if (key == "latitude") {
+            double v;
+            std::string why;
+            if (!parse_number(value, v, why))
+                return ctx_.fail(n, "latitude '%s': %s (degrees)", excerpt(value).c_str(), why.c_str());
+            if (std::fabs(v) > 90)
+                return ctx_.fail(n, "latitude %s deg is beyond +-90, expected degrees within -90..+90",
+                                 excerpt(value).c_str());
+            if (latitude_line_)
+                return ctx_.fail(n, "latitude given twice (first at line %d), expected it once",
+                                 latitude_line_);
+            latitude_deg_ = v;
+            latitude_line_ = n;
+            return true;
+        }
+        if (key == "mount") {
+            std::string v = lower(value);
+            int m;
+            if (v == "altaz" || v == "alt-az" || v == "azel" || v == "alt-azimuth")
+                m = PMRUN_MOUNT_ALTAZ;
+            else if (v == "equatorial" || v == "equat" || v == "eq")
+                m = PMRUN_MOUNT_EQUATORIAL;
+            else
+                return ctx_.fail(n, "mount '%s', expected 'altaz' or 'equatorial'",
+                                 excerpt(value).c_str());
+            if (first_data_)
+                return ctx_.fail(n, "mount given after the first record (line %d), expected it before",
+                                 first_data_);
+            if (mount_line_ && m != mount_)
+                return ctx_.fail(n, "mount '%s' conflicts with line %d, expected one mount type",
+                                 excerpt(value).c_str(), mount_line_);
+            mount_ = m;
+            mount_line_ = n;
+            return true;
+        }
+        ctx_.warn(n, "metadata '%s' accepted, not used", excerpt(key).c_str());
+        return true;
+    }
+
+    // One field; false with `why` on error.
+    bool field(const Column &c, const std::string &tok, pmrun_obs &o, std::string &why)
+    {
+        bool missing = tok == "-";
+        switch (c.kind) {
+        case Col::kPier: {
+            std::string l = lower(tok);
+            if (l == "e" || l == "east" || l == "+1" || l == "1")
+                o.pier = PMRUN_PIER_EAST;
+            else if (l == "w" || l == "west" || l == "-1")
+                o.pier = PMRUN_PIER_WEST;
+            else if (l == "0" || l == "?" || missing)
+                o.pier = PMRUN_PIER_UNKNOWN;
+            else {
+                why = "expected E, W, +1, -1, 0 or '-'";
+                return false;
+            }
+            return true;
+        }
+        case Col::kDir:
+            if (tok == "+1" || tok == "1")
+                o.dir = 1;
+            else if (tok == "-1")
+                o.dir = -1;
+            else if (tok == "0" || missing)
+                o.dir = 0;
+            else {
+                why = "expected +1, -1, 0 or '-'";
+                return false;
+            }
+            return true;
+        case Col::kTemp:
+        case Col::kTime:
+        case Col::kAux: {
+            double v = nan();
+            if (!missing && !parse_number(tok, v, why)) return false;
+            if (c.kind == Col::kTemp) o.temp_c = v;
+            if (c.kind == Col::kTime) o.time_h = v;
+            if (c.kind == Col::kAux) o.aux[c.aux] = v;
+            return true;
+        }
+        default:
+            break;
+        }
+        double v;
+        if (!parse_number(tok, v, why)) {
+            why += " (degrees)";
+            return false;
+        }
+        bool altaz = mount_ == PMRUN_MOUNT_ALTAZ;
+        switch (c.kind) {
+        case Col::kTau:
+        case Col::kT:
+            if (std::fabs(v) > kMaxAxis1Deg) {
+                why = format("beyond +-%g deg, expected an %s in degrees", kMaxAxis1Deg,
+                             altaz ? "azimuth" : "hour angle");
+                return false;
+            }
+            (c.kind == Col::kTau ? o.enc_ha : o.app_ha) = v * kDeg;
+            return true;
+        case Col::kDelta:
+            if (altaz ? std::fabs(v) > 90 : std::fabs(v) > 180) {
+                why = altaz ? "elevation beyond +-90 deg, expected -90..+90"
+                            : "declination beyond +-180 deg, expected -180..+180 (beyond +-90: "
+                              "over the pole)";
+                return false;
+            }
+            o.enc_dec = v * kDeg;
+            return true;
+        case Col::kD:
+            if (std::fabs(v) > 90) {
+                why = altaz ? "elevation beyond +-90 deg, expected -90..+90"
+                            : "apparent declination beyond +-90 deg, expected -90..+90";
+                return false;
+            }
+            o.app_dec = v * kDeg;
+            return true;
+        default:
+            return true;
+        }
+    }
+
+    bool record(int n, const std::vector<std::string> &tok)
+    {
+        pmrun *run = ctx_.run();
+        if (tok.size() != cols_.size())
+            return ctx_.bad_record(n, format("%zu fields, expected %zu: %s", tok.size(), cols_.size(),
+                                             column_list().c_str()));
+        pmrun_obs o;
+        std::memset(&o, 0, sizeof o);
+        o.enc_ha = o.enc_dec = o.app_ha = o.app_dec = 0;
+        o.pier = PMRUN_PIER_UNKNOWN;
+        o.temp_c = o.time_h = nan();
+        o.dir = 0;
+        o.line = n;
+        for (double &a : o.aux) a = nan();
+        for (size_t i = 0; i < tok.size(); ++i) {
+            std::string why;
+            if (!field(cols_[i], tok[i], o, why))
+                return ctx_.bad_record(n, format("field %zu (%s) '%s': %s", i + 1,
+                                                 cols_[i].name.c_str(), excerpt(tok[i]).c_str(),
+                                                 why.c_str()));
+        }
+        if (!has_[static_cast<int>(Col::kPier)] && mount_ == PMRUN_MOUNT_EQUATORIAL)
+            o.pier = std::fabs(o.enc_dec) > kPi / 2 ? PMRUN_PIER_WEST : PMRUN_PIER_EAST;
+        if (run->obs.size() >= static_cast<size_t>(PMRUN_MAX_RECORDS))
+            return ctx_.fail(n, "more than %d records, expected at most %d", PMRUN_MAX_RECORDS,
+                             PMRUN_MAX_RECORDS);
+        run->obs.push_back(o);
+        return true;
+    }
+
+    Context &ctx_;
+    std::vector<Column> cols_;
+    bool has_[9] = {};
+    int header_line_ = 0;
+    int first_data_ = 0;
+    int mount_ = PMRUN_MOUNT_EQUATORIAL;
+    int mount_line_ = 0;
+    double latitude_deg_ = nan();
+    int latitude_line_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<FormatParser> make_column_parser(Context &ctx)
+{
+    return std::unique_ptr<FormatParser>(new ColumnParser(ctx));
+}
+
+}  // namespace pmrun_detail

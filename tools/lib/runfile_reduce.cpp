@@ -1,0 +1,73 @@
+// runfile_reduce.cpp - reduction of TPOINT catalogue places (J2000 mean
+// places) to observed hour angle and declination with ERFA.
+// docs/formats.md, "The reduction".
+#include "runfile_internal.hpp"
+
+#include <erfa.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace pmrun_detail {
+
+bool Reduction::setup(int year, int month, int day, double latitude_rad, const Weather *weather,
+                      std::string &why)
+{
+    if (eraDtf2d("UTC", year, month, day, 0, 0, 0.0, &utc1, &utc2) < 0) {
+        why = format("date %d %d %d rejected by ERFA, expected a valid UTC date y m d", year, month,
+                     day);
+        return false;
+    }
+    double dat;
+    dubious = eraDat(year, month, day, 0.5, &dat) == 1;
+    latitude = latitude_rad;
+    refract = weather != nullptr;
+    refa = refb = 0;
+    if (weather)
+        eraRefco(weather->pressure_hpa, weather->temp_c, weather->humidity, weather->wavelength_um,
+                 &refa, &refb);
+    return true;
+}
+
+// Observed (refracted) place from the topocentric apparent one: the ERFA
+// refraction model dZ = A tan Z + B tan^3 Z (Z observed zenith distance),
+// inverted with one Newton step from the unrefracted zenith distance and
+// guarded near the horizon exactly as eraAtioq does (sin el >= 0.05,
+// cos el >= 1e-6).
+static void refract_hd(double lat, double refa, double refb, double &ha, double &dec)
+{
+    double az, el;
+    eraHd2ae(ha, dec, lat, &az, &el);
+    double r = std::max(std::cos(el), 1e-6);    // sin of the zenith distance
+    double z = std::max(std::sin(el), 0.05);    // cos of the zenith distance
+    double tz = r / z;
+    double w = refb * tz * tz;
+    double del = (refa + w) * tz / (1.0 + (refa + 3.0 * w) / (z * z));
+    eraAe2hd(az, el + del, lat, &ha, &dec);
+}
+
+bool Reduction::observed(double ra, double dec, double lst, double utc_h, double &ha,
+                         double &dec_obs, std::string &why) const
+{
+    double tai1, tai2, tt1, tt2;
+    int j = eraUtctai(utc1, utc2 + utc_h / 24.0, &tai1, &tai2);
+    if (j < 0) {
+        why = "UTC to TAI rejected by ERFA (bad date)";
+        return false;
+    }
+    eraTaitt(tai1, tai2, &tt1, &tt2);
+    // ICRS -> CIRS (precession-nutation, aberration, light deflection);
+    // proper motion, parallax and radial velocity zero; TT stands for TDB.
+    double ri, di, eo;
+    eraAtci13(ra, dec, 0.0, 0.0, 0.0, 0.0, tt1, tt2, &ri, &di, &eo);
+    // Equinox-based apparent RA through the equation of the origins.
+    double ra_app = eraAnp(ri - eo);
+    double h = eraAnpm(lst - ra_app);
+    double d = di;
+    if (refract) refract_hd(latitude, refa, refb, h, d);
+    ha = eraAnpm(h);
+    dec_obs = d;
+    return true;
+}
+
+}  // namespace pmrun_detail

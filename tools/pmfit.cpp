@@ -1,0 +1,543 @@
+// pmfit - fit a pointing model to a recorded pointing run and report it.
+//
+//   pmfit fit RUN [--order L] [--pier joint|split] [--json] [--residuals FILE]
+//                 [--save MODEL] [--emit-c HEADER] [--no-refraction] [--skip-bad]
+//   pmfit simulate OUT [--n N] [--seed S] [--lat DEG] [--mount equatorial|altaz]
+//                 [--fork] [--el-limit DEG] [--noise ARCSEC] [--order L]
+//                 [--term NAME=ARCSEC ...] [--random-aniso ARCSEC]
+//
+// Host-side program: uses the freestanding core (include/pm.h) and the run
+// reader (tools/lib/runfile.h).  Angles in the reports are arcseconds.
+#include "pm.h"
+#include "runfile.h"
+#include "modelfile.h"
+#include "simulate.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+#include <algorithm>
+
+namespace {
+
+const double RAD2AS = 206264.80624709636;
+const double PI = 3.14159265358979323846;
+
+struct Options {
+    std::string cmd, run;
+    int order = 1;
+    bool split = false;
+    bool json = false;
+    bool refraction = true;
+    bool skip_bad = false;
+    std::string residuals, save, emit_c;
+    // simulate
+    long n = 200;
+    unsigned long long seed = 1;
+    double lat = 47, el_limit = 15, noise = 1, random_aniso = 0;
+    bool altaz = false, fork = false;
+    std::vector<std::pair<std::string, double>> terms;
+};
+
+void usage(FILE *f)
+{
+    std::fprintf(f,
+        "usage: pmfit fit RUN [--order L] [--pier joint|split] [--json]\n"
+        "                     [--residuals FILE] [--save MODEL] [--emit-c HEADER]\n"
+        "                     [--no-refraction] [--skip-bad]\n"
+        "\n"
+        "  RUN              pointing run: four-column, named-column or TPOINT file\n"
+        "                   (docs/formats.md)\n"
+        "  --order L        spherical-harmonic order, 0..%d (default 1, the paper's L=1)\n"
+        "  --pier split     fit each pier side separately (default: joint)\n"
+        "  --json           one JSON object on standard output\n"
+        "  --residuals F    write per-observation residuals (arcsec) to F\n"
+        "  --save MODEL     write the fitted model as a text model file (docs/formats.md);\n"
+        "                   with --pier split: MODEL-east and MODEL-west\n"
+        "  --emit-c HEADER  write the model as C constant data with a loader, for firmware\n"
+        "  --no-refraction  leave refraction out of the TPOINT reduction\n"
+        "  --skip-bad       skip malformed records (each is reported) instead of failing\n"
+        "\n"
+        "usage: pmfit simulate OUT [--n N] [--seed S] [--lat DEG] [--mount equatorial|altaz]\n"
+        "                      [--fork] [--el-limit DEG] [--noise ARCSEC] [--order L]\n"
+        "                      [--term NAME=ARCSEC ...] [--random-aniso ARCSEC]\n"
+        "\n"
+        "  writes a simulated run in the named-column format (docs/formats.md):\n"
+        "  --n N            points (default 200)      --seed S        random seed (default 1)\n"
+        "  --lat DEG        site latitude (47)         --el-limit DEG  lowest elevation (15)\n"
+        "  --mount M        equatorial (default) or altaz; --fork: equatorial without flip\n"
+        "  --noise ARCSEC   measurement noise per axis on the sky (default 1)\n"
+        "  --order L        order of the true model (default 1)\n"
+        "  --term N=V       set true term N (as pmfit fit names it: a b c' d e' i d*Y(1,-1) ...)\n"
+        "                   to V arcsec; repeatable\n"
+        "  --random-aniso S give every anisotropic term a random value of RMS S arcsec\n",
+        PM_MAX_L);
+}
+
+[[noreturn]] void die(const std::string &msg, int code = 2)
+{
+    std::fprintf(stderr, "pmfit: %s\n", msg.c_str());
+    std::exit(code);
+}
+
+bool parse_int(const char *s, int *v)
+{
+    char *end = nullptr;
+    long x = std::strtol(s, &end, 10);
+    if (!*s || *end || x < -1000000 || x > 1000000)
+        return false;
+    *v = (int)x;
+    return true;
+}
+
+Options parse_args(int argc, char **argv)
+{
+    Options o;
+    if (argc < 2) {
+        usage(stderr);
+        std::exit(2);
+    }
+    o.cmd = argv[1];
+    if (o.cmd == "-h" || o.cmd == "--help" || o.cmd == "help") {
+        usage(stdout);
+        std::exit(0);
+    }
+    if (o.cmd != "fit" && o.cmd != "simulate")
+        die("unknown command '" + o.cmd + "' (expected: fit or simulate); see pmfit --help");
+    bool sim = o.cmd == "simulate";
+    auto number = [&](const std::string &opt, const char *v, double lo, double hi) {
+        char *end = nullptr;
+        double x = std::strtod(v, &end);
+        if (!*v || *end || !(x >= lo && x <= hi))
+            die(opt + ": expected a number in " + std::to_string(lo) + ".." + std::to_string(hi) +
+                ", got '" + v + "'");
+        return x;
+    };
+    for (int i = 2; i < argc; i++) {
+        std::string a = argv[i];
+        auto need = [&](const char *what) -> const char * {
+            if (i + 1 >= argc)
+                die(a + " needs " + what);
+            return argv[++i];
+        };
+        if (a == "--order") {
+            const char *v = need("an order");
+            if (!parse_int(v, &o.order) || o.order < 0 || o.order > PM_MAX_L)
+                die(std::string("--order: expected an integer 0..") +
+                    std::to_string(PM_MAX_L) + ", got '" + v + "'");
+        } else if (!sim && a == "--pier") {
+            std::string v = need("joint or split");
+            if (v == "split")
+                o.split = true;
+            else if (v == "joint")
+                o.split = false;
+            else
+                die("--pier: expected joint or split, got '" + v + "'");
+        } else if (!sim && a == "--json") {
+            o.json = true;
+        } else if (!sim && a == "--residuals") {
+            o.residuals = need("a file name");
+        } else if (!sim && a == "--save") {
+            o.save = need("a file name");
+        } else if (!sim && a == "--emit-c") {
+            o.emit_c = need("a file name");
+        } else if (sim && a == "--n") {
+            o.n = (long)number(a, need("a count"), 1, 1e7);
+        } else if (sim && a == "--seed") {
+            o.seed = (unsigned long long)number(a, need("a seed"), 0, 1e15);
+        } else if (sim && a == "--lat") {
+            o.lat = number(a, need("degrees"), -90, 90);
+        } else if (sim && a == "--el-limit") {
+            o.el_limit = number(a, need("degrees"), -10, 80);
+        } else if (sim && a == "--noise") {
+            o.noise = number(a, need("arcseconds"), 0, 1e5);
+        } else if (sim && a == "--random-aniso") {
+            o.random_aniso = number(a, need("arcseconds"), 0, 1e5);
+        } else if (sim && a == "--fork") {
+            o.fork = true;
+        } else if (sim && a == "--mount") {
+            std::string v = need("equatorial or altaz");
+            if (v != "equatorial" && v != "altaz")
+                die("--mount: expected equatorial or altaz, got '" + v + "'");
+            o.altaz = v == "altaz";
+        } else if (sim && a == "--term") {
+            std::string v = need("NAME=ARCSEC");
+            size_t eq = v.rfind('=');
+            if (eq == std::string::npos || eq == 0)
+                die("--term: expected NAME=ARCSEC, got '" + v + "'");
+            o.terms.push_back({v.substr(0, eq), number(a, v.c_str() + eq + 1, -1e6, 1e6)});
+        } else if (!sim && a == "--no-refraction") {
+            o.refraction = false;
+        } else if (!sim && a == "--skip-bad") {
+            o.skip_bad = true;
+        } else if (!a.empty() && a[0] == '-') {
+            die("unknown option '" + a + "'; see pmfit --help");
+        } else if (o.run.empty()) {
+            o.run = a;
+        } else {
+            die("more than one run file given ('" + o.run + "', '" + a + "')");
+        }
+    }
+    if (o.run.empty())
+        die(sim ? "no output file given; see pmfit --help" : "no run file given; see pmfit --help");
+    return o;
+}
+
+const char *status_text(pm_status s)
+{
+    switch (s) {
+    case PM_OK: return "ok";
+    case PM_WARN_NOT_CONVERGED: return "iteration bound reached";
+    case PM_WARN_UNREACHABLE: return "target unreachable";
+    case PM_ERR_ARG: return "invalid argument";
+    case PM_ERR_NONFINITE: return "non-finite input";
+    case PM_ERR_CAPACITY: return "beyond the compiled capacity";
+    case PM_ERR_TOO_FEW: return "too few observations for the number of terms";
+    case PM_ERR_SINGULAR: return "a term cannot be determined from these observations";
+    case PM_ERR_STATE: return "call out of order";
+    case PM_ERR_CONFIG: return "library built with other capacities";
+    case PM_ERR_DIVERGED: return "the fit did not converge";
+    }
+    return "unknown status";
+}
+
+// Physical meaning of a term, for the table.
+std::string meaning(const pm_model &m, int i)
+{
+    const pm_term &t = m.term[i];
+    bool altaz = m.mount == PM_MOUNT_ALTAZ;
+    if (t.l == 0) {
+        switch (t.k) {
+        case 1: return altaz ? "azimuth axis tilt (x)" : "polar axis misalignment (x)";
+        case 2: return altaz ? "azimuth axis tilt (y)" : "polar axis misalignment (y)";
+        case 3: return altaz ? "azimuth index [IA]" : "HA index [IH]";
+        case 4: return "axis non-perpendicularity [NP]";
+        case 5: return altaz ? "elevation index [IE]" : "Dec index [ID]";
+        case 6: return "collimation [CH/CA]";
+        }
+    }
+    static const char *base[] = {"", "tilt x", "tilt y", "axis-1 index", "non-perp.",
+                                 "axis-2 index", "collimation"};
+    return std::string(base[t.k]) + " varying as Y(" + std::to_string(t.l) + "," +
+           std::to_string(t.m) + ")";
+}
+
+struct Obs {
+    double eh, ed, ah, ad;
+    int pier, line;
+};
+
+struct FitOut {
+    pm_status status = PM_OK;
+    pm_model model;
+    pm_fit_result res;
+    int bad_term = -1;
+    int corr_i = -1, corr_j = -1; // most correlated pair when not converged
+    double corr = 0;
+    std::vector<double> r0, r1; // residuals (rad), sky frame
+    std::vector<int> idx;       // indices into the run
+    double rms = 0;
+};
+
+FitOut do_fit(const std::vector<Obs> &obs, const std::vector<int> &use, int mount,
+              int order)
+{
+    static pm_fit fit; // large; not on the stack
+    FitOut f;
+    pm_model_init(&f.model, mount, order);
+    std::vector<double> eh, ed, ah, ad;
+    for (int i : use) {
+        eh.push_back(obs[i].eh);
+        ed.push_back(obs[i].ed);
+        ah.push_back(obs[i].ah);
+        ad.push_back(obs[i].ad);
+    }
+    f.status = pm_fit_run(&fit, &f.model, nullptr, (long)use.size(), eh.data(), ed.data(),
+                          ah.data(), ad.data(), 100, &f.res);
+    if (f.status != PM_OK) {
+        f.bad_term = fit.bad_term;
+        if (f.status == PM_ERR_DIVERGED && fit.iterations > 0) {
+            // name the most nearly degenerate pair of the last accepted pass
+            pm_fit_result unit;
+            std::memset(&unit, 0, sizeof unit);
+            unit.sigma = 1;
+            for (int i = 0; i < fit.n_par; i++)
+                for (int j = 0; j < i; j++) {
+                    double c, r;
+                    if (pm_fit_covariance(&fit, &unit, i, j, &c, &r) == PM_OK &&
+                        std::fabs(r) > std::fabs(f.corr)) {
+                        f.corr = r;
+                        f.corr_i = i;
+                        f.corr_j = j;
+                    }
+                }
+        }
+        return f;
+    }
+    double ss = 0;
+    for (size_t j = 0; j < use.size(); j++) {
+        double r[2];
+        pm_model_residual(&f.model, nullptr, eh[j], ed[j], ah[j], ad[j], r);
+        f.r0.push_back(r[0]);
+        f.r1.push_back(r[1]);
+        f.idx.push_back(use[j]);
+        ss += r[0] * r[0] + r[1] * r[1];
+    }
+    f.rms = std::sqrt(ss / (double)use.size());
+    return f;
+}
+
+std::string term_name(const pm_model &m, int i)
+{
+    char buf[32];
+    pm_term_name(&m, i, buf, sizeof buf);
+    return buf;
+}
+
+std::string json_escape(const std::string &s)
+{
+    std::string o;
+    for (char c : s) {
+        if (c == '"' || c == '\\')
+            o += '\\', o += c;
+        else if ((unsigned char)c < 0x20) {
+            char b[8];
+            std::snprintf(b, sizeof b, "\\u%04x", c);
+            o += b;
+        } else
+            o += c;
+    }
+    return o;
+}
+
+void print_table(const char *title, const FitOut &f, const std::vector<Obs> &obs,
+                 const std::string &path)
+{
+    const pm_model &m = f.model;
+    std::printf("\n%s\n", title);
+    std::printf("  N = %ld observations, P = %d terms, order L = %d, %d Gauss-Newton passes\n",
+                f.res.n_obs, f.res.n_par, m.order, f.res.iterations);
+    std::printf("  unbiased sigma = %.3f\"   sky RMS = %.3f\"\n\n", f.res.sigma * RAD2AS,
+                f.rms * RAD2AS);
+    std::printf("  %-12s %-38s %13s %10s %7s\n", "term", "meaning", "value(\")", "1sigma(\")",
+                "signif");
+    for (int i = 0; i < m.n_terms; i++) {
+        double v = m.coef[i] * RAD2AS, e = f.res.err[i] * RAD2AS;
+        double z = e > 0 ? std::fabs(v) / e : 0;
+        std::printf("  %-12s %-38s %13.2f %10.2f %6.1f%s\n", term_name(m, i).c_str(),
+                    meaning(m, i).c_str(), v, e, z, z >= 3 ? " *" : "");
+    }
+    // worst points
+    std::vector<size_t> order(f.idx.size());
+    for (size_t j = 0; j < order.size(); j++)
+        order[j] = j;
+    auto mag = [&](size_t j) { return std::hypot(f.r0[j], f.r1[j]); };
+    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return mag(a) > mag(b); });
+    std::printf("\n  worst points (residual on the sky, arcsec):\n");
+    for (size_t k = 0; k < order.size() && k < 5; k++) {
+        size_t j = order[k];
+        const Obs &o = obs[f.idx[j]];
+        std::printf("    %s:%d  axis1 %+8.2f  axis2 %+8.2f  |r| %7.2f  (enc %7.2f, %7.2f deg)\n",
+                    path.c_str(), o.line, f.r0[j] * RAD2AS, f.r1[j] * RAD2AS, mag(j) * RAD2AS,
+                    o.eh * 180 / PI, o.ed * 180 / PI);
+    }
+}
+
+void print_json_fit(const FitOut &f)
+{
+    const pm_model &m = f.model;
+    std::printf("{\"n_obs\": %ld, \"n_params\": %d, \"order\": %d, \"sigma_arcsec\": %.6f, "
+                "\"rms_arcsec\": %.6f, \"iterations\": %d, \"terms\": [",
+                f.res.n_obs, f.res.n_par, m.order, f.res.sigma * RAD2AS, f.rms * RAD2AS,
+                f.res.iterations);
+    for (int i = 0; i < m.n_terms; i++)
+        std::printf("%s{\"name\": \"%s\", \"value_arcsec\": %.6f, \"error_arcsec\": %.6f}",
+                    i ? ", " : "", json_escape(term_name(m, i)).c_str(), m.coef[i] * RAD2AS,
+                    f.res.err[i] * RAD2AS);
+    std::printf("]}");
+}
+
+void fail_fit(const FitOut &f, const std::string &what)
+{
+    std::string msg = what + ": " + status_text(f.status);
+    if (f.status == PM_ERR_SINGULAR && f.bad_term >= 0) {
+        pm_model m;
+        pm_model_init(&m, f.model.mount, f.model.order);
+        msg += " (term " + term_name(m, f.bad_term) + ", " + meaning(m, f.bad_term) +
+               ": the sky coverage does not constrain it; lower --order or add points)";
+    }
+    if (f.status == PM_ERR_DIVERGED && f.corr_i >= 0) {
+        pm_model m;
+        pm_model_init(&m, f.model.mount, f.model.order);
+        char buf[64];
+        std::snprintf(buf, sizeof buf, "%.6f", f.corr);
+        msg += " in 100 passes: the sky coverage hardly separates " + term_name(m, f.corr_j) +
+               " from " + term_name(m, f.corr_i) + " (correlation " + buf +
+               "); lower --order or use both pier sides";
+    }
+    if (f.status == PM_ERR_TOO_FEW)
+        msg += " (need more than P/2 observations; lower --order)";
+    die(msg, 1);
+}
+
+} // namespace
+
+int cmd_simulate(const Options &o, int argc, char **argv)
+{
+    pmsim_spec spec;
+    pmsim_default(&spec);
+    spec.n = o.n;
+    spec.seed = o.seed;
+    spec.latitude_deg = o.lat;
+    spec.el_limit_deg = o.el_limit;
+    spec.noise_arcsec = o.noise;
+    spec.gem = o.fork ? 0 : 1;
+    pm_model &m = spec.truth;
+    pm_model_init(&m, o.altaz ? PM_MOUNT_ALTAZ : PM_MOUNT_EQUATORIAL, o.order);
+    if (o.random_aniso > 0) {
+        std::mt19937_64 rng(o.seed ^ 0x5eedULL);
+        std::normal_distribution<double> g(0.0, 1.0);
+        for (int i = 6; i < m.n_terms; i++)
+            m.coef[i] = o.random_aniso / RAD2AS * g(rng);
+    }
+    for (const auto &t : o.terms) {
+        int found = -1;
+        for (int i = 0; i < m.n_terms; i++)
+            if (term_name(m, i) == t.first)
+                found = i;
+        if (found < 0)
+            die("--term: no term '" + t.first + "' in an order-" + std::to_string(o.order) +
+                " model (names as pmfit fit prints them, e.g. c' or d*Y(1,-1))");
+        m.coef[found] = t.second / RAD2AS;
+    }
+    if (pm_model_prepare(&m) != PM_OK)
+        die("simulate: the true model is invalid", 1);
+    std::string cmd = "made by:";
+    for (int i = 0; i < argc; i++)
+        cmd += std::string(" ") + argv[i];
+    char err[1024];
+    if (pmsim_write(&spec, o.run.c_str(), cmd.c_str(), err, sizeof err) != 0)
+        die(err, 1);
+    std::fprintf(stderr, "pmfit: wrote %s (%ld points)\n", o.run.c_str(), o.n);
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    Options o = parse_args(argc, argv);
+    if (PM_CHECK_CONFIG() != PM_OK)
+        die("library and program were built with different PM_MAX_L/PM_MAX_EXTRA", 1);
+    if (o.cmd == "simulate")
+        return cmd_simulate(o, argc, argv);
+
+    pmrun_options ro;
+    pmrun_options_default(&ro);
+    ro.refraction = o.refraction ? 1 : 0;
+    ro.skip_bad = o.skip_bad ? 1 : 0;
+    pmrun *run = nullptr;
+    char err[1024];
+    if (pmrun_read(o.run.c_str(), &ro, &run, err, sizeof err) != 0)
+        die(err, 1);
+    std::unique_ptr<pmrun, void (*)(pmrun *)> guard(run, pmrun_free);
+
+    for (int i = 0; i < pmrun_n_warnings(run); i++)
+        std::fprintf(stderr, "pmfit: note: %s\n", pmrun_warning(run, i));
+
+    std::vector<Obs> obs;
+    for (size_t i = 0; i < pmrun_count(run); i++) {
+        const pmrun_obs *p = pmrun_get(run, i);
+        obs.push_back({p->enc_ha, p->enc_dec, p->app_ha, p->app_dec, p->pier, p->line});
+    }
+    int mount = pmrun_mount(run) == PMRUN_MOUNT_ALTAZ ? PM_MOUNT_ALTAZ : PM_MOUNT_EQUATORIAL;
+
+    // residual file is written only after every fit succeeded
+    std::vector<FitOut> fits;
+    std::vector<std::string> titles;
+    if (!o.split) {
+        std::vector<int> all(obs.size());
+        for (size_t i = 0; i < obs.size(); i++)
+            all[i] = (int)i;
+        FitOut f = do_fit(obs, all, mount, o.order);
+        if (f.status != PM_OK)
+            fail_fit(f, o.run);
+        fits.push_back(f);
+        titles.push_back("joint fit, both pier sides");
+    } else {
+        for (int side : {1, -1}) {
+            std::vector<int> use;
+            for (size_t i = 0; i < obs.size(); i++)
+                if (obs[i].pier == side)
+                    use.push_back((int)i);
+            std::string t = side > 0 ? "pier side east (normal)" : "pier side west (beyond the pole)";
+            if (use.empty())
+                die(o.run + ": --pier split: no observations on the " + t, 1);
+            FitOut f = do_fit(obs, use, mount, o.order);
+            if (f.status != PM_OK)
+                fail_fit(f, o.run + " (" + t + ")");
+            fits.push_back(f);
+            titles.push_back(t);
+        }
+    }
+
+    if (!o.residuals.empty()) {
+        std::string tmp = o.residuals + ".tmp";
+        FILE *rf = std::fopen(tmp.c_str(), "w");
+        if (!rf)
+            die("cannot write " + o.residuals + ": " + std::strerror(errno), 1);
+        std::fprintf(rf, "# residuals of pmfit fit %s (order %d, pier %s), arcsec on the sky\n",
+                     o.run.c_str(), o.order, o.split ? "split" : "joint");
+        std::fprintf(rf, "# line enc1_deg enc2_deg pier res1_arcsec res2_arcsec\n");
+        for (const FitOut &f : fits)
+            for (size_t j = 0; j < f.idx.size(); j++) {
+                const Obs &ob = obs[f.idx[j]];
+                std::fprintf(rf, "%d %.6f %.6f %d %.4f %.4f\n", ob.line, ob.eh * 180 / PI,
+                             ob.ed * 180 / PI, ob.pier, f.r0[j] * RAD2AS, f.r1[j] * RAD2AS);
+            }
+        if (std::fclose(rf) != 0 || std::rename(tmp.c_str(), o.residuals.c_str()) != 0)
+            die("cannot write " + o.residuals, 1);
+    }
+
+    for (size_t k = 0; k < fits.size(); k++) {
+        std::string suffix = fits.size() == 1 ? "" : (k == 0 ? "-east" : "-west");
+        std::string note = "fitted by pmfit from " + o.run + " (" + titles[k] + ")\n" +
+                           "N = " + std::to_string(fits[k].res.n_obs) + ", sigma = " +
+                           std::to_string(fits[k].res.sigma * RAD2AS) + " arcsec";
+        char e[1024];
+        if (!o.save.empty() &&
+            pmmodel_save((o.save + suffix).c_str(), &fits[k].model, note.c_str(), e, sizeof e) != 0)
+            die(e, 1);
+        if (!o.emit_c.empty()) {
+            std::string prefix = fits.size() == 1 ? "pm_fitted" : (k == 0 ? "pm_east" : "pm_west");
+            if (pmmodel_emit_c((o.emit_c + suffix).c_str(), &fits[k].model, prefix.c_str(),
+                               note.c_str(), e, sizeof e) != 0)
+                die(e, 1);
+        }
+    }
+
+    if (o.json) {
+        if (fits.size() == 1) {
+            print_json_fit(fits[0]);
+        } else {
+            std::printf("{\"pier\": \"split\", \"sides\": {\"east\": ");
+            print_json_fit(fits[0]);
+            std::printf(", \"west\": ");
+            print_json_fit(fits[1]);
+            std::printf("}}");
+        }
+        std::printf("\n");
+    } else {
+        std::printf("pmfit fit %s: %s mount, %zu observations\n", o.run.c_str(),
+                    mount == PM_MOUNT_ALTAZ ? "alt-az" : "equatorial", obs.size());
+        for (size_t k = 0; k < fits.size(); k++)
+            print_table(titles[k].c_str(), fits[k], obs, o.run);
+        std::printf("\n  * = significant at 3 sigma. Values are radians x 206265 (arcsec);\n"
+                    "    the model is defined in docs/model.md.\n");
+    }
+    return 0;
+}
