@@ -62,6 +62,7 @@ extern "C" {
 /* Hard iteration bounds of pm_model_invert (see its Notes). */
 #define PM_INVERT_MAX_FIXED 8
 #define PM_INVERT_MAX_NEWTON 8
+#define PM_INVERT_POLE_STARTS 8
 
 /* Round-trip tolerance the inverse iterates to (radians). */
 #define PM_INVERT_TOL 1e-13
@@ -107,9 +108,11 @@ typedef enum pm_status {
 #define PM_BASE_E 5 /* declination encoder index, e' (TPOINT: ID)    */
 #define PM_BASE_I 6 /* collimation, i (TPOINT: CH)                   */
 
-/* Pier sides / which solution the inverse returns. */
-#define PM_SIDE_NORMAL 0  /* encoder |dec| <= pi/2 */
-#define PM_SIDE_FLIPPED 1 /* encoder dec beyond the pole */
+/* Pier sides / which solution the inverse returns: on which side of the
+** mount's pole the encoder declination lies (the pole is at encoder
+** dec - e' = +-pi/2). */
+#define PM_SIDE_NORMAL 0  /* cos(enc_dec - e') >= 0 */
+#define PM_SIDE_FLIPPED 1 /* cos(enc_dec - e') < 0: beyond the pole */
 
 /* One term of the model. */
 typedef struct pm_term {
@@ -255,9 +258,10 @@ pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
 **     side     int               PM_SIDE_NORMAL or PM_SIDE_FLIPPED
 **  Returned:
 **     enc_ha   double*           encoder axis 1, in (-pi, pi]
-**     enc_dec  double*           encoder axis 2: in [-pi/2, pi/2] for
-**                                PM_SIDE_NORMAL, beyond the pole for
-**                                PM_SIDE_FLIPPED (in (pi/2, 3pi/2))
+**     enc_dec  double*           encoder axis 2, on the requested side:
+**                                enc_dec - e' in [-pi/2, pi/2] for
+**                                PM_SIDE_NORMAL, in (pi/2, 3pi/2) for
+**                                PM_SIDE_FLIPPED
 **  Returned (function value):
 **              pm_status   PM_OK; PM_WARN_NOT_CONVERGED; PM_WARN_UNREACHABLE;
 **                          PM_ERR_ARG; PM_ERR_NONFINITE; PM_ERR_STATE
@@ -265,16 +269,25 @@ pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
 **  1) The isotropic part is inverted in closed form; the anisotropic
 **     displacement is iterated to a fixed point (at most
 **     PM_INVERT_MAX_FIXED steps), falling back to damped Newton steps (at
-**     most PM_INVERT_MAX_NEWTON) where the fixed point does not contract
-**     (within about the anisotropic amplitude of the mount's pole).  The
-**     round-trip error |apply(invert(x)) - x| is below PM_INVERT_TOL
-**     on return with PM_OK.  Worst case: PM_INVERT_MAX_FIXED +
-**     3*PM_INVERT_MAX_NEWTON + 1 evaluations of the model.
-**  2) PM_WARN_NOT_CONVERGED: the bound was reached; the best position found
-**     is returned.  PM_WARN_UNREACHABLE: the target lies in the cap around
-**     the mount's pole that the collimation and non-perpendicularity make
-**     unreachable; the nearest reachable position is returned.
-**  3) The paper (Sec. 5.2) inverts by flipping the sign of the
+**     most PM_INVERT_MAX_NEWTON, each with at most 12 step halvings) where
+**     the fixed point does not contract (within about the anisotropic
+**     amplitude of the mount's pole).  The round-trip error
+**     |apply(invert(x)) - x| is below PM_INVERT_TOL on return with PM_OK.
+**  2) Within a few arcminutes of the mount's pole the closed form's two
+**     branches need not match the two sides of the pole (the anisotropic
+**     terms fold the sky there), so the other branch is tried, then
+**     side-locked Newton runs from PM_INVERT_POLE_STARTS points on the
+**     pole's edge.  Hard bound: at most (2 + 2 * PM_INVERT_POLE_STARTS) *
+**     (PM_INVERT_MAX_FIXED + 2 + 15 * PM_INVERT_MAX_NEWTON) model
+**     evaluations (2,340); elsewhere a few.  For tracking use
+**     pm_model_invert_near, which never needs the rescue (at most 130).
+**  3) PM_WARN_NOT_CONVERGED: a bound was reached; the best position found
+**     is returned.  PM_WARN_UNREACHABLE: no position on the requested side
+**     points at the target: it lies in the cap around the mount's pole
+**     that collimation, non-perpendicularity and the anisotropic terms
+**     make unreachable from that side; the nearest position found on that
+**     side is returned.
+**  4) The paper (Sec. 5.2) inverts by flipping the sign of the
 **     coefficients, with an error O(a^2); docs/model.md gives the measured
 **     size of that error.
 **  Reference: Pal et al., Sec. 5.2.
@@ -288,10 +301,12 @@ pm_status pm_model_invert(const pm_model *m, const pm_context *ctx,
 **  position (e.g. the previous tracking tick).
 **
 **  Given:
-**     start_ha, start_dec  double  encoder position to start from; its
-**                                  side of the pole selects the solution,
-**                                  and enc_ha is returned within pi of
-**                                  start_ha (no jump at +-pi when tracking)
+**     start_ha, start_dec  double  encoder position to start from (the
+**                                  previous tick); the solution is the one
+**                                  continuous with it, and enc_ha, enc_dec
+**                                  are returned within pi of start_ha,
+**                                  start_dec (no jump at +-pi when
+**                                  tracking).  At most 130 evaluations.
 **  Other arguments, return values and notes as pm_model_invert.
 */
 pm_status pm_model_invert_near(const pm_model *m, const pm_context *ctx,

@@ -46,11 +46,18 @@ double miss(const pm_model *m, const Iso<double> &k, const Trig<double> &g,
     return m_atan2(m_sqrt(dot<double>(c, c)), dot<double>(p, q));
 }
 
+/* Which side of the mount's pole an encoder declination is on: the sign of
+** cos(dec - e'). */
+int side_of(const pm_model *m, double d) { return m_cos(d - m->coef[4]) >= 0 ? 1 : -1; }
+
 /* Damped Newton iteration on the forward model, in a frame fixed at the
 ** target.  Used where the fixed point does not contract (close to the
-** mount's pole).  x = (t, d) encoder angles, updated in place. */
+** mount's pole).  x = (t, d) encoder angles, updated in place.  With
+** lock = +1/-1 a trial point beyond the pole from that side is moved back
+** onto the pole's edge (projected steps: the nearest point on one side). */
 pm_status newton(const pm_model *m, const Iso<double> &k, const V3<double> &q,
-                 double tq, double dq, double *t, double *d, double *err)
+                 double tq, double dq, double *t, double *d, double *err,
+                 int lock = 0)
 {
     /* frame at the target: e1 along increasing axis 1, e2 along axis 2 */
     double st = m_sin(tq), ct = m_cos(tq), sd = m_sin(dq), cd = m_cos(dq);
@@ -74,13 +81,18 @@ pm_status newton(const pm_model *m, const Iso<double> &k, const V3<double> &q,
         double mu = 1e-12 * (jtj00 + jtj11);
         double lam = 1.0;
         bool improved = false;
-        for (int tries = 0; tries < 4 && !improved; tries++) {
+        for (int tries = 0; tries < 12 && !improved; tries++) {
             double A = jtj00 + mu, B = jtj01, D = jtj11 + mu;
             double det = A * D - B * B;
             if (!(det > 0))
                 break;
             double x0 = (D * g0 - B * g1) / det, x1 = (A * g1 - B * g0) / det;
             double nt = *t + lam * x0, nd = *d + lam * x1;
+            if (lock && side_of(m, nd) != lock) {
+                /* back onto the edge: dec - e' = +-90 deg on the locked side */
+                double pole = m_sin(nd - m->coef[4]) >= 0 ? PI / 2 : -PI / 2;
+                nd = pole + m->coef[4] - (pole > 0 ? 1 : -1) * lock * 1e-12;
+            }
             double e = miss(m, k, trig_of(nt, nd), q);
             if (e < best) {
                 best = e;
@@ -96,6 +108,74 @@ pm_status newton(const pm_model *m, const Iso<double> &k, const V3<double> &q,
     }
     *err = best;
     return best <= PM_INVERT_TOL ? PM_OK : PM_WARN_NOT_CONVERGED;
+}
+
+/* Solve on one branch of the closed form (side = +1/-1), or from the start
+** position's branch.  Returns the status, (t, d) and the round-trip miss
+** when known (0 if the fixed point converged). */
+pm_status solve_branch(const pm_model *m, const Iso<double> &k,
+                       const V3<double> &q, double app_ha, double app_dec,
+                       int side, const double *start, double *t_out,
+                       double *d_out)
+{
+    double dt_prev = 0, dd_prev = 0;
+    Trig<double> g;
+    if (start) {
+        /* The branch of the start: the sign of the x-component of
+        ** Pd(d - e') T(i) w there, the quantity iso_inverse chooses by
+        ** (near the mount's pole it differs from the sign of cos(dec)). */
+        g = trig_of(start[0], start[1]);
+        aniso<double>(m, g, &dt_prev, &dd_prev);
+        double stp, ctp, sdp, cdp;
+        shifted<double>(k, g, &stp, &ctp, &sdp, &cdp);
+        V3<double> v = rot_z<double>(k.si, k.ci, expmap<double>(dt_prev, dd_prev));
+        side = cdp * v.x - sdp * v.z >= 0 ? 1 : -1;
+    }
+    bool reachable = iso_inverse<double>(k, q, dt_prev, dd_prev, side, &g);
+
+    /* Fixed point: x_{n+1} = iso_inverse(D(x_n)).  x_n misses the target
+    ** by |D(x_n) - D(x_{n-1})| (to first order), which is the test. */
+    double change = 0, last_change = 1e300, best_change = 1e300;
+    bool converged = false, best_reachable = reachable;
+    Trig<double> best = g;
+    for (int it = 0; it < PM_INVERT_MAX_FIXED; it++) {
+        double dt, dd;
+        aniso<double>(m, g, &dt, &dd);
+        change = m_sqrt((dt - dt_prev) * (dt - dt_prev) +
+                        (dd - dd_prev) * (dd - dd_prev));
+        if (change < best_change) {
+            best_change = change;
+            best = g;
+            best_reachable = reachable;
+        }
+        if (change <= PM_INVERT_TOL * 0.5) {
+            converged = true;
+            break;
+        }
+        if (it > 0 && change > 0.5 * last_change)
+            break; /* not contracting: Newton takes over */
+        last_change = change;
+        dt_prev = dt;
+        dd_prev = dd;
+        reachable = iso_inverse<double>(k, q, dt, dd, side, &g);
+    }
+    g = best;
+    reachable = best_reachable;
+
+    double t = m_atan2(g.st, g.ct);
+    double d = m_atan2(g.sd, g.cd); /* in (-pi, pi] */
+    if (side < 0 && d < 0)
+        d += 2 * PI; /* beyond the pole: report in (pi/2, 3pi/2) */
+    pm_status result = PM_OK;
+    if (!converged || !reachable) {
+        double err;
+        result = newton(m, k, q, app_ha, app_dec, &t, &d, &err);
+        if (result != PM_OK && !reachable)
+            result = PM_WARN_UNREACHABLE;
+    }
+    *t_out = t;
+    *d_out = d;
+    return result;
 }
 
 /* Shared inverse: side = +1/-1, or use the start position. */
@@ -116,51 +196,72 @@ pm_status invert(const pm_model *m, double app_ha, double app_dec, int side,
     Iso<double> k;
     iso_from_model<double>(m, &k);
     V3<double> q = unit_of(app_ha, app_dec);
-
-    double dt_prev = 0, dd_prev = 0;
-    Trig<double> g;
-    if (start) {
-        g = trig_of(start[0], start[1]);
-        side = g.cd >= 0 ? 1 : -1;
-        aniso<double>(m, g, &dt_prev, &dd_prev);
-    }
-    bool reachable = iso_inverse<double>(k, q, dt_prev, dd_prev, side, &g);
-
-    /* Fixed point: x_{n+1} = iso_inverse(D(x_n)).  x_n misses the target
-    ** by |D(x_n) - D(x_{n-1})| (to first order), which is the test. */
-    double change = 0, last_change = 1e300;
-    bool converged = false;
-    for (int it = 0; it < PM_INVERT_MAX_FIXED; it++) {
-        double dt, dd;
-        aniso<double>(m, g, &dt, &dd);
-        change = m_sqrt((dt - dt_prev) * (dt - dt_prev) +
-                        (dd - dd_prev) * (dd - dd_prev));
-        if (change <= PM_INVERT_TOL * 0.5) {
-            converged = true;
-            break;
+    double t, d;
+    pm_status result = solve_branch(m, k, q, app_ha, app_dec, side, start, &t, &d);
+    if (!start && (result != PM_OK || side_of(m, d) != side)) {
+        /* Within the anisotropic amplitude of the mount's pole the closed
+        ** form's branches (sign of cos(dec - e' + displacement angle)) and
+        ** the sides of the pole (sign of cos(dec - e')) differ: the other
+        ** branch may hold the solution on the requested side. */
+        double t2, d2;
+        pm_status r2 = solve_branch(m, k, q, app_ha, app_dec, -side, 0, &t2, &d2);
+        if (r2 == PM_OK && side_of(m, d2) == side) {
+            result = r2;
+            t = t2;
+            d = d2;
+        } else {
+            /* Close to the mount's pole a solution on the requested side
+            ** can lie between the pole and the fold, out of both branches'
+            ** reach: Newton from PM_INVERT_POLE_STARTS points on the pole's
+            ** edge of the requested side. */
+            bool found = false;
+            /* unreachable: the nearest point on the requested side seen */
+            double best_err = 1e300, best_t = t, best_d = d;
+            if (side_of(m, d) == side)
+                best_err = miss(m, k, trig_of(t, d), q);
+            if (side_of(m, d2) == side) {
+                double e2 = miss(m, k, trig_of(t2, d2), q);
+                if (e2 < best_err) {
+                    best_err = e2;
+                    best_t = t2;
+                    best_d = d2;
+                }
+            }
+            double pole = side > 0 ? PI / 2 : -PI / 2; /* dec' of the edge */
+            for (int j = 0; j < PM_INVERT_POLE_STARTS && !found; j++) {
+                double tj = -PI + 2 * PI * (j + 0.5) / PM_INVERT_POLE_STARTS;
+                for (int hemi = -1; hemi <= 1 && !found; hemi += 2) {
+                    double dj = hemi * pole + m->coef[4] - hemi * side * 1e-9;
+                    double err;
+                    pm_status sj =
+                        newton(m, k, q, app_ha, app_dec, &tj, &dj, &err, side);
+                    if (side_of(m, dj) != side)
+                        continue;
+                    if (sj == PM_OK) {
+                        t = tj;
+                        d = dj;
+                        result = PM_OK;
+                        found = true;
+                    } else if (err < best_err) {
+                        best_err = err;
+                        best_t = tj;
+                        best_d = dj;
+                    }
+                }
+            }
+            if (!found) {
+                /* nothing on the requested side reaches the target */
+                result = PM_WARN_UNREACHABLE;
+                if (best_err < 1e300) {
+                    t = best_t;
+                    d = best_d;
+                }
+            }
         }
-        if (it > 0 && change > 0.5 * last_change)
-            break; /* not contracting: Newton takes over */
-        last_change = change;
-        dt_prev = dt;
-        dd_prev = dd;
-        reachable = iso_inverse<double>(k, q, dt, dd, side, &g);
-    }
-
-    double t = m_atan2(g.st, g.ct);
-    double d = m_atan2(g.sd, g.cd); /* in (-pi, pi] */
-    if (side < 0 && d < 0)
-        d += 2 * PI; /* beyond the pole: report in (pi/2, 3pi/2) */
-    pm_status result = PM_OK;
-    if (!converged || !reachable) {
-        double err;
-        result = newton(m, k, q, app_ha, app_dec, &t, &d, &err);
-        if (result != PM_OK && !reachable)
-            result = PM_WARN_UNREACHABLE;
     }
     if (start) {
-        double off = wrap_pi(t - start[0]);
-        t = start[0] + off;
+        t = start[0] + wrap_pi(t - start[0]);
+        d = start[1] + wrap_pi(d - start[1]);
     } else {
         t = wrap_pi(t);
     }
@@ -330,7 +431,8 @@ pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
     Iso<double> k;
     iso_from_model<double>(m, &k);
     V3<double> p = forward_vec<double>(m, k, trig_of(enc_ha, enc_dec));
-    *app_ha = m_atan2(p.y, p.x);
+    double t = m_atan2(p.y, p.x);
+    *app_ha = t <= -PI ? PI : t; /* atan2(-0, -1) = -pi */
     *app_dec = m_atan2(p.z, m_sqrt(p.x * p.x + p.y * p.y));
     return PM_OK;
 }

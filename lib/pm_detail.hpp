@@ -338,8 +338,13 @@ inline bool iso_inverse(const Iso<T> &k, const V3<T> &q, T dt, T dd, int side,
     T disc = rho2 - uy * uy;
     bool ok = true;
     if (disc < 0) {
+        /* The target lies outside this branch's reach by about
+        ** -disc / (2 |q0_xy|) radians; within rounding of the edge (the
+        ** fold, where both branches meet) it is reached there. */
+        T rho = m_sqrt(rho2) + (T)1e-300;
+        if (-disc / (2 * rho) > (T)(PM_INVERT_TOL * 0.25))
+            ok = false;
         disc = 0;
-        ok = false;
     }
     T g1 = (T)side * m_sqrt(disc);
     /* (g1 + i g3) = (vx + i vz) exp(i d'): d' = arg(g1 + i g3) - arg(v) */
