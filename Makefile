@@ -31,7 +31,7 @@ TOOLS     := $(TOOL_SRC:tools/%.cpp=$(B)/%)
 TEST_SRC  := $(wildcard tests/check_*.c)
 TESTS     := $(TEST_SRC:tests/%.c=$(B)/tests/%)
 
-.PHONY: all test test-run demo-run deps check-freestanding check-c89 check-example install clean bench firmware demo
+.PHONY: all test test-run demo-run deps check-freestanding check-c89 check-example check-install install clean bench firmware demo
 all: $(B)/libpm.a $(B)/libpm.so $(B)/libpmhost.a $(TOOLS)
 
 $(B)/core/%.o: lib/%.cpp $(wildcard include/*.h lib/*.hpp)
@@ -112,7 +112,21 @@ check-example: $(B)/libpm.a
 	$(B)/fit_and_apply > $(B)/fit_and_apply.out
 	@echo "check-example: README example builds as C89 and runs"
 
-test-run: all check-c89 check-freestanding check-example $(TESTS)
+# make install into a staging directory, then build the example against the
+# installed header and library through pkg-config.
+check-install: all
+	@rm -rf $(B)/stage
+	@$(MAKE) --no-print-directory install PREFIX=$(CURDIR)/$(B)/stage > /dev/null
+	$(CC) -std=c89 -pedantic -Werror -c examples/fit_and_apply.c -o $(B)/stage/fa.o \
+	  $$(PKG_CONFIG_PATH=$(B)/stage/lib/pkgconfig pkg-config --cflags pm)
+	$(CC) -std=c99 -c examples/fit_and_apply_main.c -o $(B)/stage/fam.o \
+	  $$(PKG_CONFIG_PATH=$(B)/stage/lib/pkgconfig pkg-config --cflags pm)
+	$(CC) $(B)/stage/fa.o $(B)/stage/fam.o -o $(B)/stage/fa -static-libgcc \
+	  $$(PKG_CONFIG_PATH=$(B)/stage/lib/pkgconfig pkg-config --libs pm) -Wl,-rpath,$(CURDIR)/$(B)/stage/lib
+	$(B)/stage/fa > /dev/null
+	@echo "check-install: installed header, libraries and pm.pc build and run the example"
+
+test-run: all check-c89 check-freestanding check-example check-install $(TESTS)
 	@$(PYTHON) -c 'import numpy' 2>/dev/null || echo "note: numpy missing; reference tables are committed, regeneration needs python3-numpy"
 	@fail=0; total_run=0; total_fail=0; \
 	for t in $(TESTS); do \

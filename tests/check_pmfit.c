@@ -142,6 +142,7 @@ END_TEST
 START_TEST(test_pmfit_simulate_fit_roundtrip)
 {
     char run_path[300], model_path[300], hdr_path[300], args[1024];
+    double rms_fit;
     pm_model m;
     char err[512];
     int i;
@@ -156,6 +157,12 @@ START_TEST(test_pmfit_simulate_fit_roundtrip)
              model_path, hdr_path);
     ck_assert_msg(run("%s fit %s%s", args, "") == 0, "%s", out);
     ck_assert_double_lt(fabs(json_num(out, "sigma_arcsec") - 0.5), 0.05);
+    rms_fit = json_num(out, "rms_arcsec");
+    /* pmfit reads its own model file back: eval on the same run gives the
+    ** fit's sky RMS (same model, same residuals) */
+    snprintf(args, sizeof args, "%s %s --json", model_path, run_path);
+    ck_assert_msg(run("%s eval %s%s", args, "") == 0, "%s", out);
+    ck_assert_double_eq_tol(json_num(out, "rms_arcsec"), rms_fit, 1e-6);
     ck_assert_int_eq(pmmodel_load(model_path, &m, err, sizeof err), 0);
     ck_assert_int_eq(m.order, 1);
     /* c' within 1 arcsec (its error is ~0.05") */

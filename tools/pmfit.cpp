@@ -2,6 +2,7 @@
 //
 //   pmfit fit RUN [--order L] [--pier joint|split] [--json] [--residuals FILE]
 //                 [--save MODEL] [--emit-c HEADER] [--no-refraction] [--skip-bad]
+//   pmfit eval MODEL RUN [--json] [--residuals FILE] [--no-refraction] [--skip-bad]
 //   pmfit simulate OUT [--n N] [--seed S] [--lat DEG] [--mount equatorial|altaz]
 //                 [--fork] [--el-limit DEG] [--noise ARCSEC] [--order L]
 //                 [--term NAME=ARCSEC ...] [--random-aniso ARCSEC]
@@ -12,6 +13,7 @@
 #include "runfile.h"
 #include "modelfile.h"
 #include "simulate.h"
+#include "hostutil.hpp"
 
 #include <cerrno>
 #include <cmath>
@@ -30,7 +32,7 @@ const double RAD2AS = 206264.80624709636;
 const double PI = 3.14159265358979323846;
 
 struct Options {
-    std::string cmd, run;
+    std::string cmd, run, model; // model: eval's MODEL
     int order = 1;
     bool split = false;
     bool json = false;
@@ -63,6 +65,11 @@ void usage(FILE *f)
         "  --emit-c HEADER  write the model as C constant data with a loader, for firmware\n"
         "  --no-refraction  leave refraction out of the TPOINT reduction\n"
         "  --skip-bad       skip malformed records (each is reported) instead of failing\n"
+        "\n"
+        "usage: pmfit eval MODEL RUN [--json] [--residuals FILE] [--no-refraction] [--skip-bad]\n"
+        "\n"
+        "  applies a saved model (pmfit fit --save) to a run without refitting: how well\n"
+        "  does last night's model point tonight?\n"
         "\n"
         "usage: pmfit simulate OUT [--n N] [--seed S] [--lat DEG] [--mount equatorial|altaz]\n"
         "                      [--fork] [--el-limit DEG] [--noise ARCSEC] [--order L]\n"
@@ -108,9 +115,9 @@ Options parse_args(int argc, char **argv)
         usage(stdout);
         std::exit(0);
     }
-    if (o.cmd != "fit" && o.cmd != "simulate")
-        die("unknown command '" + o.cmd + "' (expected: fit or simulate); see pmfit --help");
-    bool sim = o.cmd == "simulate";
+    if (o.cmd != "fit" && o.cmd != "simulate" && o.cmd != "eval")
+        die("unknown command '" + o.cmd + "' (expected: fit, eval or simulate); see pmfit --help");
+    bool sim = o.cmd == "simulate", eval = o.cmd == "eval";
     auto number = [&](const std::string &opt, const char *v, double lo, double hi) {
         char *end = nullptr;
         double x = std::strtod(v, &end);
@@ -126,12 +133,12 @@ Options parse_args(int argc, char **argv)
                 die(a + " needs " + what);
             return argv[++i];
         };
-        if (a == "--order") {
+        if (!eval && a == "--order") {
             const char *v = need("an order");
             if (!parse_int(v, &o.order) || o.order < 0 || o.order > PM_MAX_L)
                 die(std::string("--order: expected an integer 0..") +
                     std::to_string(PM_MAX_L) + ", got '" + v + "'");
-        } else if (!sim && a == "--pier") {
+        } else if (!sim && !eval && a == "--pier") {
             std::string v = need("joint or split");
             if (v == "split")
                 o.split = true;
@@ -143,9 +150,9 @@ Options parse_args(int argc, char **argv)
             o.json = true;
         } else if (!sim && a == "--residuals") {
             o.residuals = need("a file name");
-        } else if (!sim && a == "--save") {
+        } else if (!sim && !eval && a == "--save") {
             o.save = need("a file name");
-        } else if (!sim && a == "--emit-c") {
+        } else if (!sim && !eval && a == "--emit-c") {
             o.emit_c = need("a file name");
         } else if (sim && a == "--n") {
             o.n = (long)number(a, need("a count"), 1, 1e7);
@@ -178,12 +185,16 @@ Options parse_args(int argc, char **argv)
             o.skip_bad = true;
         } else if (!a.empty() && a[0] == '-') {
             die("unknown option '" + a + "'; see pmfit --help");
+        } else if (eval && o.model.empty()) {
+            o.model = a;
         } else if (o.run.empty()) {
             o.run = a;
         } else {
             die("more than one run file given ('" + o.run + "', '" + a + "')");
         }
     }
+    if (eval && o.model.empty())
+        die("no model file given; see pmfit --help");
     if (o.run.empty())
         die(sim ? "no output file given; see pmfit --help" : "no run file given; see pmfit --help");
     return o;
@@ -245,6 +256,21 @@ struct FitOut {
     double rms = 0;
 };
 
+// Residuals of f.model on the observations `use`, and their RMS on the sky.
+void residuals(FitOut &f, const std::vector<Obs> &obs, const std::vector<int> &use)
+{
+    double ss = 0;
+    for (int i : use) {
+        double r[2];
+        pm_model_residual(&f.model, nullptr, obs[i].eh, obs[i].ed, obs[i].ah, obs[i].ad, r);
+        f.r0.push_back(r[0]);
+        f.r1.push_back(r[1]);
+        f.idx.push_back(i);
+        ss += r[0] * r[0] + r[1] * r[1];
+    }
+    f.rms = use.empty() ? 0 : std::sqrt(ss / (double)use.size());
+}
+
 FitOut do_fit(const std::vector<Obs> &obs, const std::vector<int> &use, int mount,
               int order)
 {
@@ -280,16 +306,7 @@ FitOut do_fit(const std::vector<Obs> &obs, const std::vector<int> &use, int moun
         }
         return f;
     }
-    double ss = 0;
-    for (size_t j = 0; j < use.size(); j++) {
-        double r[2];
-        pm_model_residual(&f.model, nullptr, eh[j], ed[j], ah[j], ad[j], r);
-        f.r0.push_back(r[0]);
-        f.r1.push_back(r[1]);
-        f.idx.push_back(use[j]);
-        ss += r[0] * r[0] + r[1] * r[1];
-    }
-    f.rms = std::sqrt(ss / (double)use.size());
+    residuals(f, obs, use);
     return f;
 }
 
@@ -388,6 +405,54 @@ void fail_fit(const FitOut &f, const std::string &what)
 
 } // namespace
 
+// Write per-observation residuals (arcsec) atomically.
+void write_residuals(const std::string &path, const std::string &title,
+                     const std::vector<FitOut> &fits, const std::vector<Obs> &obs)
+{
+    std::string text = "# " + title + ", arcsec on the sky\n"
+                       "# line enc1_deg enc2_deg pier res1_arcsec res2_arcsec\n";
+    char buf[160];
+    for (const FitOut &f : fits)
+        for (size_t j = 0; j < f.idx.size(); j++) {
+            const Obs &ob = obs[f.idx[j]];
+            std::snprintf(buf, sizeof buf, "%d %.6f %.6f %d %.4f %.4f\n", ob.line,
+                          ob.eh * 180 / PI, ob.ed * 180 / PI, ob.pier, f.r0[j] * RAD2AS,
+                          f.r1[j] * RAD2AS);
+            text += buf;
+        }
+    char err[1024];
+    if (pmhost::write_atomic(path, text, err, sizeof err) != 0)
+        die(err, 1);
+}
+
+int cmd_eval(const Options &o, const std::vector<Obs> &obs, int mount)
+{
+    FitOut f;
+    char err[1024];
+    if (pmmodel_load(o.model.c_str(), &f.model, err, sizeof err) != 0)
+        die(err, 1);
+    if (f.model.mount != mount)
+        die(o.model + " is a model of an " +
+                (f.model.mount == PM_MOUNT_ALTAZ ? "alt-az" : "equatorial") + " mount, " +
+                o.run + " a run of an " + (mount == PM_MOUNT_ALTAZ ? "alt-az" : "equatorial") +
+                " one", 1);
+    std::vector<int> all(obs.size());
+    for (size_t i = 0; i < obs.size(); i++)
+        all[i] = (int)i;
+    residuals(f, obs, all);
+    if (!o.residuals.empty())
+        write_residuals(o.residuals, "residuals of pmfit eval " + o.model + " " + o.run, {f}, obs);
+    if (o.json) {
+        std::printf("{\"n_obs\": %zu, \"n_params\": %d, \"order\": %d, \"rms_arcsec\": %.6f}\n",
+                    obs.size(), f.model.n_terms, f.model.order, f.rms * RAD2AS);
+    } else {
+        std::printf("pmfit eval %s on %s: %zu observations, model of order %d (%d terms)\n",
+                    o.model.c_str(), o.run.c_str(), obs.size(), f.model.order, f.model.n_terms);
+        std::printf("  sky RMS of the residuals, no refit: %.3f\"\n", f.rms * RAD2AS);
+    }
+    return 0;
+}
+
 int cmd_simulate(const Options &o, int argc, char **argv)
 {
     pmsim_spec spec;
@@ -455,6 +520,8 @@ int main(int argc, char **argv)
         obs.push_back({p->enc_ha, p->enc_dec, p->app_ha, p->app_dec, p->pier, p->line});
     }
     int mount = pmrun_mount(run) == PMRUN_MOUNT_ALTAZ ? PM_MOUNT_ALTAZ : PM_MOUNT_EQUATORIAL;
+    if (o.cmd == "eval")
+        return cmd_eval(o, obs, mount);
 
     // residual file is written only after every fit succeeded
     std::vector<FitOut> fits;
@@ -485,23 +552,11 @@ int main(int argc, char **argv)
         }
     }
 
-    if (!o.residuals.empty()) {
-        std::string tmp = o.residuals + ".tmp";
-        FILE *rf = std::fopen(tmp.c_str(), "w");
-        if (!rf)
-            die("cannot write " + o.residuals + ": " + std::strerror(errno), 1);
-        std::fprintf(rf, "# residuals of pmfit fit %s (order %d, pier %s), arcsec on the sky\n",
-                     o.run.c_str(), o.order, o.split ? "split" : "joint");
-        std::fprintf(rf, "# line enc1_deg enc2_deg pier res1_arcsec res2_arcsec\n");
-        for (const FitOut &f : fits)
-            for (size_t j = 0; j < f.idx.size(); j++) {
-                const Obs &ob = obs[f.idx[j]];
-                std::fprintf(rf, "%d %.6f %.6f %d %.4f %.4f\n", ob.line, ob.eh * 180 / PI,
-                             ob.ed * 180 / PI, ob.pier, f.r0[j] * RAD2AS, f.r1[j] * RAD2AS);
-            }
-        if (std::fclose(rf) != 0 || std::rename(tmp.c_str(), o.residuals.c_str()) != 0)
-            die("cannot write " + o.residuals, 1);
-    }
+    if (!o.residuals.empty())
+        write_residuals(o.residuals,
+                        "residuals of pmfit fit " + o.run + " (order " + std::to_string(o.order) +
+                            ", pier " + (o.split ? "split" : "joint") + ")",
+                        fits, obs);
 
     for (size_t k = 0; k < fits.size(); k++) {
         std::string suffix = fits.size() == 1 ? "" : (k == 0 ? "-east" : "-west");
