@@ -97,8 +97,33 @@ typedef enum pm_status {
 #define PM_MOUNT_EQUATORIAL 0
 #define PM_MOUNT_ALTAZ 1
 
-/* Term kinds. */
-#define PM_TERM_SH 0 /* a_klm Y_lm p_k (Pal et al. Eq. pyyexpansion) */
+/* Term kinds (docs/model.md, "Physical terms").  All but the six
+** isotropic ones are tangent-plane displacements, linear in their
+** coefficient. */
+#define PM_TERM_SH 0       /* a_klm Y_lm p_k (Pal et al. Eq. pyyexpansion) */
+#define PM_TERM_FOURIER 1  /* coef * trig(param * theta) * p_k: theta the raw
+                              angle of axis l (1 or 2), trig = cos (m = 0) or
+                              sin (m = 1), param = cycles per revolution
+                              (periodic gear error; non-integer allowed) */
+#define PM_TERM_SECTORAL 2 /* the paper's Y_{G,G} p_k (m = 0) or Y_{G,-G} p_k
+                              (m = 1) with G = param: cos^G(dec) * trig(G ha),
+                              kept to compare with PM_TERM_FOURIER */
+#define PM_TERM_ZENITH 3   /* displacement toward the zenith: l = 0:
+                              coef * cot(el) (refraction-like), l = 1:
+                              coef * cos(el) (tube flexure) */
+#define PM_TERM_AUX 4      /* coef * (input - param) * p_k, input chosen by
+                              aux (PM_AUX_*) from the pm_context */
+
+/* Inputs of PM_TERM_AUX (pm_term.aux). */
+#define PM_AUX_TEMP 0  /* pm_context.temp_c */
+#define PM_AUX_TIME 1  /* pm_context.time_h */
+#define PM_AUX_DIR 2   /* pm_context.dir (+1/-1) */
+#define PM_AUX_USER 3  /* PM_AUX_USER + j: pm_context.aux[j] */
+
+/* User inputs in a pm_context. */
+#ifndef PM_MAX_AUX
+#define PM_MAX_AUX 4
+#endif
 
 /* Base vectors k = 1..6 of Pal et al. Eq. (tdvectexpansion). */
 #define PM_BASE_A 1 /* polar axis misalignment, a (TPOINT: ME-like)  */
@@ -116,20 +141,30 @@ typedef enum pm_status {
 
 /* One term of the model. */
 typedef struct pm_term {
-    unsigned char kind; /* PM_TERM_SH */
-    unsigned char k;    /* base vector 1..6 (PM_BASE_*) */
-    signed char l;      /* harmonic degree 0..PM_MAX_L */
-    signed char m;      /* harmonic order -l..l (m<0: sin|m|tau) */
+    unsigned char kind; /* PM_TERM_* */
+    unsigned char k;    /* base vector 1..6 (PM_BASE_*); unused by ZENITH */
+    signed char l;      /* SH: degree 0..PM_MAX_L; FOURIER: axis 1 or 2;
+                           ZENITH: 0 cot(el), 1 cos(el) */
+    signed char m;      /* SH: order -l..l (m<0: sin|m|tau); FOURIER,
+                           SECTORAL: 0 cos, 1 sin */
+    signed char side;   /* 0 both pier sides; +1 normal side only; -1 only
+                           beyond the pole (PM_SIDE_* of the observation) */
+    unsigned char aux;  /* AUX: PM_AUX_* input */
+    double param;       /* FOURIER: cycles per revolution; SECTORAL: G;
+                           AUX: reference value of the input */
 } pm_term;
 
 /* Per-evaluation inputs that some terms use (temperature, time, pier side,
-** slew direction).  Pass NULL where no term needs them; the harmonic terms
-** use none. */
+** slew direction, user columns).  Pass NULL where no term needs them: the
+** harmonic, periodic and zenith terms need none; PM_TERM_AUX terms make a
+** NULL context an error (PM_ERR_ARG). */
 typedef struct pm_context {
-    double temp_c; /* ambient temperature (deg C) */
-    double time_h; /* time (hours, any zero point) */
-    int pier;      /* +1 east, -1 west, 0 unknown */
-    int dir;       /* last slew direction on axis 1: +1, -1, 0 unknown */
+    double temp_c;          /* ambient temperature (deg C) */
+    double time_h;          /* time (hours, any zero point) */
+    int pier;               /* +1 normal side (east), -1 beyond the pole
+                               (west), 0: from the encoder dec */
+    int dir;                /* last slew direction on axis 1: +1, -1, 0 */
+    double aux[PM_MAX_AUX]; /* user inputs (PM_AUX_USER + j) */
 } pm_context;
 
 /* A pointing model: the term list, the coefficients (radians) and derived
@@ -140,6 +175,12 @@ typedef struct pm_model {
     int mount;                     /* PM_MOUNT_* */
     int order;                     /* spherical-harmonic order L */
     int n_terms;                   /* P */
+    int n_base;                    /* the first n_base terms are the
+                                      harmonic set of pm_model_init; the
+                                      rest were added (pm_model_add_term) */
+    double latitude;               /* site latitude (radians), needed by
+                                      ZENITH terms on equatorial mounts */
+    int needs_ctx;                 /* derived: some term reads pm_context */
     pm_term term[PM_MAX_TERMS];
     double coef[PM_MAX_TERMS];     /* radians */
     /* Derived by pm_model_prepare; do not set by hand. */
@@ -189,6 +230,34 @@ pm_status pm_model_init(pm_model *m, int mount, int order);
 pm_status pm_model_prepare(pm_model *m);
 
 /*
+**  pm_model_add_term - append a term (a physical term, or a harmonic term
+**  restricted to one pier side) to a model.
+**
+**  Given/Returned:
+**     m        pm_model*       model (from pm_model_init)
+**  Given:
+**     t        const pm_term*  the term (kind and fields as in pm_term)
+**     value    double          its coefficient (radians; for AUX radians
+**                              per unit of the input)
+**  Returned:
+**     index    int*            its index (may be NULL)
+**  Returned (function value):
+**              pm_status   PM_OK; PM_ERR_ARG (invalid term: bad kind, base
+**                          vector, axis, side or input; ZENITH on an
+**                          equatorial mount whose latitude is not set is
+**                          accepted, m->latitude is used as it is);
+**                          PM_ERR_CAPACITY (PM_MAX_TERMS reached);
+**                          PM_ERR_NONFINITE
+**  Notes:
+**  1) The model is prepared again.  Harmonic terms (PM_TERM_SH) added here
+**     may have any l <= m->order, including 0, and apply as tangent-plane
+**     displacements; with side != 0 they give the "joint fit with
+**     side-specific terms" of docs/model.md.
+*/
+pm_status pm_model_add_term(pm_model *m, const pm_term *t, double value,
+                            int *index);
+
+/*
 **  pm_model_find - index of a harmonic term in the model.
 **
 **  Given:
@@ -213,8 +282,11 @@ pm_status pm_model_find(const pm_model *m, int k, int l, int mm, int *index);
 **              pm_status   PM_OK; PM_ERR_ARG
 **  Notes:
 **  1) Isotropic terms are named a, b, c', d, e', i; harmonic terms
-**     "<base>*Y(l,m)".  The name is truncated to fit buf (always
-**     NUL-terminated).
+**     "<base>*Y(l,m)"; periodic terms "<base>*cos(<G>*ha)" or "*sin(..dec)";
+**     paper-form periodic "<base>*Ycos(G)"/"Ysin(G)"; zenith terms
+**     "cot(el)", "cos(el)"; auxiliary terms "<base>*temp", "*time",
+**     "*dir", "*aux<j>"; a side restriction appends "@E" or "@W".  The name
+**     is truncated to fit buf (always NUL-terminated).
 */
 pm_status pm_term_name(const pm_model *m, int index, char *buf, size_t len);
 

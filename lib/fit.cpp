@@ -49,8 +49,9 @@ void dlog(const V3<double> &q, double D[2][3], double *ly, double *lz)
 /* Two design rows (model derivatives) and the residual of one observation
 ** at model m.  Residual: r = log(M^T t) - D(x), in the frame transported
 ** by the isotropic rotation M (docs/model.md). */
-void rows(const pm_model *m, double enc_ha, double enc_dec, double app_ha,
-          double app_dec, double *row0, double *row1, double r[2])
+void rows(const pm_model *m, const pm_context *ctx, double enc_ha,
+          double enc_dec, double app_ha, double app_dec, double *row0,
+          double *row1, double r[2])
 {
     Iso<double> k;
     iso_from_model<double>(m, &k);
@@ -66,7 +67,7 @@ void rows(const pm_model *m, double enc_ha, double enc_dec, double app_ha,
     double D[2][3], ly, lz;
     dlog(q, D, &ly, &lz);
     double dt, dd;
-    aniso<double>(m, g, &dt, &dd);
+    aniso<double>(m, k, g, ctx, &dt, &dd);
     r[0] = ly - dt;
     r[1] = lz - dd;
 
@@ -121,7 +122,7 @@ void rows(const pm_model *m, double enc_ha, double enc_dec, double app_ha,
     /* harmonic terms: linear, row = Y_lm N_lm (u_k, v_k) */
     double Y[PM_N_HARM(PM_MAX_L)];
     harmonics<double>(m->order, g, Y);
-    for (int i = 6; i < m->n_terms; i++) {
+    for (int i = 6; i < m->n_base; i++) {
         const pm_term *tm = &m->term[i];
         int j = tm->l * tm->l + tm->l + tm->m;
         double y = Y[j] * norm_lm(tm->l, tm->m);
@@ -129,6 +130,14 @@ void rows(const pm_model *m, double enc_ha, double enc_dec, double app_ha,
         base_uv<double>(tm->k, g, &u, &v);
         row0[i] = y * u;
         row1[i] = y * v;
+    }
+    /* added terms: linear, row = their displacement per unit coefficient
+    ** (the zenith direction's dependence on the isotropic terms is left out
+    ** of those columns: a second-order effect) */
+    if (m->n_terms > m->n_base) {
+        Site<double> st = site_of<double>(m, k, g, ctx);
+        for (int i = m->n_base; i < m->n_terms; i++)
+            term_uv<double>(m->term[i], g, st, ctx, &row0[i], &row1[i]);
     }
 }
 
@@ -240,18 +249,20 @@ pm_status pm_fit_init(pm_fit *fit, const pm_model *start)
 pm_status pm_fit_add(pm_fit *fit, const pm_context *ctx, double enc_ha,
                      double enc_dec, double app_ha, double app_dec)
 {
-    (void)ctx;
     if (!fit)
         return PM_ERR_ARG;
     if (fit->state != FIT_READY || fit->n_par != fit->lin.n_terms)
         return PM_ERR_STATE;
+    pm_status cs = context_ok(&fit->lin, ctx);
+    if (cs != PM_OK)
+        return cs;
     if (!finite(enc_ha) || !finite(enc_dec) || !finite(app_ha) ||
         !finite(app_dec))
         return PM_ERR_NONFINITE;
     if (m_fabs(app_dec) > PI / 2 + 1e-9)
         return PM_ERR_ARG;
     double r0[PM_MAX_TERMS], r1[PM_MAX_TERMS], r[2];
-    rows(&fit->lin, enc_ha, enc_dec, app_ha, app_dec, r0, r1, r);
+    rows(&fit->lin, ctx, enc_ha, enc_dec, app_ha, app_dec, r0, r1, r);
     int P = fit->n_par;
     for (int i = 0; i < P; i++)
         if (!finite(r0[i]) || !finite(r1[i]))
@@ -454,8 +465,10 @@ pm_status pm_fit_row(const pm_model *m, const pm_context *ctx, double enc_ha,
                      double enc_dec, double app_ha, double app_dec,
                      double *row0, double *row1, double r[2])
 {
-    (void)ctx;
     pm_status st = model_ready(m);
+    if (st != PM_OK)
+        return st;
+    st = context_ok(m, ctx);
     if (st != PM_OK)
         return st;
     if (!row0 || !row1 || !r)
@@ -463,7 +476,7 @@ pm_status pm_fit_row(const pm_model *m, const pm_context *ctx, double enc_ha,
     if (!finite(enc_ha) || !finite(enc_dec) || !finite(app_ha) ||
         !finite(app_dec))
         return PM_ERR_NONFINITE;
-    rows(m, enc_ha, enc_dec, app_ha, app_dec, row0, row1, r);
+    rows(m, ctx, enc_ha, enc_dec, app_ha, app_dec, row0, row1, r);
     return PM_OK;
 }
 

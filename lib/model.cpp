@@ -38,10 +38,11 @@ double wrap_pi(double a)
 
 /* Round-trip residual of encoder trig g against target q, measured as the
 ** tangent offset (radians) of q seen from the model's position. */
-double miss(const pm_model *m, const Iso<double> &k, const Trig<double> &g,
+double miss(const pm_model *m, const Iso<double> &k, const pm_context *ctx,
+            const Trig<double> &g,
             const V3<double> &q)
 {
-    V3<double> p = forward_vec<double>(m, k, g);
+    V3<double> p = forward_vec<double>(m, k, g, ctx);
     V3<double> c = cross<double>(p, q);
     return m_atan2(m_sqrt(dot<double>(c, c)), dot<double>(p, q));
 }
@@ -55,7 +56,8 @@ int side_of(const pm_model *m, double d) { return m_cos(d - m->coef[4]) >= 0 ? 1
 ** mount's pole).  x = (t, d) encoder angles, updated in place.  With
 ** lock = +1/-1 a trial point beyond the pole from that side is moved back
 ** onto the pole's edge (projected steps: the nearest point on one side). */
-pm_status newton(const pm_model *m, const Iso<double> &k, const V3<double> &q,
+pm_status newton(const pm_model *m, const Iso<double> &k, const pm_context *ctx,
+                 const V3<double> &q,
                  double tq, double dq, double *t, double *d, double *err,
                  int lock = 0)
 {
@@ -64,11 +66,11 @@ pm_status newton(const pm_model *m, const Iso<double> &k, const V3<double> &q,
     V3<double> e1 = v3(-st, ct, 0.0);
     V3<double> e2 = v3(-sd * ct, -sd * st, cd);
     const double h = 1e-7;
-    double best = miss(m, k, trig_of(*t, *d), q);
+    double best = miss(m, k, ctx, trig_of(*t, *d), q);
     for (int it = 0; it < PM_INVERT_MAX_NEWTON && best > PM_INVERT_TOL; it++) {
-        V3<double> f0 = forward_vec<double>(m, k, trig_of(*t, *d));
-        V3<double> ft = forward_vec<double>(m, k, trig_of(*t + h, *d));
-        V3<double> fd = forward_vec<double>(m, k, trig_of(*t, *d + h));
+        V3<double> f0 = forward_vec<double>(m, k, trig_of(*t, *d), ctx);
+        V3<double> ft = forward_vec<double>(m, k, trig_of(*t + h, *d), ctx);
+        V3<double> fd = forward_vec<double>(m, k, trig_of(*t, *d + h), ctx);
         double F1 = dot(q, e1) - dot(f0, e1), F2 = dot(q, e2) - dot(f0, e2);
         double a = (dot(ft, e1) - dot(f0, e1)) / h;
         double b = (dot(fd, e1) - dot(f0, e1)) / h;
@@ -93,7 +95,7 @@ pm_status newton(const pm_model *m, const Iso<double> &k, const V3<double> &q,
                 double pole = m_sin(nd - m->coef[4]) >= 0 ? PI / 2 : -PI / 2;
                 nd = pole + m->coef[4] - (pole > 0 ? 1 : -1) * lock * 1e-12;
             }
-            double e = miss(m, k, trig_of(nt, nd), q);
+            double e = miss(m, k, ctx, trig_of(nt, nd), q);
             if (e < best) {
                 best = e;
                 *t = nt;
@@ -114,7 +116,7 @@ pm_status newton(const pm_model *m, const Iso<double> &k, const V3<double> &q,
 ** position's branch.  Returns the status, (t, d) and the round-trip miss
 ** when known (0 if the fixed point converged). */
 pm_status solve_branch(const pm_model *m, const Iso<double> &k,
-                       const V3<double> &q, double app_ha, double app_dec,
+                       const pm_context *ctx, const V3<double> &q, double app_ha, double app_dec,
                        int side, const double *start, double *t_out,
                        double *d_out)
 {
@@ -125,7 +127,7 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
         ** Pd(d - e') T(i) w there, the quantity iso_inverse chooses by
         ** (near the mount's pole it differs from the sign of cos(dec)). */
         g = trig_of(start[0], start[1]);
-        aniso<double>(m, g, &dt_prev, &dd_prev);
+        aniso<double>(m, k, g, ctx, &dt_prev, &dd_prev);
         double stp, ctp, sdp, cdp;
         shifted<double>(k, g, &stp, &ctp, &sdp, &cdp);
         V3<double> v = rot_z<double>(k.si, k.ci, expmap<double>(dt_prev, dd_prev));
@@ -140,7 +142,7 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
     Trig<double> best = g;
     for (int it = 0; it < PM_INVERT_MAX_FIXED; it++) {
         double dt, dd;
-        aniso<double>(m, g, &dt, &dd);
+        aniso<double>(m, k, g, ctx, &dt, &dd);
         change = m_sqrt((dt - dt_prev) * (dt - dt_prev) +
                         (dd - dd_prev) * (dd - dd_prev));
         if (change < best_change) {
@@ -169,7 +171,7 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
     pm_status result = PM_OK;
     if (!converged || !reachable) {
         double err;
-        result = newton(m, k, q, app_ha, app_dec, &t, &d, &err);
+        result = newton(m, k, ctx, q, app_ha, app_dec, &t, &d, &err);
         if (result != PM_OK && !reachable)
             result = PM_WARN_UNREACHABLE;
     }
@@ -179,10 +181,14 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
 }
 
 /* Shared inverse: side = +1/-1, or use the start position. */
-pm_status invert(const pm_model *m, double app_ha, double app_dec, int side,
-                 const double *start, double *enc_ha, double *enc_dec)
+pm_status invert(const pm_model *m, const pm_context *ctx, double app_ha,
+                 double app_dec, int side, const double *start, double *enc_ha,
+                 double *enc_dec)
 {
     pm_status st = model_ready(m);
+    if (st != PM_OK)
+        return st;
+    st = context_ok(m, ctx);
     if (st != PM_OK)
         return st;
     if (!enc_ha || !enc_dec)
@@ -197,14 +203,14 @@ pm_status invert(const pm_model *m, double app_ha, double app_dec, int side,
     iso_from_model<double>(m, &k);
     V3<double> q = unit_of(app_ha, app_dec);
     double t, d;
-    pm_status result = solve_branch(m, k, q, app_ha, app_dec, side, start, &t, &d);
+    pm_status result = solve_branch(m, k, ctx, q, app_ha, app_dec, side, start, &t, &d);
     if (!start && (result != PM_OK || side_of(m, d) != side)) {
         /* Within the anisotropic amplitude of the mount's pole the closed
         ** form's branches (sign of cos(dec - e' + displacement angle)) and
         ** the sides of the pole (sign of cos(dec - e')) differ: the other
         ** branch may hold the solution on the requested side. */
         double t2, d2;
-        pm_status r2 = solve_branch(m, k, q, app_ha, app_dec, -side, 0, &t2, &d2);
+        pm_status r2 = solve_branch(m, k, ctx, q, app_ha, app_dec, -side, 0, &t2, &d2);
         if (r2 == PM_OK && side_of(m, d2) == side) {
             result = r2;
             t = t2;
@@ -218,9 +224,9 @@ pm_status invert(const pm_model *m, double app_ha, double app_dec, int side,
             /* unreachable: the nearest point on the requested side seen */
             double best_err = 1e300, best_t = t, best_d = d;
             if (side_of(m, d) == side)
-                best_err = miss(m, k, trig_of(t, d), q);
+                best_err = miss(m, k, ctx, trig_of(t, d), q);
             if (side_of(m, d2) == side) {
-                double e2 = miss(m, k, trig_of(t2, d2), q);
+                double e2 = miss(m, k, ctx, trig_of(t2, d2), q);
                 if (e2 < best_err) {
                     best_err = e2;
                     best_t = t2;
@@ -234,7 +240,7 @@ pm_status invert(const pm_model *m, double app_ha, double app_dec, int side,
                     double dj = hemi * pole + m->coef[4] - hemi * side * 1e-9;
                     double err;
                     pm_status sj =
-                        newton(m, k, q, app_ha, app_dec, &tj, &dj, &err, side);
+                        newton(m, k, ctx, q, app_ha, app_dec, &tj, &dj, &err, side);
                     if (side_of(m, dj) != side)
                         continue;
                     if (sj == PM_OK) {
@@ -298,7 +304,60 @@ pm_status pm_model_init(pm_model *m, int mount, int order)
                 n++;
             }
     m->n_terms = n;
+    m->n_base = n;
     return pm_model_prepare(m);
+}
+
+/* Is an added term well formed for model m? */
+static bool term_valid(const pm_model *m, const pm_term *t)
+{
+    if (t->side < -1 || t->side > 1)
+        return false;
+    if (t->kind != PM_TERM_ZENITH && (t->k < 1 || t->k > 6))
+        return false;
+    switch (t->kind) {
+    case PM_TERM_SH:
+        return t->l >= 0 && t->l <= m->order && t->m >= -t->l && t->m <= t->l;
+    case PM_TERM_FOURIER:
+        return (t->l == 1 || t->l == 2) && (t->m == 0 || t->m == 1) &&
+               finite(t->param) && t->param > 0 && t->param <= 1e6;
+    case PM_TERM_SECTORAL:
+        return (t->m == 0 || t->m == 1) && t->param >= 1 && t->param <= 100000 &&
+               t->param == (double)(long)t->param;
+    case PM_TERM_ZENITH:
+        return t->l == 0 || t->l == 1;
+    case PM_TERM_AUX:
+        return t->aux <= PM_AUX_USER + PM_MAX_AUX - 1 && finite(t->param);
+    default:
+        return false;
+    }
+}
+
+pm_status pm_model_add_term(pm_model *m, const pm_term *t, double value, int *index)
+{
+    if (!m || !t)
+        return PM_ERR_ARG;
+    if (m->prepared != 1)
+        return PM_ERR_STATE;
+    if (!term_valid(m, t))
+        return PM_ERR_ARG;
+    if (!finite(value))
+        return PM_ERR_NONFINITE;
+    if (m->n_terms >= PM_MAX_TERMS)
+        return PM_ERR_CAPACITY;
+    int n = m->n_terms;
+    m->term[n] = *t;
+    m->coef[n] = value;
+    m->n_terms = n + 1;
+    pm_status st = pm_model_prepare(m);
+    if (st != PM_OK) {
+        m->n_terms = n; /* leave the model as it was */
+        pm_model_prepare(m);
+        return st;
+    }
+    if (index)
+        *index = n;
+    return PM_OK;
 }
 
 pm_status pm_model_prepare(pm_model *m)
@@ -311,15 +370,27 @@ pm_status pm_model_prepare(pm_model *m)
         return PM_ERR_CAPACITY;
     if (m->n_terms < 6 || m->n_terms > PM_MAX_TERMS)
         return PM_ERR_CAPACITY;
+    if (m->n_base < 6 || m->n_base > m->n_terms)
+        return PM_ERR_ARG;
+    if (!finite(m->latitude) || m_fabs(m->latitude) > PI / 2)
+        return PM_ERR_ARG;
+    m->needs_ctx = 0;
     for (int i = 0; i < m->n_terms; i++) {
         const pm_term *t = &m->term[i];
-        if (t->kind != PM_TERM_SH || t->k < 1 || t->k > 6)
-            return PM_ERR_ARG;
-        if (i < 6 && (t->l != 0 || t->k != i + 1))
-            return PM_ERR_ARG; /* the six isotropic terms come first */
-        if (i >= 6 && (t->l < 1 || t->l > m->order || t->m < -t->l ||
-                       t->m > t->l))
-            return PM_ERR_ARG;
+        if (i < m->n_base) { /* the harmonic set: plain SH, both sides */
+            if (t->kind != PM_TERM_SH || t->k < 1 || t->k > 6 || t->side != 0)
+                return PM_ERR_ARG;
+            if (i < 6 && (t->l != 0 || t->k != i + 1))
+                return PM_ERR_ARG; /* the six isotropic terms come first */
+            if (i >= 6 && (t->l < 1 || t->l > m->order || t->m < -t->l ||
+                           t->m > t->l))
+                return PM_ERR_ARG;
+        } else {
+            if (!term_valid(m, t))
+                return PM_ERR_ARG;
+            if (t->kind == PM_TERM_AUX)
+                m->needs_ctx = 1;
+        }
         if (!finite(m->coef[i]))
             return PM_ERR_NONFINITE;
     }
@@ -352,7 +423,7 @@ pm_status pm_model_prepare(pm_model *m)
     m->ci = m_cos(m->coef[5]);
     /* harmonic coefficients per base vector, normalisation folded in */
     __builtin_memset(m->dense, 0, sizeof m->dense);
-    for (int i = 6; i < m->n_terms; i++) {
+    for (int i = 6; i < m->n_base; i++) {
         const pm_term *t = &m->term[i];
         int j = t->l * t->l + t->l + t->m;
         m->dense[t->k - 1][j] += m->coef[i] * norm_lm(t->l, t->m);
@@ -369,7 +440,8 @@ pm_status pm_model_find(const pm_model *m, int k, int l, int mm, int *index)
         return PM_ERR_ARG;
     for (int i = 0; i < m->n_terms; i++) {
         const pm_term *t = &m->term[i];
-        if (t->kind == PM_TERM_SH && t->k == k && t->l == l && t->m == mm) {
+        if (t->kind == PM_TERM_SH && t->side == 0 && t->k == k && t->l == l &&
+            t->m == mm) {
             *index = i;
             return PM_OK;
         }
@@ -383,11 +455,15 @@ pm_status pm_term_name(const pm_model *m, int index, char *buf, size_t len)
         index >= PM_MAX_TERMS)
         return PM_ERR_ARG;
     const pm_term *t = &m->term[index];
-    if (t->k < 1 || t->k > 6)
+    if (t->kind != PM_TERM_ZENITH && (t->k < 1 || t->k > 6))
         return PM_ERR_ARG;
-    char tmp[32];
+    char tmp[48];
     size_t n = 0;
-    switch (t->k) {
+    if (t->kind == PM_TERM_ZENITH) {
+        const char *z = t->l == 0 ? "cot(el)" : "cos(el)";
+        while (*z)
+            tmp[n++] = *z++;
+    } else switch (t->k) {
     case 1: tmp[n++] = 'a'; break;
     case 2: tmp[n++] = 'b'; break;
     case 3: tmp[n++] = 'c'; tmp[n++] = '\''; break;
@@ -395,7 +471,51 @@ pm_status pm_term_name(const pm_model *m, int index, char *buf, size_t len)
     case 5: tmp[n++] = 'e'; tmp[n++] = '\''; break;
     default: tmp[n++] = 'i'; break;
     }
-    if (t->l > 0) {
+    if (t->kind == PM_TERM_FOURIER || t->kind == PM_TERM_SECTORAL) {
+        const char *s = t->kind == PM_TERM_FOURIER ? (t->m ? "*sin(" : "*cos(")
+                                                   : (t->m ? "*Ysin(" : "*Ycos(");
+        while (*s)
+            tmp[n++] = *s++;
+        /* G with up to 3 decimals, no printf in the core */
+        double g = t->param;
+        long ip = (long)g;
+        long fr = (long)((g - (double)ip) * 1000.0 + 0.5);
+        if (fr >= 1000) {
+            ip++;
+            fr -= 1000;
+        }
+        char d[24];
+        int nd = 0;
+        do {
+            d[nd++] = (char)('0' + ip % 10);
+            ip /= 10;
+        } while (ip > 0 && nd < 20);
+        while (nd > 0)
+            tmp[n++] = d[--nd];
+        if (fr > 0) {
+            tmp[n++] = '.';
+            tmp[n++] = (char)('0' + fr / 100);
+            if (fr % 100) {
+                tmp[n++] = (char)('0' + fr / 10 % 10);
+                if (fr % 10)
+                    tmp[n++] = (char)('0' + fr % 10);
+            }
+        }
+        if (t->kind == PM_TERM_FOURIER) {
+            const char *ax = t->l == 1 ? "*ha" : "*dec";
+            while (*ax)
+                tmp[n++] = *ax++;
+        }
+        tmp[n++] = ')';
+    } else if (t->kind == PM_TERM_AUX) {
+        const char *s = t->aux == PM_AUX_TEMP ? "*temp"
+                        : t->aux == PM_AUX_TIME ? "*time"
+                        : t->aux == PM_AUX_DIR ? "*dir" : "*aux";
+        while (*s)
+            tmp[n++] = *s++;
+        if (t->aux >= PM_AUX_USER)
+            tmp[n++] = (char)('0' + (t->aux - PM_AUX_USER) % 10);
+    } else if (t->kind == PM_TERM_SH && t->l > 0) {
         const char *s = "*Y(";
         while (*s)
             tmp[n++] = *s++;
@@ -409,6 +529,10 @@ pm_status pm_term_name(const pm_model *m, int index, char *buf, size_t len)
         tmp[n++] = (char)('0' + mm % 10);
         tmp[n++] = ')';
     }
+    if (t->side) {
+        tmp[n++] = '@';
+        tmp[n++] = t->side > 0 ? 'E' : 'W';
+    }
     size_t i;
     for (i = 0; i < n && i + 1 < len; i++)
         buf[i] = tmp[i];
@@ -420,8 +544,10 @@ pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
                          double enc_ha, double enc_dec, double *app_ha,
                          double *app_dec)
 {
-    (void)ctx; /* the harmonic terms use no context */
     pm_status st = model_ready(m);
+    if (st != PM_OK)
+        return st;
+    st = context_ok(m, ctx);
     if (st != PM_OK)
         return st;
     if (!app_ha || !app_dec)
@@ -430,7 +556,7 @@ pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
         return PM_ERR_NONFINITE;
     Iso<double> k;
     iso_from_model<double>(m, &k);
-    V3<double> p = forward_vec<double>(m, k, trig_of(enc_ha, enc_dec));
+    V3<double> p = forward_vec<double>(m, k, trig_of(enc_ha, enc_dec), ctx);
     double t = m_atan2(p.y, p.x);
     *app_ha = t <= -PI ? PI : t; /* atan2(-0, -1) = -pi */
     *app_dec = m_atan2(p.z, m_sqrt(p.x * p.x + p.y * p.y));
@@ -441,10 +567,9 @@ pm_status pm_model_invert(const pm_model *m, const pm_context *ctx,
                           double app_ha, double app_dec, int side,
                           double *enc_ha, double *enc_dec)
 {
-    (void)ctx;
     if (side != PM_SIDE_NORMAL && side != PM_SIDE_FLIPPED)
         return PM_ERR_ARG;
-    return invert(m, app_ha, app_dec, side == PM_SIDE_NORMAL ? 1 : -1, 0,
+    return invert(m, ctx, app_ha, app_dec, side == PM_SIDE_NORMAL ? 1 : -1, 0,
                   enc_ha, enc_dec);
 }
 
@@ -453,17 +578,18 @@ pm_status pm_model_invert_near(const pm_model *m, const pm_context *ctx,
                                double start_dec, double *enc_ha,
                                double *enc_dec)
 {
-    (void)ctx;
     double start[2] = {start_ha, start_dec};
-    return invert(m, app_ha, app_dec, 1, start, enc_ha, enc_dec);
+    return invert(m, ctx, app_ha, app_dec, 1, start, enc_ha, enc_dec);
 }
 
 pm_status pm_model_residual(const pm_model *m, const pm_context *ctx,
                             double enc_ha, double enc_dec, double app_ha,
                             double app_dec, double res[2])
 {
-    (void)ctx;
     pm_status st = model_ready(m);
+    if (st != PM_OK)
+        return st;
+    st = context_ok(m, ctx);
     if (st != PM_OK)
         return st;
     if (!res)
@@ -473,7 +599,7 @@ pm_status pm_model_residual(const pm_model *m, const pm_context *ctx,
         return PM_ERR_NONFINITE;
     Iso<double> k;
     iso_from_model<double>(m, &k);
-    V3<double> p = forward_vec<double>(m, k, trig_of(enc_ha, enc_dec));
+    V3<double> p = forward_vec<double>(m, k, trig_of(enc_ha, enc_dec), ctx);
     V3<double> q = unit_of(app_ha, app_dec);
     /* sky frame at the model position */
     double rho = m_sqrt(p.x * p.x + p.y * p.y);

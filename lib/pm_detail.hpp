@@ -94,10 +94,13 @@ template <typename T> inline V3<T> mat_tmul(const T *h, const V3<T> &v)
               h[2] * v.x + h[5] * v.y + h[8] * v.z);
 }
 
-/* Sine and cosine of one encoder position. */
+/* Sine and cosine of one encoder position, and the angles themselves when
+** known (have_angles; the periodic terms need them). */
 template <typename T> struct Trig {
     T st, ct; /* axis 1 */
     T sd, cd; /* axis 2 (cd signed: negative beyond the pole) */
+    T t, d;   /* the angles, valid when have_angles */
+    bool have_angles;
 };
 
 /*
@@ -241,29 +244,6 @@ template <typename T> inline void iso_from_model(const pm_model *m, Iso<T> *o)
     o->ci = (T)m->ci;
 }
 
-/* Anisotropic displacement (tangent components in the transported frame)
-** at encoder trig g: sum over the model's harmonic terms with l >= 1. */
-template <typename T>
-inline void aniso(const pm_model *m, const Trig<T> &g, T *dt, T *dd)
-{
-    T Y[PM_N_HARM(PM_MAX_L)];
-    T S[6] = {0, 0, 0, 0, 0, 0};
-    int nh = PM_N_HARM(m->order);
-    if (m->order > 0) {
-        harmonics<T>(m->order, g, Y);
-        for (int k = 0; k < 6; k++) {
-            const double *row = m->dense[k];
-            T acc = 0;
-            for (int j = 1; j < nh; j++)
-                acc += (T)row[j] * Y[j];
-            S[k] = acc;
-        }
-    }
-    /* sum_k S_k (u_k, v_k), written out */
-    *dt = -g.sd * (S[0] * g.ct + S[1] * g.st + S[3]) + g.cd * S[2] + S[5];
-    *dd = S[0] * g.st - S[1] * g.ct - S[4];
-}
-
 /* sin/cos of axis angles shifted by the index terms. */
 template <typename T>
 inline void shifted(const Iso<T> &k, const Trig<T> &g, T *stp, T *ctp, T *sdp,
@@ -275,12 +255,183 @@ inline void shifted(const Iso<T> &k, const Trig<T> &g, T *stp, T *ctp, T *sdp,
     *cdp = g.cd * k.ce + g.sd * k.se;
 }
 
+/* x^n for integer n >= 0 by squaring. */
+template <typename T> inline T ipow(T x, long n)
+{
+    T r = 1;
+    while (n > 0) {
+        if (n & 1)
+            r *= x;
+        x *= x;
+        n >>= 1;
+    }
+    return r;
+}
+
+/* What the added (non-base) terms need at one position: the pier side, the
+** zenith in the transported frame, the angles. */
+template <typename T> struct Site {
+    int side;        /* +1 normal side, -1 beyond the pole */
+    bool have_zenith;
+    T zx, zy, zz;    /* M^T Z: zx = sin(el), (zy, zz) toward the zenith */
+};
+
+template <typename T>
+inline Site<T> site_of(const pm_model *m, const Iso<T> &k, const Trig<T> &g,
+                       const pm_context *ctx)
+{
+    Site<T> s;
+    T stp, ctp, sdp, cdp;
+    shifted<T>(k, g, &stp, &ctp, &sdp, &cdp);
+    s.side = ctx && ctx->pier ? (ctx->pier > 0 ? 1 : -1) : (cdp >= 0 ? 1 : -1);
+    s.have_zenith = false;
+    s.zx = s.zy = s.zz = 0;
+    for (int i = m->n_base; i < m->n_terms; i++)
+        if (m->term[i].kind == PM_TERM_ZENITH) {
+            V3<T> z = m->mount == PM_MOUNT_ALTAZ
+                          ? v3<T>(0, 0, 1)
+                          : v3<T>((T)m_cos(m->latitude), 0,
+                                  (T)m_sin(m->latitude));
+            z = mat_tmul<T>(k.h, z);
+            z = rot_zt<T>(stp, ctp, z);
+            z = rot_xt<T>(k.sd, k.cd, z);
+            z = rot_dt<T>(sdp, cdp, z);
+            z = rot_zt<T>(k.si, k.ci, z);
+            s.zx = z.x;
+            s.zy = z.y;
+            s.zz = z.z;
+            s.have_zenith = true;
+            break;
+        }
+    return s;
+}
+
+/* Value of the input of an AUX term (finite inputs are checked by the
+** callers). */
+inline double aux_input(const pm_context *ctx, int aux)
+{
+    switch (aux) {
+    case PM_AUX_TEMP: return ctx->temp_c;
+    case PM_AUX_TIME: return ctx->time_h;
+    case PM_AUX_DIR: return (double)ctx->dir;
+    default: return ctx->aux[aux - PM_AUX_USER];
+    }
+}
+
+/* Does the context carry what the model's AUX terms read, finite? */
+inline pm_status context_ok(const pm_model *m, const pm_context *ctx)
+{
+    if (!m->needs_ctx)
+        return PM_OK;
+    if (!ctx)
+        return PM_ERR_ARG;
+    for (int i = m->n_base; i < m->n_terms; i++)
+        if (m->term[i].kind == PM_TERM_AUX) {
+            double x = aux_input(ctx, m->term[i].aux);
+            if (!finite(x))
+                return PM_ERR_NONFINITE;
+        }
+    return PM_OK;
+}
+
+/* Displacement per unit coefficient of an added term t at position g. */
+template <typename T>
+inline void term_uv(const pm_term &t, const Trig<T> &g, const Site<T> &s,
+                    const pm_context *ctx, T *u, T *v)
+{
+    *u = 0;
+    *v = 0;
+    if (t.side && t.side != s.side)
+        return;
+    T f = 0;
+    switch (t.kind) {
+    case PM_TERM_SH: {
+        T Y[PM_N_HARM(PM_MAX_L)] = {};
+        harmonics<T>(t.l, g, Y);
+        f = Y[t.l * t.l + t.l + t.m] * (T)norm_lm(t.l, t.m);
+        break;
+    }
+    case PM_TERM_FOURIER: {
+        T a = (T)t.param * (t.l == 1 ? g.t : g.d);
+        f = t.m ? m_sin(a) : m_cos(a);
+        break;
+    }
+    case PM_TERM_SECTORAL: {
+        long G = (long)t.param;
+        T a = (T)G * g.t;
+        f = ipow<T>(g.cd, G) * (t.m ? m_sin(a) : m_cos(a));
+        break;
+    }
+    case PM_TERM_ZENITH: {
+        if (t.l == 0) { /* cot(el) along the unit vector to the zenith */
+            T sel = s.zx > (T)0.01 ? s.zx : (T)0.01;
+            *u = s.zy / sel;
+            *v = s.zz / sel;
+        } else { /* cos(el) along it */
+            *u = s.zy;
+            *v = s.zz;
+        }
+        return;
+    }
+    case PM_TERM_AUX:
+        f = (T)(aux_input(ctx, t.aux) - t.param);
+        break;
+    default:
+        return;
+    }
+    T bu, bv;
+    base_uv<T>(t.k, g, &bu, &bv);
+    *u = f * bu;
+    *v = f * bv;
+}
+
+/* Anisotropic displacement (tangent components in the transported frame)
+** at encoder trig g: the base harmonic terms with l >= 1 through the dense
+** table, then the added terms. */
+template <typename T>
+inline void aniso(const pm_model *m, const Iso<T> &k, const Trig<T> &g0,
+                  const pm_context *ctx, T *dt, T *dd)
+{
+    T Y[PM_N_HARM(PM_MAX_L)];
+    T S[6] = {0, 0, 0, 0, 0, 0};
+    int nh = PM_N_HARM(m->order);
+    if (m->order > 0) {
+        harmonics<T>(m->order, g0, Y);
+        for (int kk = 0; kk < 6; kk++) {
+            const double *row = m->dense[kk];
+            T acc = 0;
+            for (int j = 1; j < nh; j++)
+                acc += (T)row[j] * Y[j];
+            S[kk] = acc;
+        }
+    }
+    /* sum_k S_k (u_k, v_k), written out */
+    *dt = -g0.sd * (S[0] * g0.ct + S[1] * g0.st + S[3]) + g0.cd * S[2] + S[5];
+    *dd = S[0] * g0.st - S[1] * g0.ct - S[4];
+    if (m->n_terms > m->n_base) {
+        Trig<T> g = g0;
+        if (!g.have_angles) {
+            g.t = m_atan2(g.st, g.ct);
+            g.d = m_atan2(g.sd, g.cd);
+            g.have_angles = true;
+        }
+        Site<T> s = site_of<T>(m, k, g, ctx);
+        for (int i = m->n_base; i < m->n_terms; i++) {
+            T u, v;
+            term_uv<T>(m->term[i], g, s, ctx, &u, &v);
+            *dt += (T)m->coef[i] * u;
+            *dd += (T)m->coef[i] * v;
+        }
+    }
+}
+
 /* Forward model as a unit vector: p' = H Pt(t') X(d) Pd(d') T(i) w. */
 template <typename T>
-inline V3<T> forward_vec(const pm_model *m, const Iso<T> &k, const Trig<T> &g)
+inline V3<T> forward_vec(const pm_model *m, const Iso<T> &k, const Trig<T> &g,
+                         const pm_context *ctx)
 {
     T dt, dd, stp, ctp, sdp, cdp;
-    aniso<T>(m, g, &dt, &dd);
+    aniso<T>(m, k, g, ctx, &dt, &dd);
     shifted<T>(k, g, &stp, &ctp, &sdp, &cdp);
     V3<T> w = expmap<T>(dt, dd);
     w = rot_z<T>(k.si, k.ci, w);
@@ -297,6 +448,9 @@ template <typename T> inline Trig<T> trig_of(T t, T d)
     g.ct = m_cos(t);
     g.sd = m_sin(d);
     g.cd = m_cos(d);
+    g.t = t;
+    g.d = d;
+    g.have_angles = true;
     return g;
 }
 
@@ -366,6 +520,8 @@ inline bool iso_inverse(const Iso<T> &k, const V3<T> &q, T dt, T dd, int side,
     g->ct = ctp * k.cc + stp * k.sc;
     g->sd = sdp * k.ce + cdp * k.se;
     g->cd = cdp * k.ce - sdp * k.se;
+    g->t = g->d = 0;
+    g->have_angles = false;
     return ok;
 }
 

@@ -39,18 +39,21 @@ struct Options {
     bool refraction = true;
     bool skip_bad = false;
     std::string residuals, save, emit_c;
+    std::vector<std::string> adds; // fit: --add EFFECT
     // simulate
     long n = 200;
     unsigned long long seed = 1;
     double lat = 47, el_limit = 15, noise = 1, random_aniso = 0;
     bool altaz = false, fork = false;
     std::vector<std::pair<std::string, double>> terms;
+    std::vector<std::pair<std::string, double>> effects; // simulate --effect SPEC=ARCSEC
+    double phase_deg = 0;
 };
 
 void usage(FILE *f)
 {
     std::fprintf(f,
-        "usage: pmfit fit RUN [--order L] [--pier joint|split] [--json]\n"
+        "usage: pmfit fit RUN [--order L] [--pier joint|split] [--add EFFECT ...] [--json]\n"
         "                     [--residuals FILE] [--save MODEL] [--emit-c HEADER]\n"
         "                     [--no-refraction] [--skip-bad]\n"
         "\n"
@@ -60,6 +63,20 @@ void usage(FILE *f)
         "  --pier split     fit each pier side separately (default: joint)\n"
         "  --json           one JSON object on standard output\n"
         "  --residuals F    write per-observation residuals (arcsec) to F\n"
+        "  --add EFFECT     add physical terms (repeatable; docs/model.md):\n"
+        "                     ha_periodic:G[:H]   periodic error of G cycles/rev on the HA\n"
+        "                                         axis, harmonics 1..H (default 1)\n"
+        "                     dec_periodic:G[:H]  the same on the Dec axis\n"
+        "                     ha_periodic_paper:G the paper's Y(G,+-G) form, for comparison\n"
+        "                     refraction          cot(elevation) toward the zenith\n"
+        "                     tube_flexure        cos(elevation) toward the zenith\n"
+        "                     temperature[:B,..]  (temp - mean) on base vectors B (default c',e')\n"
+        "                     time_drift[:B,..]   (time - mean), default c',e'\n"
+        "                     hysteresis[:B,..]   last slew direction (+-1), default c'\n"
+        "                     aux:NAME[:B,..]     any named column, default c',e'\n"
+        "                     TERM@E or TERM@W    a term for one pier side only, e.g. i@W,\n"
+        "                                         c'*Y(1,0)@E, refraction@W (joint fit +\n"
+        "                                         F-test: do the sides really differ?)\n"
         "  --save MODEL     write the fitted model as a text model file (docs/formats.md);\n"
         "                   with --pier split: MODEL-east and MODEL-west\n"
         "  --emit-c HEADER  write the model as C constant data with a loader, for firmware\n"
@@ -83,7 +100,11 @@ void usage(FILE *f)
         "  --order L        order of the true model (default 1)\n"
         "  --term N=V       set true term N (as pmfit fit names it: a b c' d e' i d*Y(1,-1) ...)\n"
         "                   to V arcsec; repeatable\n"
-        "  --random-aniso S give every anisotropic term a random value of RMS S arcsec\n",
+        "  --random-aniso S give every anisotropic term a random value of RMS S arcsec\n"
+        "  --effect E=V     inject a physical effect E (any fit --add EFFECT) of size V\n"
+        "                   arcsec (periodic: amplitude, phase --phase DEG; temperature,\n"
+        "                   time_drift: arcsec per deg C / per hour; hysteresis: arcsec per\n"
+        "                   unit of direction, i.e. half the backlash); repeatable\n",
         PM_MAX_L);
 }
 
@@ -150,6 +171,8 @@ Options parse_args(int argc, char **argv)
             o.json = true;
         } else if (!sim && a == "--residuals") {
             o.residuals = need("a file name");
+        } else if (!sim && !eval && a == "--add") {
+            o.adds.push_back(need("an effect (see pmfit --help)"));
         } else if (!sim && !eval && a == "--save") {
             o.save = need("a file name");
         } else if (!sim && !eval && a == "--emit-c") {
@@ -173,6 +196,14 @@ Options parse_args(int argc, char **argv)
             if (v != "equatorial" && v != "altaz")
                 die("--mount: expected equatorial or altaz, got '" + v + "'");
             o.altaz = v == "altaz";
+        } else if (sim && a == "--effect") {
+            std::string v = need("SPEC=ARCSEC");
+            size_t eq = v.rfind('=');
+            if (eq == std::string::npos || eq == 0)
+                die("--effect: expected SPEC=ARCSEC (SPEC as for fit --add), got '" + v + "'");
+            o.effects.push_back({v.substr(0, eq), number(a, v.c_str() + eq + 1, -1e6, 1e6)});
+        } else if (sim && a == "--phase") {
+            o.phase_deg = number(a, need("degrees"), -360, 360);
         } else if (sim && a == "--term") {
             std::string v = need("NAME=ARCSEC");
             size_t eq = v.rfind('=');
@@ -223,7 +254,7 @@ std::string meaning(const pm_model &m, int i)
 {
     const pm_term &t = m.term[i];
     bool altaz = m.mount == PM_MOUNT_ALTAZ;
-    if (t.l == 0) {
+    if (t.kind == PM_TERM_SH && t.l == 0 && t.side == 0) {
         switch (t.k) {
         case 1: return altaz ? "azimuth axis tilt (x)" : "polar axis misalignment (x)";
         case 2: return altaz ? "azimuth axis tilt (y)" : "polar axis misalignment (y)";
@@ -235,13 +266,34 @@ std::string meaning(const pm_model &m, int i)
     }
     static const char *base[] = {"", "tilt x", "tilt y", "axis-1 index", "non-perp.",
                                  "axis-2 index", "collimation"};
+    std::string side = t.side > 0 ? ", east side" : (t.side < 0 ? ", west side" : "");
+    char g[32];
+    std::snprintf(g, sizeof g, "%g", t.param);
+    switch (t.kind) {
+    case PM_TERM_FOURIER:
+        return std::string("periodic error, ") + g + " cyc/rev of axis " +
+               (t.l == 1 ? "1" : "2") + (t.m ? " (sin)" : " (cos)") + side;
+    case PM_TERM_SECTORAL:
+        return std::string("paper-form periodic Y(") + g + ",+-" + g + ")" + side;
+    case PM_TERM_ZENITH:
+        return std::string(t.l == 0 ? "refraction-like cot(el)" : "tube flexure cos(el)") + side;
+    case PM_TERM_AUX: {
+        const char *in = t.aux == PM_AUX_TEMP ? "temperature"
+                         : t.aux == PM_AUX_TIME ? "time drift"
+                         : t.aux == PM_AUX_DIR ? "hysteresis (slew dir)" : "aux input";
+        return std::string(in) + " on " + base[t.k] + " [per unit]" + side;
+    }
+    }
+    if (t.l == 0)
+        return std::string(base[t.k]) + side;
     return std::string(base[t.k]) + " varying as Y(" + std::to_string(t.l) + "," +
-           std::to_string(t.m) + ")";
+           std::to_string(t.m) + ")" + side;
 }
 
 struct Obs {
     double eh, ed, ah, ad;
     int pier, line;
+    pm_context ctx; // inputs of the physical terms
 };
 
 struct FitOut {
@@ -256,13 +308,83 @@ struct FitOut {
     double rms = 0;
 };
 
+// Regularised incomplete beta I_x(a, b) by its continued fraction (modified
+// Lentz), for the F distribution's tail.
+double inc_beta(double a, double b, double x)
+{
+    if (x <= 0)
+        return 0;
+    if (x >= 1)
+        return 1;
+    if (x > (a + 1) / (a + b + 2))
+        return 1 - inc_beta(b, a, 1 - x);
+    double lbeta = std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b);
+    double front = std::exp(lbeta + a * std::log(x) + b * std::log(1 - x)) / a;
+    const double tiny = 1e-300;
+    double f = 1, c = 1, d = 0;
+    for (int i = 0; i <= 400; i++) {
+        int mm = i / 2;
+        double num;
+        if (i == 0)
+            num = 1;
+        else if (i % 2 == 0)
+            num = mm * (b - mm) * x / ((a + 2 * mm - 1) * (a + 2 * mm));
+        else
+            num = -(a + mm) * (a + b + mm) * x / ((a + 2 * mm) * (a + 2 * mm + 1));
+        d = 1 + num * d;
+        d = std::fabs(d) < tiny ? tiny : d;
+        d = 1 / d;
+        c = 1 + num / c;
+        c = std::fabs(c) < tiny ? tiny : c;
+        f *= c * d;
+        if (std::fabs(1 - c * d) < 1e-15)
+            break;
+    }
+    return front * (f - 1);
+}
+
+// P(F > f) for the F distribution with (d1, d2) degrees of freedom.
+double f_tail(double f, double d1, double d2)
+{
+    if (!(f > 0))
+        return 1;
+    return inc_beta(d2 / 2, d1 / 2, d2 / (d2 + d1 * f));
+}
+
+struct FTest {
+    bool done = false;
+    double f = 0, p = 1;
+    int d1 = 0;
+    long d2 = 0;
+    std::string what;
+};
+
+// Do the extra parameters of `big` over `small` (nested models, same data)
+// reduce chi^2 more than noise would?
+FTest f_test(double chi2_small, int p_small, double chi2_big, int p_big, long n_obs,
+             const std::string &what)
+{
+    FTest t;
+    t.done = true;
+    t.what = what;
+    t.d1 = p_big - p_small;
+    t.d2 = 2 * n_obs - p_big;
+    if (t.d1 <= 0 || t.d2 <= 0 || !(chi2_big > 0)) {
+        t.done = false;
+        return t;
+    }
+    t.f = ((chi2_small - chi2_big) / t.d1) / (chi2_big / (double)t.d2);
+    t.p = f_tail(t.f, t.d1, (double)t.d2);
+    return t;
+}
+
 // Residuals of f.model on the observations `use`, and their RMS on the sky.
 void residuals(FitOut &f, const std::vector<Obs> &obs, const std::vector<int> &use)
 {
     double ss = 0;
     for (int i : use) {
         double r[2];
-        pm_model_residual(&f.model, nullptr, obs[i].eh, obs[i].ed, obs[i].ah, obs[i].ad, r);
+        pm_model_residual(&f.model, &obs[i].ctx, obs[i].eh, obs[i].ed, obs[i].ah, obs[i].ad, r);
         f.r0.push_back(r[0]);
         f.r1.push_back(r[1]);
         f.idx.push_back(i);
@@ -271,20 +393,21 @@ void residuals(FitOut &f, const std::vector<Obs> &obs, const std::vector<int> &u
     f.rms = use.empty() ? 0 : std::sqrt(ss / (double)use.size());
 }
 
-FitOut do_fit(const std::vector<Obs> &obs, const std::vector<int> &use, int mount,
-              int order)
+FitOut do_fit(const std::vector<Obs> &obs, const std::vector<int> &use, const pm_model &start)
 {
     static pm_fit fit; // large; not on the stack
     FitOut f;
-    pm_model_init(&f.model, mount, order);
+    f.model = start;
     std::vector<double> eh, ed, ah, ad;
+    std::vector<pm_context> ctx;
     for (int i : use) {
         eh.push_back(obs[i].eh);
         ed.push_back(obs[i].ed);
         ah.push_back(obs[i].ah);
         ad.push_back(obs[i].ad);
+        ctx.push_back(obs[i].ctx);
     }
-    f.status = pm_fit_run(&fit, &f.model, nullptr, (long)use.size(), eh.data(), ed.data(),
+    f.status = pm_fit_run(&fit, &f.model, ctx.data(), (long)use.size(), eh.data(), ed.data(),
                           ah.data(), ad.data(), 100, &f.res);
     if (f.status != PM_OK) {
         f.bad_term = fit.bad_term;
@@ -366,7 +489,7 @@ void print_table(const char *title, const FitOut &f, const std::vector<Obs> &obs
     }
 }
 
-void print_json_fit(const FitOut &f)
+void print_json_fit(const FitOut &f, const std::string &extra)
 {
     const pm_model &m = f.model;
     std::printf("{\"n_obs\": %ld, \"n_params\": %d, \"order\": %d, \"sigma_arcsec\": %.6f, "
@@ -377,7 +500,7 @@ void print_json_fit(const FitOut &f)
         std::printf("%s{\"name\": \"%s\", \"value_arcsec\": %.6f, \"error_arcsec\": %.6f}",
                     i ? ", " : "", json_escape(term_name(m, i)).c_str(), m.coef[i] * RAD2AS,
                     f.res.err[i] * RAD2AS);
-    std::printf("]}");
+    std::printf("]%s%s}", extra.empty() ? "" : ", ", extra.c_str());
 }
 
 void fail_fit(const FitOut &f, const std::string &what)
@@ -404,6 +527,199 @@ void fail_fit(const FitOut &f, const std::string &what)
 }
 
 } // namespace
+
+// Base vectors named in a list like "c',e',i" (default: def).
+std::vector<int> parse_bases(const std::string &spec, const std::string &list,
+                             const std::vector<int> &def)
+{
+    if (list.empty())
+        return def;
+    std::vector<int> ks;
+    size_t pos = 0;
+    while (pos <= list.size()) {
+        size_t c = list.find(',', pos);
+        std::string b = list.substr(pos, c == std::string::npos ? std::string::npos : c - pos);
+        static const char *names[] = {"a", "b", "c'", "d", "e'", "i"};
+        int k = 0;
+        for (int j = 0; j < 6; j++)
+            if (b == names[j])
+                k = j + 1;
+        if (!k)
+            die("--add " + spec + ": unknown base vector '" + b + "' (expected a, b, c', d, e', i)");
+        ks.push_back(k);
+        if (c == std::string::npos)
+            break;
+        pos = c + 1;
+    }
+    return ks;
+}
+
+// The model to fit: the harmonic set of the order plus the --add effects.
+pm_model build_model(const Options &o, const std::vector<Obs> &obs, int mount, double lat,
+                     const std::vector<std::string> &aux_names)
+{
+    pm_model m;
+    pm_model_init(&m, mount, o.order);
+    m.latitude = std::isnan(lat) ? 0.0 : lat;
+    pm_model_prepare(&m);
+    auto add = [&](const std::string &spec, pm_term t) {
+        int st = pm_model_add_term(&m, &t, 0.0, nullptr);
+        if (st == PM_ERR_CAPACITY)
+            die("--add " + spec + ": more than " + std::to_string(PM_MAX_TERMS) +
+                " terms (this build's PM_MAX_TERMS)");
+        if (st != PM_OK)
+            die("--add " + spec + ": not a valid term for this model");
+    };
+    for (const std::string &spec : o.adds) {
+        std::string body = spec;
+        int side = 0;
+        if (body.size() > 2 && body[body.size() - 2] == '@') {
+            char c = body.back();
+            side = c == 'E' || c == 'e' ? 1 : (c == 'W' || c == 'w' ? -1 : 0);
+            if (!side)
+                die("--add " + spec + ": expected @E or @W for a pier side");
+            body = body.substr(0, body.size() - 2);
+        }
+        std::vector<std::string> f;
+        {
+            size_t pos = 0, c;
+            while ((c = body.find(':', pos)) != std::string::npos) {
+                f.push_back(body.substr(pos, c - pos));
+                pos = c + 1;
+            }
+            f.push_back(body.substr(pos));
+        }
+        pm_term t;
+        std::memset(&t, 0, sizeof t);
+        t.side = (signed char)side;
+        const std::string &name = f[0];
+        if (name == "ha_periodic" || name == "dec_periodic") {
+            if (f.size() < 2 || f.size() > 3)
+                die("--add " + spec + ": expected " + name + ":G[:H]");
+            char *end;
+            double G = std::strtod(f[1].c_str(), &end);
+            if (*end || !(G > 0 && G <= 100000))
+                die("--add " + spec + ": G must be cycles per revolution, > 0");
+            long H = f.size() == 3 ? std::strtol(f[2].c_str(), &end, 10) : 1;
+            if (f.size() == 3 && (*end || H < 1 || H > 8))
+                die("--add " + spec + ": H must be 1..8 harmonics");
+            t.kind = PM_TERM_FOURIER;
+            t.l = (signed char)(name == "ha_periodic" ? 1 : 2);
+            t.k = (unsigned char)(name == "ha_periodic" ? PM_BASE_C : PM_BASE_E);
+            for (long h = 1; h <= H; h++)
+                for (int sc = 0; sc < 2; sc++) {
+                    t.param = G * (double)h;
+                    t.m = (signed char)sc;
+                    add(spec, t);
+                }
+        } else if (name == "ha_periodic_paper") {
+            char *end;
+            long G = f.size() == 2 ? std::strtol(f[1].c_str(), &end, 10) : 0;
+            if (f.size() != 2 || *end || G < 1 || G > 100000)
+                die("--add " + spec + ": expected ha_periodic_paper:G with an integer G");
+            t.kind = PM_TERM_SECTORAL;
+            t.k = PM_BASE_C;
+            t.param = (double)G;
+            for (int sc = 0; sc < 2; sc++) {
+                t.m = (signed char)sc;
+                add(spec, t);
+            }
+        } else if (name == "refraction" || name == "tube_flexure") {
+            if (f.size() != 1)
+                die("--add " + spec + ": takes no arguments");
+            if (mount == PM_MOUNT_EQUATORIAL && std::isnan(lat))
+                die("--add " + spec + ": needs the site latitude, which the run file does not "
+                    "give (a '# latitude: DEG' line or a TPOINT run line)");
+            t.kind = PM_TERM_ZENITH;
+            t.l = (signed char)(name == "refraction" ? 0 : 1);
+            add(spec, t);
+        } else if (name == "temperature" || name == "time_drift" || name == "hysteresis" ||
+                   name == "aux") {
+            int input;
+            std::vector<int> def = {PM_BASE_C, PM_BASE_E};
+            size_t bases_at = 1;
+            if (name == "temperature")
+                input = PM_AUX_TEMP;
+            else if (name == "time_drift")
+                input = PM_AUX_TIME;
+            else if (name == "hysteresis") {
+                input = PM_AUX_DIR;
+                def = {PM_BASE_C};
+            } else {
+                if (f.size() < 2)
+                    die("--add " + spec + ": expected aux:NAME[:BASES]");
+                int j = -1;
+                for (size_t q = 0; q < aux_names.size(); q++)
+                    if (aux_names[q] == f[1])
+                        j = (int)q;
+                if (j < 0)
+                    die("--add " + spec + ": the run has no column '" + f[1] + "'");
+                if (j >= PM_MAX_AUX)
+                    die("--add " + spec + ": column '" + f[1] + "' is beyond the first " +
+                        std::to_string(PM_MAX_AUX) + " auxiliary columns the core takes");
+                input = PM_AUX_USER + j;
+                bases_at = 2;
+            }
+            if (f.size() > bases_at + 1)
+                die("--add " + spec + ": too many ':' fields");
+            std::vector<int> ks =
+                parse_bases(spec, f.size() > bases_at ? f[bases_at] : std::string(), def);
+            // reference: the mean of the input, so the term is decorrelated from the index
+            double sum = 0;
+            size_t no_dir = 0;
+            for (const Obs &ob : obs) {
+                pm_context c = ob.ctx;
+                double x = input == PM_AUX_TEMP ? c.temp_c
+                           : input == PM_AUX_TIME ? c.time_h
+                           : input == PM_AUX_DIR ? (double)c.dir : c.aux[input - PM_AUX_USER];
+                if (!std::isfinite(x))
+                    die("--add " + spec + ": the run gives no value for the observation at "
+                        "line " + std::to_string(ob.line));
+                no_dir += input == PM_AUX_DIR && x == 0;
+                sum += x;
+            }
+            if (no_dir * 10 > obs.size()) // 0 = unknown; the first point always is
+                die("--add " + spec + ": the slew direction is unknown for " +
+                    std::to_string(no_dir) + " of " + std::to_string(obs.size()) +
+                    " observations");
+            t.kind = PM_TERM_AUX;
+            t.aux = (unsigned char)input;
+            t.param = obs.empty() ? 0 : sum / (double)obs.size();
+            for (int k : ks) {
+                t.k = (unsigned char)k;
+                add(spec, t);
+            }
+        } else {
+            // a harmonic term by name, for one pier side
+            int found = -1;
+            for (int i = 0; i < m.n_base; i++)
+                if (term_name(m, i) == body)
+                    found = i;
+            if (found < 0)
+                die("--add " + spec + ": unknown effect or term (see pmfit --help)");
+            if (!side)
+                die("--add " + spec + ": " + body + " is already in the model; add it for one "
+                    "pier side with " + body + "@E or " + body + "@W");
+            t = m.term[found];
+            t.side = (signed char)side;
+            add(spec, t);
+        }
+    }
+    return m;
+}
+
+// The model without its side-specific added terms (for the pier F-test).
+pm_model without_side_terms(const pm_model &m)
+{
+    pm_model r;
+    pm_model_init(&r, m.mount, m.order);
+    r.latitude = m.latitude;
+    pm_model_prepare(&r);
+    for (int i = m.n_base; i < m.n_terms; i++)
+        if (m.term[i].side == 0)
+            pm_model_add_term(&r, &m.term[i], 0.0, nullptr);
+    return r;
+}
 
 // Write per-observation residuals (arcsec) atomically.
 void write_residuals(const std::string &path, const std::string &title,
@@ -481,8 +797,42 @@ int cmd_simulate(const Options &o, int argc, char **argv)
                 " model (names as pmfit fit prints them, e.g. c' or d*Y(1,-1))");
         m.coef[found] = t.second / RAD2AS;
     }
+    m.latitude = o.lat * PI / 180;
     if (pm_model_prepare(&m) != PM_OK)
         die("simulate: the true model is invalid", 1);
+    // physical effects: the terms fit --add would add, with the given size
+    for (const auto &e : o.effects) {
+        Options one = o;
+        one.adds = {e.first};
+        Obs ref{0, 0, 0, 0, 1, 0, pm_context()};
+        std::memset(&ref.ctx, 0, sizeof ref.ctx);
+        ref.ctx.temp_c = spec.temp_start_c;
+        ref.ctx.time_h = spec.start_time_h;
+        ref.ctx.dir = 1;
+        pm_model with = build_model(one, {ref}, m.mount, m.latitude, {});
+        int first = m.n_terms;
+        for (int i = m.n_base; i < with.n_terms; i++) {
+            pm_term t = with.term[i];
+            if (t.kind == PM_TERM_AUX) // references: the run's start, no direction
+                t.param = t.aux == PM_AUX_TEMP ? spec.temp_start_c
+                          : t.aux == PM_AUX_TIME ? spec.start_time_h : 0.0;
+            if (pm_model_add_term(&m, &t, 0.0, nullptr) != PM_OK)
+                die("simulate: cannot add --effect " + e.first, 1);
+        }
+        double v = e.second / RAD2AS;
+        bool periodic = m.n_terms > first && (m.term[first].kind == PM_TERM_FOURIER ||
+                                              m.term[first].kind == PM_TERM_SECTORAL);
+        if (periodic) { // first harmonic: amplitude and phase
+            double ph = o.phase_deg * PI / 180;
+            m.coef[first] = v * std::cos(ph);
+            m.coef[first + 1] = v * std::sin(ph);
+        } else {
+            for (int i = first; i < m.n_terms; i++)
+                m.coef[i] = v;
+        }
+        if (pm_model_prepare(&m) != PM_OK)
+            die("simulate: the true model is invalid", 1);
+    }
     std::string cmd = "made by:";
     for (int i = 0; i < argc; i++)
         cmd += std::string(" ") + argv[i];
@@ -515,26 +865,61 @@ int main(int argc, char **argv)
         std::fprintf(stderr, "pmfit: note: %s\n", pmrun_warning(run, i));
 
     std::vector<Obs> obs;
+    bool have_dir = false;
     for (size_t i = 0; i < pmrun_count(run); i++) {
         const pmrun_obs *p = pmrun_get(run, i);
-        obs.push_back({p->enc_ha, p->enc_dec, p->app_ha, p->app_dec, p->pier, p->line});
+        Obs ob{p->enc_ha, p->enc_dec, p->app_ha, p->app_dec, p->pier, p->line, pm_context()};
+        std::memset(&ob.ctx, 0, sizeof ob.ctx);
+        ob.ctx.temp_c = p->temp_c;
+        ob.ctx.time_h = p->time_h;
+        ob.ctx.pier = p->pier;
+        ob.ctx.dir = p->dir;
+        have_dir = have_dir || p->dir != 0;
+        for (int j = 0; j < PM_MAX_AUX && j < PMRUN_MAX_AUX; j++)
+            ob.ctx.aux[j] = p->aux[j];
+        obs.push_back(ob);
     }
+    // Without a direction column, the slew direction on axis 1 is the sign
+    // of the encoder's change from the previous observation.
+    if (!have_dir)
+        for (size_t i = 1; i < obs.size(); i++) {
+            double dh = std::remainder(obs[i].eh - obs[i - 1].eh, 2 * PI);
+            obs[i].ctx.dir = dh > 0 ? 1 : (dh < 0 ? -1 : 0);
+        }
+    std::vector<std::string> aux_names;
+    for (int j = 0; j < pmrun_n_aux(run); j++)
+        aux_names.push_back(pmrun_aux_name(run, j));
     int mount = pmrun_mount(run) == PMRUN_MOUNT_ALTAZ ? PM_MOUNT_ALTAZ : PM_MOUNT_EQUATORIAL;
     if (o.cmd == "eval")
         return cmd_eval(o, obs, mount);
 
+    pm_model start = build_model(o, obs, mount, pmrun_latitude_rad(run), aux_names);
+    bool side_terms = false;
+    for (int i = start.n_base; i < start.n_terms; i++)
+        side_terms = side_terms || start.term[i].side != 0;
+    if (o.split && side_terms)
+        die("--pier split fits the sides independently; side-specific terms (@E, @W) belong "
+            "to a joint fit");
+    std::vector<int> all(obs.size());
+    for (size_t i = 0; i < obs.size(); i++)
+        all[i] = (int)i;
+
     // residual file is written only after every fit succeeded
     std::vector<FitOut> fits;
     std::vector<std::string> titles;
+    FTest ftest;
     if (!o.split) {
-        std::vector<int> all(obs.size());
-        for (size_t i = 0; i < obs.size(); i++)
-            all[i] = (int)i;
-        FitOut f = do_fit(obs, all, mount, o.order);
+        FitOut f = do_fit(obs, all, start);
         if (f.status != PM_OK)
             fail_fit(f, o.run);
         fits.push_back(f);
         titles.push_back("joint fit, both pier sides");
+        if (side_terms) {
+            FitOut g = do_fit(obs, all, without_side_terms(start));
+            if (g.status == PM_OK)
+                ftest = f_test(g.res.chi2, g.res.n_par, f.res.chi2, f.res.n_par, f.res.n_obs,
+                               "side-specific terms vs shared only");
+        }
     } else {
         for (int side : {1, -1}) {
             std::vector<int> use;
@@ -544,12 +929,17 @@ int main(int argc, char **argv)
             std::string t = side > 0 ? "pier side east (normal)" : "pier side west (beyond the pole)";
             if (use.empty())
                 die(o.run + ": --pier split: no observations on the " + t, 1);
-            FitOut f = do_fit(obs, use, mount, o.order);
+            FitOut f = do_fit(obs, use, start);
             if (f.status != PM_OK)
                 fail_fit(f, o.run + " (" + t + ")");
             fits.push_back(f);
             titles.push_back(t);
         }
+        FitOut g = do_fit(obs, all, start);
+        if (g.status == PM_OK)
+            ftest = f_test(g.res.chi2, g.res.n_par, fits[0].res.chi2 + fits[1].res.chi2,
+                           fits[0].res.n_par + fits[1].res.n_par, g.res.n_obs,
+                           "split (independent sides) vs joint");
     }
 
     if (!o.residuals.empty())
@@ -575,14 +965,24 @@ int main(int argc, char **argv)
         }
     }
 
+    std::string fjson;
+    if (ftest.done) {
+        char b[256];
+        std::snprintf(b, sizeof b,
+                      "\"pier_f_test\": {\"test\": \"%s\", \"f\": %.6g, \"dof1\": %d, "
+                      "\"dof2\": %ld, \"p\": %.6g}",
+                      ftest.what.c_str(), ftest.f, ftest.d1, ftest.d2, ftest.p);
+        fjson = b;
+    }
     if (o.json) {
         if (fits.size() == 1) {
-            print_json_fit(fits[0]);
+            print_json_fit(fits[0], fjson);
         } else {
-            std::printf("{\"pier\": \"split\", \"sides\": {\"east\": ");
-            print_json_fit(fits[0]);
+            std::printf("{\"pier\": \"split\", %s%s\"sides\": {\"east\": ", fjson.c_str(),
+                        fjson.empty() ? "" : ", ");
+            print_json_fit(fits[0], "");
             std::printf(", \"west\": ");
-            print_json_fit(fits[1]);
+            print_json_fit(fits[1], "");
             std::printf("}}");
         }
         std::printf("\n");
@@ -591,6 +991,11 @@ int main(int argc, char **argv)
                     mount == PM_MOUNT_ALTAZ ? "alt-az" : "equatorial", obs.size());
         for (size_t k = 0; k < fits.size(); k++)
             print_table(titles[k].c_str(), fits[k], obs, o.run);
+        if (ftest.done)
+            std::printf("\n  pier sides, %s: F = %.3g (%d, %ld dof), p = %.3g: %s\n",
+                        ftest.what.c_str(), ftest.f, ftest.d1, ftest.d2, ftest.p,
+                        ftest.p < 0.01 ? "the sides differ significantly"
+                                       : "no significant difference between the sides");
         std::printf("\n  * = significant at 3 sigma. Values are radians x 206265 (arcsec);\n"
                     "    the model is defined in docs/model.md.\n");
     }

@@ -35,6 +35,33 @@ void comment_lines(std::string &out, const char *comment, const char *lead)
         out += std::string(lead) + line + "\n";
 }
 
+const char *kind_name(int kind)
+{
+    switch (kind) {
+    case PM_TERM_SH: return "sh";
+    case PM_TERM_FOURIER: return "fourier";
+    case PM_TERM_SECTORAL: return "sectoral";
+    case PM_TERM_ZENITH: return "zenith";
+    case PM_TERM_AUX: return "aux";
+    }
+    return "?";
+}
+
+int kind_of(const std::string &s)
+{
+    for (int k = PM_TERM_SH; k <= PM_TERM_AUX; k++)
+        if (s == kind_name(k))
+            return k;
+    return -1;
+}
+
+std::string fmt17(double v)
+{
+    char b[40];
+    std::snprintf(b, sizeof b, "%.17g", v);
+    return b;
+}
+
 bool parse_double(const std::string &s, double *v)
 {
     if (s.empty())
@@ -74,12 +101,20 @@ extern "C" int pmmodel_save(const char *path, const pm_model *m, const char *com
     out += "pm-model 1\n";
     out += std::string("mount ") + (m->mount == PM_MOUNT_ALTAZ ? "altaz" : "equatorial") + "\n";
     out += "order " + std::to_string(m->order) + "\n";
+    if (m->latitude != 0)
+        out += "latitude " + fmt17(m->latitude) + "\n";
     out += "terms " + std::to_string(m->n_terms) + "\n";
     out += "# name k l m value_rad\n";
     for (int i = 0; i < m->n_terms; i++) {
-        char buf[128];
-        std::snprintf(buf, sizeof buf, "term %s %d %d %d %.17g\n", name_of(m, i).c_str(),
-                      m->term[i].k, m->term[i].l, m->term[i].m, m->coef[i]);
+        char buf[256];
+        const pm_term &t = m->term[i];
+        if (i < m->n_base)
+            std::snprintf(buf, sizeof buf, "term %s %d %d %d %.17g\n", name_of(m, i).c_str(),
+                          t.k, t.l, t.m, m->coef[i]);
+        else
+            std::snprintf(buf, sizeof buf, "xterm %s %s %d %d %d %d %d %.17g %.17g\n",
+                          name_of(m, i).c_str(), kind_name(t.kind), t.k, t.l, t.m, t.side, t.aux,
+                          t.param, m->coef[i]);
         out += buf;
     }
     out += "end\n";
@@ -107,6 +142,8 @@ extern "C" int pmmodel_load(const char *path, pm_model *out, char *err, size_t e
     enum { HEADER, MOUNT, ORDER, TERMS, BODY, DONE } state = HEADER;
     int mount = 0;
     long order = 0, nterms = 0;
+    int base = -1; // index of the first added term
+    double latitude = 0;
     pm_model m;
     std::memset(&m, 0, sizeof m);
     int got = 0;
@@ -149,6 +186,11 @@ extern "C" int pmmodel_load(const char *path, pm_model *out, char *err, size_t e
             state = TERMS;
             break;
         case TERMS:
+            if (tok.size() == 2 && tok[0] == "latitude") {
+                if (!parse_double(tok[1], &latitude) || std::fabs(latitude) > 1.5707963267948966)
+                    return fail("bad latitude '" + tok[1] + "' (expected radians, |lat| <= pi/2)");
+                break;
+            }
             if (tok.size() != 2 || tok[0] != "terms" || !parse_int(tok[1], 6, 100000, &nterms))
                 return fail("expected 'terms P' with an integer P >= 6");
             if (nterms > PM_MAX_TERMS)
@@ -157,6 +199,7 @@ extern "C" int pmmodel_load(const char *path, pm_model *out, char *err, size_t e
             m.mount = mount;
             m.order = (int)order;
             m.n_terms = (int)nterms;
+            m.latitude = latitude;
             state = BODY;
             break;
         case BODY: {
@@ -169,10 +212,44 @@ extern "C" int pmmodel_load(const char *path, pm_model *out, char *err, size_t e
             }
             long k, l, mm;
             double v;
+            if (tok.size() == 10 && tok[0] == "xterm") {
+                if (got >= nterms)
+                    return fail("more terms than the header's " + std::to_string(nterms));
+                if (got < 6)
+                    return fail("an added term (xterm) before the six isotropic terms");
+                long side, aux;
+                double param;
+                int kind = kind_of(tok[2]);
+                if (kind < 0)
+                    return fail("unknown term kind '" + tok[2] +
+                                "' (expected sh, fourier, sectoral, zenith or aux)");
+                if (!parse_int(tok[3], 0, 6, &k) || !parse_int(tok[4], -100, 100, &l) ||
+                    !parse_int(tok[5], -100, 100, &mm) || !parse_int(tok[6], -1, 1, &side) ||
+                    !parse_int(tok[7], 0, 255, &aux))
+                    return fail("bad fields of an added term (expected xterm NAME KIND k l m "
+                                "side aux param value)");
+                if (!parse_double(tok[8], &param) || !parse_double(tok[9], &v))
+                    return fail("bad parameter or value (expected finite numbers)");
+                if (base < 0)
+                    base = got;
+                pm_term &nt = m.term[got];
+                nt.kind = (unsigned char)kind;
+                nt.k = (unsigned char)k;
+                nt.l = (signed char)l;
+                nt.m = (signed char)mm;
+                nt.side = (signed char)side;
+                nt.aux = (unsigned char)aux;
+                nt.param = param;
+                m.coef[got] = v;
+                got++;
+                break;
+            }
             if (tok.size() != 6 || tok[0] != "term")
-                return fail("expected 'term NAME k l m value' or 'end'");
+                return fail("expected 'term NAME k l m value', 'xterm ...' or 'end'");
             if (got >= nterms)
                 return fail("more terms than the header's " + std::to_string(nterms));
+            if (base >= 0)
+                return fail("a harmonic term after an added term (xterm lines come last)");
             if (!parse_int(tok[2], 1, 6, &k) || !parse_int(tok[3], 0, order, &l) ||
                 !parse_int(tok[4], -l, l, &mm))
                 return fail("bad term indices '" + tok[2] + " " + tok[3] + " " + tok[4] +
@@ -198,10 +275,12 @@ extern "C" int pmmodel_load(const char *path, pm_model *out, char *err, size_t e
         return fail(state == HEADER ? "empty file; expected a pm model file"
                                     : "file ends before 'end' (truncated?)");
     }
+    m.n_base = base < 0 ? (int)nterms : base;
     pm_status st = pm_model_prepare(&m);
     if (st != PM_OK) {
         set_err(err, errlen, std::string(path) + ": the terms do not form a valid model "
-                             "(the six isotropic terms a b c' d e' i must come first, in order)");
+                             "(the six isotropic terms a b c' d e' i must come first, in order; "
+                             "added terms must be valid for the mount and order)");
         return -1;
     }
     *out = m;
@@ -230,6 +309,8 @@ extern "C" int pmmodel_emit_c(const char *path, const pm_model *m, const char *p
          (m->mount == PM_MOUNT_ALTAZ ? "PM_MOUNT_ALTAZ" : "PM_MOUNT_EQUATORIAL") + "\n";
     o += "#define " + guard.substr(0, guard.size() - 2) + "_ORDER " + std::to_string(m->order) + "\n";
     o += "#define " + guard.substr(0, guard.size() - 2) + "_NTERMS " + std::to_string(m->n_terms) +
+         "\n";
+    o += "#define " + guard.substr(0, guard.size() - 2) + "_NBASE " + std::to_string(m->n_base) +
          "\n\n";
     o += "/* coefficients (radians) */\nstatic const double " + p + "_coef[" +
          std::to_string(m->n_terms) + "] = {\n";
@@ -239,13 +320,26 @@ extern "C" int pmmodel_emit_c(const char *path, const pm_model *m, const char *p
                       i + 1 < m->n_terms ? "," : "", name_of(m, i).c_str());
         o += buf;
     }
-    o += "};\n\n/* terms: base vector k, degree l, order m */\nstatic const signed char " + p +
-         "_terms[" + std::to_string(m->n_terms) + "][3] = {\n";
-    for (int i = 0; i < m->n_terms; i++) {
+    o += "};\n\n/* harmonic terms: base vector k, degree l, order m */\nstatic const signed char " +
+         p + "_terms[" + std::to_string(m->n_base) + "][3] = {\n";
+    for (int i = 0; i < m->n_base; i++) {
         char buf[64];
         std::snprintf(buf, sizeof buf, "    {%d, %d, %d}%s\n", m->term[i].k, m->term[i].l,
-                      m->term[i].m, i + 1 < m->n_terms ? "," : "");
+                      m->term[i].m, i + 1 < m->n_base ? "," : "");
         o += buf;
+    }
+    int n_added = m->n_terms - m->n_base;
+    if (n_added > 0) {
+        o += "};\n\n/* added terms: kind, k, l, m, side, aux, param (pm_term) */\n"
+             "static const pm_term " + p + "_added[" + std::to_string(n_added) + "] = {\n";
+        for (int i = m->n_base; i < m->n_terms; i++) {
+            const pm_term &t = m->term[i];
+            char buf[160];
+            std::snprintf(buf, sizeof buf, "    {%d, %d, %d, %d, %d, %d, %.17g}%s /* %s */\n", t.kind,
+                          t.k, t.l, t.m, t.side, t.aux, t.param, i + 1 < m->n_terms ? "," : "",
+                          name_of(m, i).c_str());
+            o += buf;
+        }
     }
     std::string G = guard.substr(0, guard.size() - 2);
     o += "};\n\n"
@@ -254,13 +348,20 @@ extern "C" int pmmodel_emit_c(const char *path, const pm_model *m, const char *p
          "    int i;\n"
          "    pm_status s = pm_model_init(m, " + G + "_MOUNT, " + G + "_ORDER);\n"
          "    if (s != PM_OK)\n        return s;\n"
-         "    if (m->n_terms != " + G + "_NTERMS)\n        return PM_ERR_CONFIG;\n"
-         "    for (i = 0; i < " + G + "_NTERMS; i++) {\n"
+         "    if (m->n_terms != " + G + "_NBASE)\n        return PM_ERR_CONFIG;\n"
+         "    m->latitude = " + fmt17(m->latitude) + ";\n"
+         "    for (i = 0; i < " + G + "_NBASE; i++) {\n"
          "        if (m->term[i].k != " + p + "_terms[i][0] || m->term[i].l != " + p + "_terms[i][1] ||\n"
          "            m->term[i].m != " + p + "_terms[i][2])\n"
          "            return PM_ERR_CONFIG;\n"
          "        m->coef[i] = " + p + "_coef[i];\n"
-         "    }\n"
+         "    }\n" +
+         (n_added > 0 ? "    for (i = " + G + "_NBASE; i < " + G + "_NTERMS; i++) {\n"
+                        "        s = pm_model_add_term(m, &" + p + "_added[i - " + G + "_NBASE], " + p +
+                        "_coef[i], 0);\n"
+                        "        if (s != PM_OK)\n            return s;\n"
+                        "    }\n"
+                      : std::string()) +
          "    return pm_model_prepare(m);\n}\n\n#endif\n";
     return write_atomic(path, o, err, errlen);
 }

@@ -123,14 +123,27 @@ extern "C" int pmsim_write(const pmsim_spec *s, const char *path, const char *co
     out << "# mount: " << (altaz ? "altaz" : "equatorial") << "\n";
     out << (altaz ? "# tau delta T D temp time dir\n" : "# tau delta T D pier temp time dir\n");
     char buf[256];
-    double prev_enc_ha = 0;
     for (long i = 0; i < s->n; i++) {
         const Target &t = seq[(size_t)i];
         int side = 0; // pm side for the inverse
         if (!altaz && s->gem)
             side = t.ha > 0 ? PM_SIDE_FLIPPED : PM_SIDE_NORMAL; // west of the meridian: flipped
+        double time_h = s->start_time_h + (double)i * s->minutes_per_point / 60.0;
+        double temp = s->temp_start_c + s->temp_rate_c_per_h * (time_h - s->start_time_h);
+        // the slew direction on axis 1 is the commanded one: toward the new target
+        int dir = 0;
+        if (i > 0) {
+            double dh = std::remainder(t.ha - seq[(size_t)i - 1].ha, 2 * PI);
+            dir = dh > 0 ? 1 : (dh < 0 ? -1 : 0);
+        }
+        pm_context ctx;
+        std::memset(&ctx, 0, sizeof ctx);
+        ctx.temp_c = temp;
+        ctx.time_h = time_h;
+        ctx.dir = dir;
+        ctx.pier = altaz ? 0 : (side == PM_SIDE_FLIPPED ? -1 : 1);
         double eh, ed;
-        pm_status st = pm_model_invert(&s->truth, nullptr, t.ha, t.dec,
+        pm_status st = pm_model_invert(&s->truth, &ctx, t.ha, t.dec,
                                        side ? PM_SIDE_FLIPPED : PM_SIDE_NORMAL, &eh, &ed);
         if (st < 0 || st == PM_WARN_NOT_CONVERGED) {
             set_err(err, errlen, "simulate: the true model could not be inverted (status " +
@@ -147,10 +160,6 @@ extern "C" int pmsim_write(const pmsim_spec *s, const char *path, const char *co
         if (D < -PI / 2)
             D = -PI - D, T += PI;
         T = std::remainder(T, 2 * PI);
-        double time_h = s->start_time_h + (double)i * s->minutes_per_point / 60.0;
-        double temp = s->temp_start_c + s->temp_rate_c_per_h * (time_h - s->start_time_h);
-        int dir = i == 0 ? 0 : (eh >= prev_enc_ha ? 1 : -1);
-        prev_enc_ha = eh;
         double enc1 = eh / DEG, app1 = T / DEG;
         double enc2 = std::remainder(ed, 2 * PI) / DEG; // flipped: beyond +-90, within +-180
         if (altaz) { // azimuth in [0, 360)
