@@ -427,6 +427,68 @@ pm_status pm_model_residual(const pm_model *m, const pm_context *ctx,
 pm_status pm_terms_eval(int order, double ha, double dec, double *out);
 
 /* ---------------------------------------------------------------------- */
+/* Float build of the evaluation (single-precision FPUs: Cortex-M4F).     */
+/* ---------------------------------------------------------------------- */
+
+/* A model prepared for single-precision evaluation.  Positions stay double
+** at the interface (a float holds an angle only to ~6e-8 rad = 0.012");
+** the correction is computed in float in a frame local to the position,
+** where it is small, and added in double (docs/model.md, "Float build"). */
+typedef struct pm_model_f {
+    int mount, order, n_terms, n_base, needs_ctx;
+    int prepared;
+    double c, e;                   /* index terms c', e' (radians), exact */
+    float a, b, ra, rb;            /* polar axis (a, b) and Rodrigues factors */
+    float sd, vd, si, vi;          /* sin d, 1 - cos d, sin i, 1 - cos i */
+    float lat_s, lat_c;            /* site latitude */
+    float dense[6][PM_N_HARM(PM_MAX_L)];
+    pm_term term[PM_MAX_TERMS];    /* the added terms (index >= n_base) */
+    float coef[PM_MAX_TERMS];
+} pm_model_f;
+
+/*
+**  pm_model_f_prepare - single-precision copy of a prepared model.
+**
+**  Given:
+**     m        const pm_model*  prepared model
+**  Returned:
+**     mf       pm_model_f*      float model
+**  Returned (function value):
+**              pm_status   PM_OK; PM_ERR_ARG; PM_ERR_STATE
+*/
+pm_status pm_model_f_prepare(pm_model_f *mf, const pm_model *m);
+
+/*
+**  pm_model_apply_f, pm_model_invert_f, pm_model_invert_near_f - as
+**  pm_model_apply, pm_model_invert, pm_model_invert_near, evaluated in
+**  single precision.
+**
+**  Notes:
+**  1) The correction (apparent - encoder, after the exact index shifts)
+**     agrees with the double build to 0.01" over the sky (tested at L=2).
+**  2) The inverse is a Newton iteration on sky offsets at the target
+**     (Jacobian by differences, kept while steps gain a factor 10, steps
+**     cut back when they do not help): at most 1 + 6 * PM_INVERT_F_MAX
+**     model evaluations, usually 4; it iterates to PM_INVERT_F_TOL (0.002",
+**     above the float forward's own noise of ~0.0002"), not 1e-13.
+**     PM_WARN_NOT_CONVERGED if the bound is reached or the solution found
+**     is on the other side of the mount's pole; this happens only within
+**     about a degree of the mount's pole (use the double build there).
+*/
+#define PM_INVERT_F_MAX 12
+#define PM_INVERT_F_TOL 1e-8
+pm_status pm_model_apply_f(const pm_model_f *m, const pm_context *ctx,
+                           double enc_ha, double enc_dec,
+                           double *app_ha, double *app_dec);
+pm_status pm_model_invert_f(const pm_model_f *m, const pm_context *ctx,
+                            double app_ha, double app_dec, int side,
+                            double *enc_ha, double *enc_dec);
+pm_status pm_model_invert_near_f(const pm_model_f *m, const pm_context *ctx,
+                                 double app_ha, double app_dec,
+                                 double start_ha, double start_dec,
+                                 double *enc_ha, double *enc_dec);
+
+/* ---------------------------------------------------------------------- */
 /* Fit.                                                                   */
 /* ---------------------------------------------------------------------- */
 

@@ -1,0 +1,379 @@
+/*
+**  model_f.cpp - the pointing model evaluated in single precision, for
+**  FPUs without double precision (Cortex-M4F).
+**
+**  A float holds an absolute angle only to ~6e-8 rad (0.012"), so the float
+**  build never forms absolute directions.  The index terms c' and e' (the
+**  only large ones: degrees on real mounts) are exact shifts of the frame
+**  angles, done in double; everything else is a small correction computed
+**  in the frame local to the shifted position, as an offset from (1,0,0),
+**  where float's relative precision is enough; the result is the frame angle
+**  plus the correction, added in double.  The harmonics, base vectors and
+**  added terms are the same templates as the double build.
+**
+**  Reference: Pal et al., Exp Astron (2016), Secs. 2-3; docs/model.md.
+*/
+#include "pm.h"
+#include "pm_detail.hpp"
+
+using namespace pm::detail;
+
+namespace {
+
+/* Wrap into (-pi, pi] (double; one or two steps for finite inputs). */
+double wrap(double a)
+{
+    while (a > PI)
+        a -= 2 * PI;
+    while (a <= -PI)
+        a += 2 * PI;
+    return a;
+}
+
+/* The added terms' view of a position, in float (cf. site_of). */
+Site<float> site_f(const pm_model_f *m, const Trig<float> &ge, int side,
+                   float ia, float ib, float ic) /* omega' = (ia, ib, ic) */
+{
+    Site<float> s;
+    s.side = side;
+    s.have_zenith = false;
+    s.zx = s.zy = s.zz = 0;
+    for (int i = m->n_base; i < m->n_terms; i++)
+        if (m->term[i].kind == PM_TERM_ZENITH) {
+            /* Z in the frame of the shifted position, then through H_loc^T,
+            ** X_loc^T, T(i)^T (directions only: float is enough) */
+            V3<float> z = m->mount == PM_MOUNT_ALTAZ ? v3<float>(0, 0, 1)
+                                                      : v3<float>(m->lat_c, 0, m->lat_s);
+            z = rot_dt<float>(ge.sd, ge.cd, rot_zt<float>(ge.st, ge.ct, z));
+            V3<float> w = v3<float>(ia, ib, ic);
+            V3<float> wz = cross<float>(w, z);
+            V3<float> wwz = cross<float>(w, wz);
+            z = v3<float>(z.x - m->ra * wz.x + m->rb * wwz.x, z.y - m->ra * wz.y + m->rb * wwz.y,
+                          z.z - m->ra * wz.z + m->rb * wwz.z);
+            V3<float> n = v3<float>(ge.cd, 0, -ge.sd);
+            V3<float> nz = cross<float>(n, z);
+            V3<float> nnz = cross<float>(n, nz);
+            z = v3<float>(z.x - m->sd * nz.x + m->vd * nnz.x, z.y - m->sd * nz.y + m->vd * nnz.y,
+                          z.z - m->sd * nz.z + m->vd * nnz.z);
+            z = rot_zt<float>(m->si, 1 - m->vi, z);
+            s.zx = z.x;
+            s.zy = z.y;
+            s.zz = z.z;
+            s.have_zenith = true;
+            break;
+        }
+    return s;
+}
+
+/* v + s1 (n x v) + s2 (n x (n x v)) for v = (1,0,0) + o, returned as the new
+** offset from (1,0,0): a rotation written as identity plus a small part. */
+V3<float> rotate_offset(const V3<float> &n, float s1, float s2, const V3<float> &o)
+{
+    V3<float> v = v3<float>(1 + o.x, o.y, o.z); /* rounding of 1 + o.x only
+                                                    enters the cross products */
+    V3<float> nv = cross<float>(n, v);
+    V3<float> nnv = cross<float>(n, nv);
+    return v3<float>(o.x + s1 * nv.x + s2 * nnv.x, o.y + s1 * nv.y + s2 * nnv.y,
+                     o.z + s1 * nv.z + s2 * nnv.z);
+}
+
+/* Forward model: encoder (t, d) -> apparent (T, D), in float except for the
+** frame angles. */
+void forward_f(const pm_model_f *m, const pm_context *ctx, double t, double d, double *T,
+               double *D)
+{
+    /* frame angles: exact index shifts; beyond the pole, the equivalent
+    ** position (t_r, d_r) = (t_c + pi, pi - d_e) with |d_r| <= pi/2 */
+    double tc = t + m->c, de = wrap(d - m->e);
+    bool flip = de > PI / 2 || de < -PI / 2;
+    double tr = flip ? tc + PI : tc;
+    double dr = flip ? (de > 0 ? PI - de : -PI - de) : de;
+    float st = m_sin((float)wrap(tr)), ct = m_cos((float)wrap(tr));
+    /* cos d_r from the complement pi/2 - |d_r|, formed in double: near the
+    ** pole cos((float)d_r) would carry the angle's own rounding (1e-7 rad),
+    ** which the HA correction (~ offset / cos d) magnifies */
+    float cu = (float)(PI / 2 - m_fabs(dr));
+    float cd = m_sin(cu), sd = dr >= 0 ? m_cos(cu) : -m_cos(cu);
+    /* trig of the shifted position (t_c, d_e) */
+    Trig<float> ge;
+    ge.st = flip ? -st : st;
+    ge.ct = flip ? -ct : ct;
+    ge.sd = sd;
+    ge.cd = flip ? -cd : cd;
+    ge.have_angles = false;
+    /* trig of the encoder position itself (harmonics, base vectors) */
+    float sc = m_sin((float)m->c), cc = m_cos((float)m->c);
+    float se = m_sin((float)m->e), ce = m_cos((float)m->e);
+    Trig<float> g;
+    g.st = ge.st * cc - ge.ct * sc;
+    g.ct = ge.ct * cc + ge.st * sc;
+    g.sd = ge.sd * ce + ge.cd * se;
+    g.cd = ge.cd * ce - ge.sd * se;
+    g.t = (float)t;
+    g.d = (float)d;
+    g.have_angles = true;
+
+    /* the polar-axis rotation in the local frame: omega' = Q^T (a, b, 0) */
+    V3<float> om = rot_dt<float>(ge.sd, ge.cd, rot_zt<float>(ge.st, ge.ct, v3<float>(m->a, m->b, 0)));
+
+    /* anisotropic displacement (same templates as the double build) */
+    float Y[PM_N_HARM(PM_MAX_L)];
+    float S[6] = {0, 0, 0, 0, 0, 0};
+    if (m->order > 0) {
+        harmonics<float>(m->order, g, Y);
+        int nh = PM_N_HARM(m->order);
+        for (int k = 0; k < 6; k++) {
+            float acc = 0;
+            for (int j = 1; j < nh; j++)
+                acc += m->dense[k][j] * Y[j];
+            S[k] = acc;
+        }
+    }
+    float dt = -g.sd * (S[0] * g.ct + S[1] * g.st + S[3]) + g.cd * S[2] + S[5];
+    float dd = S[0] * g.st - S[1] * g.ct - S[4];
+    if (m->n_terms > m->n_base) {
+        int side = ctx && ctx->pier ? (ctx->pier > 0 ? 1 : -1) : (flip ? -1 : 1);
+        Site<float> s = site_f(m, ge, side, om.x, om.y, om.z);
+        for (int i = m->n_base; i < m->n_terms; i++) {
+            float u, v;
+            term_uv<float>(m->term[i], g, s, ctx, &u, &v);
+            dt += m->coef[i] * u;
+            dd += m->coef[i] * v;
+        }
+    }
+
+    /* w = expmap(dt, dd) as an offset from (1,0,0) */
+    float r2 = dt * dt + dd * dd;
+    float sinc = 1 - r2 / 6 + r2 * r2 / 120;
+    V3<float> o = v3<float>(-r2 / 2 + r2 * r2 / 24, dt * sinc, dd * sinc);
+    if (r2 >= 1e-4f) {
+        float r = m_sqrt(r2);
+        o = v3<float>(-2 * m_sin(r / 2) * m_sin(r / 2), dt * m_sin(r) / r, dd * m_sin(r) / r);
+    }
+    /* T(i): (1 + ox, oy, oz) -> offset */
+    float ci = 1 - m->vi;
+    o = v3<float>(o.x * ci - o.y * m->si - m->vi, o.x * m->si + o.y * ci + m->si, o.z);
+    /* X(d) about n = Pd(d_e)^T x = (cos d_e, 0, -sin d_e) */
+    o = rotate_offset(v3<float>(ge.cd, 0, -ge.sd), m->sd, m->vd, o);
+    /* H about omega' (Rodrigues with the prepared factors, unit scaling in
+    ** the factors: ra = sin(th)/th, rb = (1 - cos th)/th^2) */
+    o = rotate_offset(om, m->ra, m->rb, o);
+    /* beyond the pole the frame of (t_r, d_r) is (x, -y, -z) */
+    if (flip) {
+        o.y = -o.y;
+        o.z = -o.z;
+    }
+    /* angles of (1 + ox, oy, oz) in the frame at (t_r, d_r), written so that
+    ** only small quantities are differenced */
+    float eta = cd * o.x - sd * o.z; /* q = cd + eta */
+    float zeta = sd * o.x + cd * o.z;
+    float q = cd + eta;
+    float rho = m_sqrt(o.y * o.y + q * q);
+    float rmc = rho + cd > 0 ? (2 * cd * eta + eta * eta + o.y * o.y) / (rho + cd) : rho - cd;
+    float dT = m_atan2(o.y, q);
+    float dD = m_atan2(zeta * cd - rmc * sd, rho * cd + (sd + zeta) * sd);
+    *T = wrap(tr + (double)dT);
+    *D = dr + (double)dD;
+}
+
+/* Offset of apparent (T1, D1) from (T2, D2), in the frame at (T2, D2). */
+void sky_offset(double T1, double D1, double T2, double D2, float *x, float *y)
+{
+    float dT = (float)wrap(T1 - T2), dD = (float)(D1 - D2);
+    float c1 = m_cos((float)D1), s2 = m_sin((float)D2);
+    float h = m_sin(dT / 2);
+    *x = c1 * m_sin(dT);
+    *y = m_sin(dD) + c1 * s2 * 2 * h * h;
+}
+
+pm_status check_f(const pm_model_f *m, const pm_context *ctx)
+{
+    if (!m)
+        return PM_ERR_ARG;
+    if (m->prepared != 1 || m->n_terms < 6 || m->n_terms > PM_MAX_TERMS)
+        return PM_ERR_STATE;
+    if (m->needs_ctx) {
+        if (!ctx)
+            return PM_ERR_ARG;
+        for (int i = m->n_base; i < m->n_terms; i++)
+            if (m->term[i].kind == PM_TERM_AUX && !finite(aux_input(ctx, m->term[i].aux)))
+                return PM_ERR_NONFINITE;
+    }
+    return PM_OK;
+}
+
+pm_status invert_f(const pm_model_f *m, const pm_context *ctx, double T, double D, int side,
+                   const double *start, double *enc_ha, double *enc_dec)
+{
+    pm_status st = check_f(m, ctx);
+    if (st != PM_OK)
+        return st;
+    if (!enc_ha || !enc_dec)
+        return PM_ERR_ARG;
+    if (!finite(T) || !finite(D) || (start && (!finite(start[0]) || !finite(start[1]))))
+        return PM_ERR_NONFINITE;
+    if (m_fabs(D) > PI / 2 + 1e-12)
+        return PM_ERR_ARG;
+    double t, d;
+    if (start) {
+        t = start[0];
+        d = start[1];
+    } else if (side > 0) {
+        t = T - m->c;
+        d = D + m->e;
+    } else {
+        t = T + PI - m->c;
+        d = PI - D + m->e;
+    }
+    /* Newton on sky offsets at the target, the Jacobian by differences:
+    ** kept while each step gains a factor 10 (chord steps, one evaluation
+    ** each), refreshed otherwise; a step that does not reduce the offset is
+    ** cut back (at most 3 times). */
+    const double h = 1e-5;
+    double T0, D0, T1, D1;
+    float fx, fy, ax, ay, j00 = 0, j01 = 0, j10 = 0, j11 = 0, det = 0;
+    forward_f(m, ctx, t, d, &T0, &D0);
+    sky_offset(T0, D0, T, D, &fx, &fy);
+    float fn = m_sqrt(fx * fx + fy * fy);
+    bool refresh = true;
+    pm_status result = PM_WARN_NOT_CONVERGED;
+    for (int it = 0; it <= PM_INVERT_F_MAX; it++) {
+        if (fn <= (float)PM_INVERT_F_TOL) {
+            result = PM_OK;
+            break;
+        }
+        if (it == PM_INVERT_F_MAX)
+            break;
+        if (refresh) {
+            forward_f(m, ctx, t + h, d, &T1, &D1);
+            sky_offset(T1, D1, T, D, &ax, &ay);
+            j00 = (ax - fx) / (float)h;
+            j10 = (ay - fy) / (float)h;
+            forward_f(m, ctx, t, d + h, &T1, &D1);
+            sky_offset(T1, D1, T, D, &ax, &ay);
+            j01 = (ax - fx) / (float)h;
+            j11 = (ay - fy) / (float)h;
+            det = j00 * j11 - j01 * j10;
+            if (!(m_fabs(det) > 1e-12f))
+                break;
+        }
+        double ds_t = (double)((j11 * fx - j01 * fy) / det);
+        double ds_d = (double)((j00 * fy - j10 * fx) / det);
+        float lam = 1, nfx = 0, nfy = 0, nfn = 0;
+        double nt = t, nd = d;
+        for (int cut = 0; cut < 4; cut++, lam *= 0.25f) {
+            nt = t - lam * ds_t;
+            nd = d - lam * ds_d;
+            forward_f(m, ctx, nt, nd, &T0, &D0);
+            sky_offset(T0, D0, T, D, &nfx, &nfy);
+            nfn = m_sqrt(nfx * nfx + nfy * nfy);
+            if (nfn < fn)
+                break;
+        }
+        if (!(nfn < fn)) {
+            if (refresh)
+                break; /* no progress even with a fresh Jacobian */
+            refresh = true;
+            continue;
+        }
+        refresh = nfn > 0.1f * fn;
+        t = nt;
+        d = nd;
+        fx = nfx;
+        fy = nfy;
+        fn = nfn;
+    }
+    /* the solution must be on the requested side of the mount's pole */
+    if (result == PM_OK && !start && (m_cos((float)wrap(d - m->e)) >= 0 ? 1 : -1) != side)
+        result = PM_WARN_NOT_CONVERGED;
+    if (start) {
+        t = start[0] + wrap(t - start[0]);
+        d = start[1] + wrap(d - start[1]);
+    } else {
+        t = wrap(t);
+    }
+    *enc_ha = t;
+    *enc_dec = d;
+    return result;
+}
+
+} /* namespace */
+
+extern "C" {
+
+pm_status pm_model_f_prepare(pm_model_f *mf, const pm_model *m)
+{
+    if (!mf)
+        return PM_ERR_ARG;
+    pm_status st = model_ready(m);
+    if (st != PM_OK)
+        return st;
+    __builtin_memset(mf, 0, sizeof *mf);
+    mf->mount = m->mount;
+    mf->order = m->order;
+    mf->n_terms = m->n_terms;
+    mf->n_base = m->n_base;
+    mf->needs_ctx = m->needs_ctx;
+    mf->c = m->coef[2];
+    mf->e = m->coef[4];
+    double a = m->coef[0], b = m->coef[1], th2 = a * a + b * b;
+    mf->a = (float)a;
+    mf->b = (float)b;
+    if (th2 < 1e-8) {
+        mf->ra = (float)(1 - th2 / 6);
+        mf->rb = (float)(0.5 - th2 / 24);
+    } else {
+        double th = m_sqrt(th2);
+        mf->ra = (float)(m_sin(th) / th);
+        mf->rb = (float)((1 - m_cos(th)) / th2);
+    }
+    double dh = m->coef[3], ih = m->coef[5];
+    mf->sd = (float)m_sin(dh);
+    mf->vd = (float)(2 * m_sin(dh / 2) * m_sin(dh / 2));
+    mf->si = (float)m_sin(ih);
+    mf->vi = (float)(2 * m_sin(ih / 2) * m_sin(ih / 2));
+    mf->lat_s = (float)m_sin(m->latitude);
+    mf->lat_c = (float)m_cos(m->latitude);
+    for (int k = 0; k < 6; k++)
+        for (int j = 0; j < PM_N_HARM(PM_MAX_L); j++)
+            mf->dense[k][j] = (float)m->dense[k][j];
+    for (int i = 0; i < m->n_terms; i++) {
+        mf->term[i] = m->term[i];
+        mf->coef[i] = (float)m->coef[i];
+    }
+    mf->prepared = 1;
+    return PM_OK;
+}
+
+pm_status pm_model_apply_f(const pm_model_f *m, const pm_context *ctx, double enc_ha,
+                           double enc_dec, double *app_ha, double *app_dec)
+{
+    pm_status st = check_f(m, ctx);
+    if (st != PM_OK)
+        return st;
+    if (!app_ha || !app_dec)
+        return PM_ERR_ARG;
+    if (!finite(enc_ha) || !finite(enc_dec))
+        return PM_ERR_NONFINITE;
+    forward_f(m, ctx, enc_ha, enc_dec, app_ha, app_dec);
+    return PM_OK;
+}
+
+pm_status pm_model_invert_f(const pm_model_f *m, const pm_context *ctx, double app_ha,
+                            double app_dec, int side, double *enc_ha, double *enc_dec)
+{
+    if (side != PM_SIDE_NORMAL && side != PM_SIDE_FLIPPED)
+        return PM_ERR_ARG;
+    return invert_f(m, ctx, app_ha, app_dec, side == PM_SIDE_NORMAL ? 1 : -1, 0, enc_ha,
+                    enc_dec);
+}
+
+pm_status pm_model_invert_near_f(const pm_model_f *m, const pm_context *ctx, double app_ha,
+                                 double app_dec, double start_ha, double start_dec,
+                                 double *enc_ha, double *enc_dec)
+{
+    double start[2] = {start_ha, start_dec};
+    return invert_f(m, ctx, app_ha, app_dec, 1, start, enc_ha, enc_dec);
+}
+
+} /* extern "C" */
