@@ -584,12 +584,16 @@ pm_status pm_fit_add(pm_fit *fit, const pm_context *ctx,
 **     observations again until res->converged (Gauss-Newton); pm_fit_run
 **     does the loop for observations held in arrays.
 **  3) Convergence: every step below 1e-6 of its 1-sigma error (or 1e-15
-**     rad), or a predicted chi^2 decrease s^T J^T r below 1e-12 of chi^2.
+**     rad), or a predicted chi^2 decrease s^T J^T r below 1e-4 sigma^2,
+**     so that the step moves every coefficient by less than 1% of its
+**     1-sigma error (noise-free data still converge to rounding, since
+**     sigma is then at rounding level).
 **  4) Damping (Armijo): a pass whose chi^2 did not fall by at least 1e-4 of
 **     what the step predicted is rejected: the step is halved, *out is the
 **     new trial point and res->accepted is 0 (the other fields of *res are
-**     left as they were).  After 40 halvings the accepted point is returned
-**     as converged.  So chi^2 never increases, which matters when terms are
+**     left as they were).  When what is left of the step could not matter
+**     (predicted decrease below 1e-6 sigma^2), or after 40 halvings, the
+**     accepted point is returned as converged.  So chi^2 never increases, which matters when terms are
 **     nearly degenerate (one pier side only, narrow sky) and residuals
 **     large, where undamped Gauss-Newton can oscillate.
 **  5) On error *out and *res are unchanged and the accumulated pass is kept

@@ -46,38 +46,28 @@ void dlog(const V3<double> &q, double D[2][3], double *ly, double *lz)
     D[1][2] = f + q.z * g * q.x * q.z;
 }
 
-/* Two design rows (model derivatives) and the residual of one observation
-** at model m.  Residual: r = log(M^T t) - D(x), in the frame transported
-** by the isotropic rotation M (docs/model.md). */
-void rows(const pm_model *m, const pm_context *ctx, double enc_ha,
-          double enc_dec, double app_ha, double app_dec, double *row0,
-          double *row1, double r[2])
-{
+/* M^T x for the model's isotropic rotation M = H Pt(t') X(d) Pd(d') T(i)
+** at one position, and its derivatives with respect to the six isotropic
+** coefficients (a, b, c', d, e', i). */
+struct Chain {
+    const pm_model *m;
     Iso<double> k;
-    iso_from_model<double>(m, &k);
-    Trig<double> g = trig_of(enc_ha, enc_dec);
     double stp, ctp, sdp, cdp;
-    shifted<double>(k, g, &stp, &ctp, &sdp, &cdp);
-    V3<double> t = unit_of(app_ha, app_dec);
-    V3<double> s0 = mat_tmul<double>(k.h, t);
-    V3<double> s1 = rot_zt<double>(stp, ctp, s0);
-    V3<double> s2 = rot_xt<double>(k.sd, k.cd, s1);
-    V3<double> s3 = rot_dt<double>(sdp, cdp, s2);
-    V3<double> q = rot_zt<double>(k.si, k.ci, s3);
-    double D[2][3], ly, lz;
-    dlog(q, D, &ly, &lz);
-    double dt, dd;
-    aniso<double>(m, k, g, ctx, &dt, &dd);
-    r[0] = ly - dt;
-    r[1] = lz - dd;
+};
 
-    /* isotropic terms: dq/dtheta, then row = -dlog * dq/dtheta */
+V3<double> mt_and_derivs(const Chain &c, const V3<double> &x, V3<double> dq[6])
+{
+    const Iso<double> &k = c.k;
     const V3<double> ex = v3(1.0, 0.0, 0.0), ey = v3(0.0, 1.0, 0.0),
                      ez = v3(0.0, 0.0, 1.0);
-    V3<double> dq[6];
+    V3<double> s0 = mat_tmul<double>(k.h, x);
+    V3<double> s1 = rot_zt<double>(c.stp, c.ctp, s0);
+    V3<double> s2 = rot_xt<double>(k.sd, k.cd, s1);
+    V3<double> s3 = rot_dt<double>(c.sdp, c.cdp, s2);
+    V3<double> q = rot_zt<double>(k.si, k.ci, s3);
     {
         /* right Jacobian of exp at w = (a, b, 0) */
-        double a = m->coef[0], b = m->coef[1], th2 = a * a + b * b, Bc, Cc;
+        double a = c.m->coef[0], b = c.m->coef[1], th2 = a * a + b * b, Bc, Cc;
         if (th2 < 1e-8) {
             Bc = 0.5 - th2 / 24;
             Cc = 1.0 / 6 - th2 / 120;
@@ -95,25 +85,50 @@ void rows(const pm_model *m, const pm_context *ctx, double enc_ha,
                                e.y - Bc * we.y + Cc * wwe.y,
                                e.z - Bc * we.z + Cc * wwe.z);
             V3<double> v = cross(s0, jr); /* -(jr x s0) */
-            v = rot_zt<double>(stp, ctp, v);
+            v = rot_zt<double>(c.stp, c.ctp, v);
             v = rot_xt<double>(k.sd, k.cd, v);
-            v = rot_dt<double>(sdp, cdp, v);
+            v = rot_dt<double>(c.sdp, c.cdp, v);
             dq[j] = rot_zt<double>(k.si, k.ci, v);
         }
     }
     {
         V3<double> v = cross(s1, ez); /* -(ez x s1) */
         v = rot_xt<double>(k.sd, k.cd, v);
-        v = rot_dt<double>(sdp, cdp, v);
+        v = rot_dt<double>(c.sdp, c.cdp, v);
         dq[2] = rot_zt<double>(k.si, k.ci, v);
     }
     {
         V3<double> v = cross(s2, ex);
-        v = rot_dt<double>(sdp, cdp, v);
+        v = rot_dt<double>(c.sdp, c.cdp, v);
         dq[3] = rot_zt<double>(k.si, k.ci, v);
     }
     dq[4] = rot_zt<double>(k.si, k.ci, cross(s3, ey));
     dq[5] = cross(q, ez);
+    return q;
+}
+
+/* Two design rows (model derivatives) and the residual of one observation
+** at model m.  Residual: r = log(M^T t) - D(x), in the frame transported
+** by the isotropic rotation M (docs/model.md). */
+void rows(const pm_model *m, const pm_context *ctx, double enc_ha,
+          double enc_dec, double app_ha, double app_dec, double *row0,
+          double *row1, double r[2])
+{
+    Chain c;
+    c.m = m;
+    iso_from_model<double>(m, &c.k);
+    Trig<double> g = trig_of(enc_ha, enc_dec);
+    shifted<double>(c.k, g, &c.stp, &c.ctp, &c.sdp, &c.cdp);
+    V3<double> dq[6];
+    V3<double> q = mt_and_derivs(c, unit_of(app_ha, app_dec), dq);
+    double D[2][3], ly, lz;
+    dlog(q, D, &ly, &lz);
+    double dt, dd;
+    aniso<double>(m, c.k, g, ctx, &dt, &dd);
+    r[0] = ly - dt;
+    r[1] = lz - dd;
+
+    /* isotropic terms: row = -dlog * dq/dtheta */
     for (int j = 0; j < 6; j++) {
         row0[j] = -(D[0][0] * dq[j].x + D[0][1] * dq[j].y + D[0][2] * dq[j].z);
         row1[j] = -(D[1][0] * dq[j].x + D[1][1] * dq[j].y + D[1][2] * dq[j].z);
@@ -131,13 +146,40 @@ void rows(const pm_model *m, const pm_context *ctx, double enc_ha,
         row0[i] = y * u;
         row1[i] = y * v;
     }
-    /* added terms: linear, row = their displacement per unit coefficient
-    ** (the zenith direction's dependence on the isotropic terms is left out
-    ** of those columns: a second-order effect) */
-    if (m->n_terms > m->n_base) {
-        Site<double> st = site_of<double>(m, k, g, ctx);
-        for (int i = m->n_base; i < m->n_terms; i++)
-            term_uv<double>(m->term[i], g, st, ctx, &row0[i], &row1[i]);
+    if (m->n_terms == m->n_base)
+        return;
+    /* added terms: linear, row = their displacement per unit coefficient */
+    Site<double> st = site_of<double>(m, c.k, g, ctx);
+    for (int i = m->n_base; i < m->n_terms; i++)
+        term_uv<double>(m->term[i], g, st, ctx, &row0[i], &row1[i]);
+    /* The zenith terms' direction, M^T Z, turns with the isotropic terms:
+    ** their part of the isotropic columns (exact Jacobian). */
+    if (!st.have_zenith)
+        return;
+    V3<double> Z = m->mount == PM_MOUNT_ALTAZ
+                       ? v3(0.0, 0.0, 1.0)
+                       : v3(m_cos(m->latitude), 0.0, m_sin(m->latitude));
+    V3<double> dz[6];
+    V3<double> z = mt_and_derivs(c, Z, dz);
+    for (int i = m->n_base; i < m->n_terms; i++) {
+        const pm_term &t = m->term[i];
+        if (t.kind != PM_TERM_ZENITH || (t.side && t.side != st.side))
+            continue;
+        for (int j = 0; j < 6; j++) {
+            double du, dv;
+            if (t.l == 0 && z.x > 0.01) { /* (zy, zz) / zx */
+                du = (dz[j].y * z.x - z.y * dz[j].x) / (z.x * z.x);
+                dv = (dz[j].z * z.x - z.z * dz[j].x) / (z.x * z.x);
+            } else if (t.l == 0) { /* clamped: (zy, zz) / 0.01 */
+                du = dz[j].y / 0.01;
+                dv = dz[j].z / 0.01;
+            } else {
+                du = dz[j].y;
+                dv = dz[j].z;
+            }
+            row0[j] += m->coef[i] * du;
+            row1[j] += m->coef[i] * dv;
+        }
     }
 }
 
@@ -300,7 +342,11 @@ pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res)
     if (fit->iterations > 0 &&
         fit->chi2 > fit->base_chi2 - 1e-4 * frac * fit->base_pred) {
         pm_model next = fit->lin;
-        bool give_up = fit->halvings >= 40;
+        /* give up on the step (the accepted point is the answer) when what
+        ** is left of it could not matter statistically, or after 40 cuts */
+        long dof_r = 2 * fit->n_obs - P;
+        bool give_up = fit->halvings >= 40 ||
+                       0.5 * frac * fit->base_pred <= 1e-6 * fit->base_chi2 / (double)dof_r;
         for (int i = 0; i < P; i++) {
             if (!give_up)
                 fit->step[i] *= 0.5;
@@ -370,9 +416,11 @@ pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res)
     double max_step = 0, pred = 0;
     for (int i = 0; i < P; i++)
         pred += step[i] * fit->atb[i]; /* predicted chi^2 decrease */
-    /* Converged: every step negligible against its error, or the predicted
-    ** decrease of chi^2 below rounding-level relevance. */
-    int converged = pred <= 1e-12 * fit->chi2 ? 1 : 0;
+    /* Converged: every step negligible against its error, or a predicted
+    ** decrease of chi^2 below 1e-4 sigma^2 (the step then moves every
+    ** coefficient by less than 1% of its 1-sigma error). */
+    long dof_c = 2 * fit->n_obs - P;
+    int converged = pred <= 1e-4 * fit->chi2 / (double)dof_c ? 1 : 0;
     int small = 1;
     double err[PM_MAX_TERMS];
     for (int i = 0; i < P; i++) {

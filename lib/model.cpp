@@ -112,6 +112,14 @@ pm_status newton(const pm_model *m, const Iso<double> &k, const pm_context *ctx,
     return best <= PM_INVERT_TOL ? PM_OK : PM_WARN_NOT_CONVERGED;
 }
 
+/* Give trig g the angles nearest the reference angles. */
+void on_turn(Trig<double> *g, double ref_t, double ref_d)
+{
+    g->t = ref_t + wrap_pi(m_atan2(g->st, g->ct) - ref_t);
+    g->d = ref_d + wrap_pi(m_atan2(g->sd, g->cd) - ref_d);
+    g->have_angles = true;
+}
+
 /* Solve on one branch of the closed form (side = +1/-1), or from the start
 ** position's branch.  Returns the status, (t, d) and the round-trip miss
 ** when known (0 if the fixed point converged). */
@@ -121,6 +129,12 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
                        double *d_out)
 {
     double dt_prev = 0, dd_prev = 0;
+    /* Periodic terms of non-integer G read the raw angle itself, not only
+    ** its sine and cosine: iterate with the angles on the turn the result
+    ** is returned on (near the start, or ha in (-pi, pi] and dec near 0 or,
+    ** beyond the pole, near pi). */
+    double ref_t = start ? start[0] : 0.0;
+    double ref_d = start ? start[1] : (side > 0 ? 0.0 : PI);
     Trig<double> g;
     if (start) {
         /* The branch of the start: the sign of the x-component of
@@ -134,6 +148,7 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
         side = cdp * v.x - sdp * v.z >= 0 ? 1 : -1;
     }
     bool reachable = iso_inverse<double>(k, q, dt_prev, dd_prev, side, &g);
+    on_turn(&g, ref_t, ref_d);
 
     /* Fixed point: x_{n+1} = iso_inverse(D(x_n)).  x_n misses the target
     ** by |D(x_n) - D(x_{n-1})| (to first order), which is the test. */
@@ -160,14 +175,13 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
         dt_prev = dt;
         dd_prev = dd;
         reachable = iso_inverse<double>(k, q, dt, dd, side, &g);
+        on_turn(&g, ref_t, ref_d);
     }
     g = best;
     reachable = best_reachable;
 
-    double t = m_atan2(g.st, g.ct);
-    double d = m_atan2(g.sd, g.cd); /* in (-pi, pi] */
-    if (side < 0 && d < 0)
-        d += 2 * PI; /* beyond the pole: report in (pi/2, 3pi/2) */
+    double t = g.t; /* on the turn of ref_t, ref_d (on_turn) */
+    double d = g.d;
     pm_status result = PM_OK;
     if (!converged || !reachable) {
         double err;

@@ -1,0 +1,432 @@
+// fitrun.cpp - fitting a pointing run with a chosen term set (host side).
+#include "fitrun.hpp"
+#include "runfile.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <stdexcept>
+
+namespace pmhost {
+
+Run load_run(const std::string &path, bool refraction, bool skip_bad)
+{
+    pmrun_options ro;
+    pmrun_options_default(&ro);
+    ro.refraction = refraction ? 1 : 0;
+    ro.skip_bad = skip_bad ? 1 : 0;
+    pmrun *run = nullptr;
+    char err[1024];
+    if (pmrun_read(path.c_str(), &ro, &run, err, sizeof err) != 0)
+        throw std::runtime_error(err);
+    std::unique_ptr<pmrun, void (*)(pmrun *)> guard(run, pmrun_free);
+    Run r;
+    r.path = path;
+    r.mount = pmrun_mount(run) == PMRUN_MOUNT_ALTAZ ? PM_MOUNT_ALTAZ : PM_MOUNT_EQUATORIAL;
+    r.latitude = pmrun_latitude_rad(run);
+    for (int i = 0; i < pmrun_n_warnings(run); i++)
+        r.notes.push_back(pmrun_warning(run, i));
+    bool have_dir = false;
+    for (size_t i = 0; i < pmrun_count(run); i++) {
+        const pmrun_obs *p = pmrun_get(run, i);
+        Obs ob{p->enc_ha, p->enc_dec, p->app_ha, p->app_dec, p->pier, p->line, pm_context()};
+        std::memset(&ob.ctx, 0, sizeof ob.ctx);
+        ob.ctx.temp_c = p->temp_c;
+        ob.ctx.time_h = p->time_h;
+        ob.ctx.pier = p->pier;
+        ob.ctx.dir = p->dir;
+        have_dir = have_dir || p->dir != 0;
+        for (int j = 0; j < PM_MAX_AUX && j < PMRUN_MAX_AUX; j++)
+            ob.ctx.aux[j] = p->aux[j];
+        r.obs.push_back(ob);
+    }
+    if (!have_dir) {
+        r.dir_derived = true;
+        for (size_t i = 1; i < r.obs.size(); i++) {
+            double dh = std::remainder(r.obs[i].eh - r.obs[i - 1].eh, 2 * PI);
+            r.obs[i].ctx.dir = dh > 0 ? 1 : (dh < 0 ? -1 : 0);
+        }
+    }
+    for (int j = 0; j < pmrun_n_aux(run); j++)
+        r.aux_names.push_back(pmrun_aux_name(run, j));
+    return r;
+}
+
+std::string term_name(const pm_model &m, int i)
+{
+    char buf[32];
+    pm_term_name(&m, i, buf, sizeof buf);
+    return buf;
+}
+
+// Physical meaning of a term, for the table.
+std::string meaning(const pm_model &m, int i)
+{
+    const pm_term &t = m.term[i];
+    bool altaz = m.mount == PM_MOUNT_ALTAZ;
+    if (t.kind == PM_TERM_SH && t.l == 0 && t.side == 0) {
+        switch (t.k) {
+        case 1: return altaz ? "azimuth axis tilt (x)" : "polar axis misalignment (x)";
+        case 2: return altaz ? "azimuth axis tilt (y)" : "polar axis misalignment (y)";
+        case 3: return altaz ? "azimuth index [IA]" : "HA index [IH]";
+        case 4: return "axis non-perpendicularity [NP]";
+        case 5: return altaz ? "elevation index [IE]" : "Dec index [ID]";
+        case 6: return "collimation [CH/CA]";
+        }
+    }
+    static const char *base[] = {"", "tilt x", "tilt y", "axis-1 index", "non-perp.",
+                                 "axis-2 index", "collimation"};
+    std::string side = t.side > 0 ? ", east side" : (t.side < 0 ? ", west side" : "");
+    char g[32];
+    std::snprintf(g, sizeof g, "%g", t.param);
+    switch (t.kind) {
+    case PM_TERM_FOURIER:
+        return std::string("periodic error, ") + g + " cyc/rev of axis " +
+               (t.l == 1 ? "1" : "2") + (t.m ? " (sin)" : " (cos)") + side;
+    case PM_TERM_SECTORAL:
+        return std::string("paper-form periodic Y(") + g + ",+-" + g + ")" + side;
+    case PM_TERM_ZENITH:
+        return std::string(t.l == 0 ? "refraction-like cot(el)" : "tube flexure cos(el)") + side;
+    case PM_TERM_AUX: {
+        const char *in = t.aux == PM_AUX_TEMP ? "temperature"
+                         : t.aux == PM_AUX_TIME ? "time drift"
+                         : t.aux == PM_AUX_DIR ? "hysteresis (slew dir)" : "aux input";
+        return std::string(in) + " on " + base[t.k] + " [per unit]" + side;
+    }
+    }
+    if (t.l == 0)
+        return std::string(base[t.k]) + side;
+    return std::string(base[t.k]) + " varying as Y(" + std::to_string(t.l) + "," +
+           std::to_string(t.m) + ")" + side;
+}
+
+std::string json_escape(const std::string &s)
+{
+    std::string o;
+    for (char c : s) {
+        if (c == '"' || c == '\\')
+            o += '\\', o += c;
+        else if ((unsigned char)c < 0x20) {
+            char b[8];
+            std::snprintf(b, sizeof b, "\\u%04x", c);
+            o += b;
+        } else
+            o += c;
+    }
+    return o;
+}
+
+// Regularised incomplete beta I_x(a, b) by its continued fraction (modified
+// Lentz), for the F distribution's tail.
+double inc_beta(double a, double b, double x)
+{
+    if (x <= 0)
+        return 0;
+    if (x >= 1)
+        return 1;
+    if (x > (a + 1) / (a + b + 2))
+        return 1 - inc_beta(b, a, 1 - x);
+    double lbeta = std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b);
+    double front = std::exp(lbeta + a * std::log(x) + b * std::log(1 - x)) / a;
+    const double tiny = 1e-300;
+    double f = 1, c = 1, d = 0;
+    for (int i = 0; i <= 400; i++) {
+        int mm = i / 2;
+        double num;
+        if (i == 0)
+            num = 1;
+        else if (i % 2 == 0)
+            num = mm * (b - mm) * x / ((a + 2 * mm - 1) * (a + 2 * mm));
+        else
+            num = -(a + mm) * (a + b + mm) * x / ((a + 2 * mm) * (a + 2 * mm + 1));
+        d = 1 + num * d;
+        d = std::fabs(d) < tiny ? tiny : d;
+        d = 1 / d;
+        c = 1 + num / c;
+        c = std::fabs(c) < tiny ? tiny : c;
+        f *= c * d;
+        if (std::fabs(1 - c * d) < 1e-15)
+            break;
+    }
+    return front * (f - 1);
+}
+
+// P(F > f) for the F distribution with (d1, d2) degrees of freedom.
+double f_tail(double f, double d1, double d2)
+{
+    if (!(f > 0))
+        return 1;
+    return inc_beta(d2 / 2, d1 / 2, d2 / (d2 + d1 * f));
+}
+
+// Do the extra parameters of `big` over `small` (nested models, same data)
+// reduce chi^2 more than noise would?
+FTest f_test(double chi2_small, int p_small, double chi2_big, int p_big, long n_obs,
+             const std::string &what)
+{
+    FTest t;
+    t.done = true;
+    t.what = what;
+    t.d1 = p_big - p_small;
+    t.d2 = 2 * n_obs - p_big;
+    if (t.d1 <= 0 || t.d2 <= 0 || !(chi2_big > 0)) {
+        t.done = false;
+        return t;
+    }
+    t.f = ((chi2_small - chi2_big) / t.d1) / (chi2_big / (double)t.d2);
+    t.p = f_tail(t.f, t.d1, (double)t.d2);
+    return t;
+}
+
+// Residuals of f.model on the observations `use`, and their RMS on the sky.
+void residuals(FitOut &f, const std::vector<Obs> &obs, const std::vector<int> &use)
+{
+    double ss = 0;
+    for (int i : use) {
+        double r[2];
+        pm_model_residual(&f.model, &obs[i].ctx, obs[i].eh, obs[i].ed, obs[i].ah, obs[i].ad, r);
+        f.r0.push_back(r[0]);
+        f.r1.push_back(r[1]);
+        f.idx.push_back(i);
+        ss += r[0] * r[0] + r[1] * r[1];
+    }
+    f.rms = use.empty() ? 0 : std::sqrt(ss / (double)use.size());
+}
+
+FitOut do_fit(const std::vector<Obs> &obs, const std::vector<int> &use, const pm_model &start,
+              int max_passes)
+{
+    static pm_fit fit; // large; not on the stack
+    FitOut f;
+    f.model = start;
+    std::vector<double> eh, ed, ah, ad;
+    std::vector<pm_context> ctx;
+    for (int i : use) {
+        eh.push_back(obs[i].eh);
+        ed.push_back(obs[i].ed);
+        ah.push_back(obs[i].ah);
+        ad.push_back(obs[i].ad);
+        ctx.push_back(obs[i].ctx);
+    }
+    f.status = pm_fit_run(&fit, &f.model, ctx.data(), (long)use.size(), eh.data(), ed.data(),
+                          ah.data(), ad.data(), max_passes, &f.res);
+    if (f.status != PM_OK) {
+        f.bad_term = fit.bad_term;
+        if (f.status == PM_ERR_DIVERGED && fit.iterations > 0) {
+            // name the most nearly degenerate pair of the last accepted pass
+            pm_fit_result unit;
+            std::memset(&unit, 0, sizeof unit);
+            unit.sigma = 1;
+            for (int i = 0; i < fit.n_par; i++)
+                for (int j = 0; j < i; j++) {
+                    double c, r;
+                    if (pm_fit_covariance(&fit, &unit, i, j, &c, &r) == PM_OK &&
+                        std::fabs(r) > std::fabs(f.corr)) {
+                        f.corr = r;
+                        f.corr_i = i;
+                        f.corr_j = j;
+                    }
+                }
+        }
+        return f;
+    }
+    residuals(f, obs, use);
+    return f;
+}
+
+// Base vectors named in a list like "c',e',i" (default: def).
+std::vector<int> parse_bases(const std::string &spec, const std::string &list,
+                             const std::vector<int> &def)
+{
+    if (list.empty())
+        return def;
+    std::vector<int> ks;
+    size_t pos = 0;
+    while (pos <= list.size()) {
+        size_t c = list.find(',', pos);
+        std::string b = list.substr(pos, c == std::string::npos ? std::string::npos : c - pos);
+        static const char *names[] = {"a", "b", "c'", "d", "e'", "i"};
+        int k = 0;
+        for (int j = 0; j < 6; j++)
+            if (b == names[j])
+                k = j + 1;
+        if (!k)
+            throw std::runtime_error("--add " + spec + ": unknown base vector '" + b + "' (expected a, b, c', d, e', i)");
+        ks.push_back(k);
+        if (c == std::string::npos)
+            break;
+        pos = c + 1;
+    }
+    return ks;
+}
+
+// The model to fit: the harmonic set of the order plus the --add effects.
+pm_model build_model(int order, const std::vector<std::string> &adds,
+                     const std::vector<Obs> &obs, int mount, double lat,
+                     const std::vector<std::string> &aux_names)
+{
+    pm_model m;
+    pm_model_init(&m, mount, order);
+    m.latitude = std::isnan(lat) ? 0.0 : lat;
+    pm_model_prepare(&m);
+    auto add = [&](const std::string &spec, pm_term t) {
+        int st = pm_model_add_term(&m, &t, 0.0, nullptr);
+        if (st == PM_ERR_CAPACITY)
+            throw std::runtime_error("--add " + spec + ": more than " + std::to_string(PM_MAX_TERMS) +
+                " terms (this build's PM_MAX_TERMS)");
+        if (st != PM_OK)
+            throw std::runtime_error("--add " + spec + ": not a valid term for this model");
+    };
+    for (const std::string &spec : adds) {
+        std::string body = spec;
+        int side = 0;
+        if (body.size() > 2 && body[body.size() - 2] == '@') {
+            char c = body.back();
+            side = c == 'E' || c == 'e' ? 1 : (c == 'W' || c == 'w' ? -1 : 0);
+            if (!side)
+                throw std::runtime_error("--add " + spec + ": expected @E or @W for a pier side");
+            body = body.substr(0, body.size() - 2);
+        }
+        std::vector<std::string> f;
+        {
+            size_t pos = 0, c;
+            while ((c = body.find(':', pos)) != std::string::npos) {
+                f.push_back(body.substr(pos, c - pos));
+                pos = c + 1;
+            }
+            f.push_back(body.substr(pos));
+        }
+        pm_term t;
+        std::memset(&t, 0, sizeof t);
+        t.side = (signed char)side;
+        const std::string &name = f[0];
+        if (name == "ha_periodic" || name == "dec_periodic") {
+            if (f.size() < 2 || f.size() > 3)
+                throw std::runtime_error("--add " + spec + ": expected " + name + ":G[:H]");
+            char *end;
+            double G = std::strtod(f[1].c_str(), &end);
+            if (*end || !(G > 0 && G <= 100000))
+                throw std::runtime_error("--add " + spec + ": G must be cycles per revolution, > 0");
+            long H = f.size() == 3 ? std::strtol(f[2].c_str(), &end, 10) : 1;
+            if (f.size() == 3 && (*end || H < 1 || H > 8))
+                throw std::runtime_error("--add " + spec + ": H must be 1..8 harmonics");
+            t.kind = PM_TERM_FOURIER;
+            t.l = (signed char)(name == "ha_periodic" ? 1 : 2);
+            t.k = (unsigned char)(name == "ha_periodic" ? PM_BASE_C : PM_BASE_E);
+            for (long h = 1; h <= H; h++)
+                for (int sc = 0; sc < 2; sc++) {
+                    t.param = G * (double)h;
+                    t.m = (signed char)sc;
+                    add(spec, t);
+                }
+        } else if (name == "ha_periodic_paper") {
+            char *end;
+            long G = f.size() == 2 ? std::strtol(f[1].c_str(), &end, 10) : 0;
+            if (f.size() != 2 || *end || G < 1 || G > 100000)
+                throw std::runtime_error("--add " + spec + ": expected ha_periodic_paper:G with an integer G");
+            t.kind = PM_TERM_SECTORAL;
+            t.k = PM_BASE_C;
+            t.param = (double)G;
+            for (int sc = 0; sc < 2; sc++) {
+                t.m = (signed char)sc;
+                add(spec, t);
+            }
+        } else if (name == "refraction" || name == "tube_flexure") {
+            if (f.size() != 1)
+                throw std::runtime_error("--add " + spec + ": takes no arguments");
+            if (mount == PM_MOUNT_EQUATORIAL && std::isnan(lat))
+                throw std::runtime_error("--add " + spec + ": needs the site latitude, which the run file does not "
+                    "give (a '# latitude: DEG' line or a TPOINT run line)");
+            t.kind = PM_TERM_ZENITH;
+            t.l = (signed char)(name == "refraction" ? 0 : 1);
+            add(spec, t);
+        } else if (name == "temperature" || name == "time_drift" || name == "hysteresis" ||
+                   name == "aux") {
+            int input;
+            std::vector<int> def = {PM_BASE_C, PM_BASE_E};
+            size_t bases_at = 1;
+            if (name == "temperature")
+                input = PM_AUX_TEMP;
+            else if (name == "time_drift")
+                input = PM_AUX_TIME;
+            else if (name == "hysteresis") {
+                input = PM_AUX_DIR;
+                def = {PM_BASE_C};
+            } else {
+                if (f.size() < 2)
+                    throw std::runtime_error("--add " + spec + ": expected aux:NAME[:BASES]");
+                int j = -1;
+                for (size_t q = 0; q < aux_names.size(); q++)
+                    if (aux_names[q] == f[1])
+                        j = (int)q;
+                if (j < 0)
+                    throw std::runtime_error("--add " + spec + ": the run has no column '" + f[1] + "'");
+                if (j >= PM_MAX_AUX)
+                    throw std::runtime_error("--add " + spec + ": column '" + f[1] + "' is beyond the first " +
+                        std::to_string(PM_MAX_AUX) + " auxiliary columns the core takes");
+                input = PM_AUX_USER + j;
+                bases_at = 2;
+            }
+            if (f.size() > bases_at + 1)
+                throw std::runtime_error("--add " + spec + ": too many ':' fields");
+            std::vector<int> ks =
+                parse_bases(spec, f.size() > bases_at ? f[bases_at] : std::string(), def);
+            // reference: the mean of the input, so the term is decorrelated from the index
+            double sum = 0;
+            size_t no_dir = 0;
+            for (const Obs &ob : obs) {
+                pm_context c = ob.ctx;
+                double x = input == PM_AUX_TEMP ? c.temp_c
+                           : input == PM_AUX_TIME ? c.time_h
+                           : input == PM_AUX_DIR ? (double)c.dir : c.aux[input - PM_AUX_USER];
+                if (!std::isfinite(x))
+                    throw std::runtime_error("--add " + spec + ": the run gives no value for the observation at "
+                        "line " + std::to_string(ob.line));
+                no_dir += input == PM_AUX_DIR && x == 0;
+                sum += x;
+            }
+            if (no_dir * 10 > obs.size()) // 0 = unknown; the first point always is
+                throw std::runtime_error("--add " + spec + ": the slew direction is unknown for " +
+                    std::to_string(no_dir) + " of " + std::to_string(obs.size()) +
+                    " observations");
+            t.kind = PM_TERM_AUX;
+            t.aux = (unsigned char)input;
+            t.param = obs.empty() ? 0 : sum / (double)obs.size();
+            for (int k : ks) {
+                t.k = (unsigned char)k;
+                add(spec, t);
+            }
+        } else {
+            // a harmonic term by name, for one pier side
+            int found = -1;
+            for (int i = 0; i < m.n_base; i++)
+                if (term_name(m, i) == body)
+                    found = i;
+            if (found < 0)
+                throw std::runtime_error("--add " + spec + ": unknown effect or term (see pmfit --help)");
+            if (!side)
+                throw std::runtime_error("--add " + spec + ": " + body + " is already in the model; add it for one "
+                    "pier side with " + body + "@E or " + body + "@W");
+            t = m.term[found];
+            t.side = (signed char)side;
+            add(spec, t);
+        }
+    }
+    return m;
+}
+
+// The model without its side-specific added terms (for the pier F-test).
+pm_model without_side_terms(const pm_model &m)
+{
+    pm_model r;
+    pm_model_init(&r, m.mount, m.order);
+    r.latitude = m.latitude;
+    pm_model_prepare(&r);
+    for (int i = m.n_base; i < m.n_terms; i++)
+        if (m.term[i].side == 0)
+            pm_model_add_term(&r, &m.term[i], 0.0, nullptr);
+    return r;
+}
+
+} // namespace pmhost

@@ -1,0 +1,86 @@
+// fitrun.hpp - fitting a pointing run with a chosen term set (host side):
+// the observations with their contexts, models built from effect names, the
+// Gauss-Newton fit with diagnostics, residuals, and the F-test.  Shared by
+// pmfit fit/eval/simulate and pmfit explain.  Errors are exceptions
+// (std::runtime_error) carrying the message for the user.
+#ifndef PM_FITRUN_HPP
+#define PM_FITRUN_HPP
+
+#include "pm.h"
+
+#include <string>
+#include <vector>
+
+namespace pmhost {
+
+const double RAD2AS = 206264.80624709636;
+const double PI = 3.14159265358979323846;
+
+struct Obs {
+    double eh, ed, ah, ad;
+    int pier, line;
+    pm_context ctx; // inputs of the physical terms
+};
+
+struct FitOut {
+    pm_status status = PM_OK;
+    pm_model model;
+    pm_fit_result res;
+    int bad_term = -1;
+    int corr_i = -1, corr_j = -1; // most correlated pair when not converged
+    double corr = 0;
+    std::vector<double> r0, r1; // residuals (rad), sky frame
+    std::vector<int> idx;       // indices into the run
+    double rms = 0;
+};
+
+// A pointing run read from a file, with per-observation contexts.
+struct Run {
+    std::string path;
+    int mount = PM_MOUNT_EQUATORIAL;
+    double latitude = 0; // radians; NaN when the file gives none
+    std::vector<Obs> obs;
+    std::vector<std::string> aux_names;
+    std::vector<std::string> notes; // reader warnings, skipped records
+    bool dir_derived = false;       // slew directions from the sequence
+};
+
+// Read a run (pmrun_read); without a direction column the slew direction on
+// axis 1 is the sign of the encoder's change from the previous observation.
+Run load_run(const std::string &path, bool refraction, bool skip_bad);
+
+// Name and physical meaning of a model term.
+std::string term_name(const pm_model &m, int i);
+std::string meaning(const pm_model &m, int i);
+std::string json_escape(const std::string &s);
+
+// The harmonic set of `order` plus the effects `adds` (pmfit fit --add
+// syntax, documented in its usage).
+pm_model build_model(int order, const std::vector<std::string> &adds,
+                     const std::vector<Obs> &obs, int mount, double lat,
+                     const std::vector<std::string> &aux_names);
+// The model without its side-specific added terms.
+pm_model without_side_terms(const pm_model &m);
+
+// Fit `start` to the observations `use` (Gauss-Newton, at most max_passes);
+// on success the residuals are filled in.
+FitOut do_fit(const std::vector<Obs> &obs, const std::vector<int> &use, const pm_model &start,
+              int max_passes = 100);
+void residuals(FitOut &f, const std::vector<Obs> &obs, const std::vector<int> &use);
+
+// The F distribution's upper tail, and the nested-model F-test.
+double inc_beta(double a, double b, double x);
+double f_tail(double f, double d1, double d2);
+struct FTest {
+    bool done = false;
+    double f = 0, p = 1;
+    int d1 = 0;
+    long d2 = 0;
+    std::string what;
+};
+FTest f_test(double chi2_small, int p_small, double chi2_big, int p_big, long n_obs,
+             const std::string &what);
+
+} // namespace pmhost
+
+#endif
