@@ -2,6 +2,7 @@
 //
 //   pmfit fit RUN [--order L] [--pier joint|split] [--json] [--residuals FILE]
 //                 [--save MODEL] [--emit-c HEADER] [--no-refraction] [--skip-bad]
+//   pmfit explain RUN [--order L] [--add EFFECT ...] [--json] [--plots DIR] [--alpha P]
 //   pmfit eval MODEL RUN [--json] [--residuals FILE] [--no-refraction] [--skip-bad]
 //   pmfit simulate OUT [--n N] [--seed S] [--lat DEG] [--mount equatorial|altaz]
 //                 [--fork] [--el-limit DEG] [--noise ARCSEC] [--order L]
@@ -15,6 +16,8 @@
 #include "simulate.h"
 #include "hostutil.hpp"
 #include "fitrun.hpp"
+#include "explain.hpp"
+#include "plots.hpp"
 
 #include <cerrno>
 #include <cmath>
@@ -26,6 +29,7 @@
 #include <string>
 #include <vector>
 #include <algorithm>
+#include <filesystem>
 #include <stdexcept>
 
 namespace {
@@ -40,7 +44,9 @@ struct Options {
     bool refraction = true;
     bool skip_bad = false;
     std::string residuals, save, emit_c;
-    std::vector<std::string> adds; // fit: --add EFFECT
+    std::vector<std::string> adds; // fit, explain: --add EFFECT
+    std::string plots;             // explain: --plots DIR
+    double alpha = 0.01;           // explain: --alpha
     // simulate
     long n = 200;
     unsigned long long seed = 1;
@@ -84,6 +90,17 @@ void usage(FILE *f)
         "  --no-refraction  leave refraction out of the TPOINT reduction\n"
         "  --skip-bad       skip malformed records (each is reported) instead of failing\n"
         "\n"
+        "usage: pmfit explain RUN [--order L] [--add EFFECT ...] [--json] [--plots DIR]\n"
+        "                     [--alpha P] [--no-refraction] [--skip-bad]\n"
+        "\n"
+        "  fits the baseline model (order L, default 1, plus --add terms), locates where the\n"
+        "  residuals are too large, names the physics left out (ha_periodic, dec_periodic,\n"
+        "  pier_side, refraction, tube_flexure, temperature, time_drift, hysteresis,\n"
+        "  higher_order, outlier), adds it and repeats while the false-alarm probability is\n"
+        "  below P (default 0.01) and the cross-validated RMS improves (docs/explain.md);\n"
+        "  --plots DIR writes SVG pictures: residuals on the sky before/after, residual vs the\n"
+        "  located variable, periodograms, sigma per step\n"
+        "\n"
         "usage: pmfit eval MODEL RUN [--json] [--residuals FILE] [--no-refraction] [--skip-bad]\n"
         "\n"
         "  applies a saved model (pmfit fit --save) to a run without refitting: how well\n"
@@ -105,7 +122,9 @@ void usage(FILE *f)
         "  --effect E=V     inject a physical effect E (any fit --add EFFECT) of size V\n"
         "                   arcsec (periodic: amplitude, phase --phase DEG; temperature,\n"
         "                   time_drift: arcsec per deg C / per hour; hysteresis: arcsec per\n"
-        "                   unit of direction, i.e. half the backlash); repeatable\n",
+        "                   unit of direction, i.e. half the backlash), or outlier[:N] (N\n"
+        "                   points off by V) or higher_order (order L+1 terms of RMS V);\n"
+        "                   repeatable\n",
         PM_MAX_L);
 }
 
@@ -137,9 +156,10 @@ Options parse_args(int argc, char **argv)
         usage(stdout);
         std::exit(0);
     }
-    if (o.cmd != "fit" && o.cmd != "simulate" && o.cmd != "eval")
-        die("unknown command '" + o.cmd + "' (expected: fit, eval or simulate); see pmfit --help");
-    bool sim = o.cmd == "simulate", eval = o.cmd == "eval";
+    if (o.cmd != "fit" && o.cmd != "simulate" && o.cmd != "eval" && o.cmd != "explain")
+        die("unknown command '" + o.cmd +
+            "' (expected: fit, explain, eval or simulate); see pmfit --help");
+    bool sim = o.cmd == "simulate", eval = o.cmd == "eval", expl = o.cmd == "explain";
     auto number = [&](const std::string &opt, const char *v, double lo, double hi) {
         char *end = nullptr;
         double x = std::strtod(v, &end);
@@ -160,7 +180,7 @@ Options parse_args(int argc, char **argv)
             if (!parse_int(v, &o.order) || o.order < 0 || o.order > PM_MAX_L)
                 die(std::string("--order: expected an integer 0..") +
                     std::to_string(PM_MAX_L) + ", got '" + v + "'");
-        } else if (!sim && !eval && a == "--pier") {
+        } else if (!sim && !eval && !expl && a == "--pier") {
             std::string v = need("joint or split");
             if (v == "split")
                 o.split = true;
@@ -172,11 +192,15 @@ Options parse_args(int argc, char **argv)
             o.json = true;
         } else if (!sim && a == "--residuals") {
             o.residuals = need("a file name");
+        } else if (expl && a == "--plots") {
+            o.plots = need("a directory");
+        } else if (expl && a == "--alpha") {
+            o.alpha = number(a, need("a probability"), 1e-12, 0.5);
         } else if (!sim && !eval && a == "--add") {
             o.adds.push_back(need("an effect (see pmfit --help)"));
-        } else if (!sim && !eval && a == "--save") {
+        } else if (!sim && !eval && !expl && a == "--save") {
             o.save = need("a file name");
-        } else if (!sim && !eval && a == "--emit-c") {
+        } else if (!sim && !eval && !expl && a == "--emit-c") {
             o.emit_c = need("a file name");
         } else if (sim && a == "--n") {
             o.n = (long)number(a, need("a count"), 1, 1e7);
@@ -379,6 +403,228 @@ int cmd_eval(const Options &o, const std::vector<Obs> &obs, int mount)
     return 0;
 }
 
+// The pictures of pmfit explain --plots DIR (SVG).
+void write_explain_plots(const std::string &dir, const Run &run, const Explanation &ex)
+{
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (ec)
+        die("--plots: cannot create " + dir + ": " + ec.message(), 1);
+    std::string err;
+    auto check = [&](int rc) {
+        if (rc != 0)
+            die("--plots: " + err, 1);
+    };
+    bool altaz = run.mount == PM_MOUNT_ALTAZ;
+    std::string xl = altaz ? "azimuth (deg)" : "hour angle (deg)";
+    std::string yl = altaz ? "elevation (deg)" : "declination (deg)";
+    auto vecs = [&](const FitOut &f) {
+        std::vector<pmplot::Vec> v;
+        for (size_t j = 0; j < f.idx.size(); j++) {
+            const Obs &o = run.obs[f.idx[j]];
+            double x = std::remainder(o.ah, 2 * PI) * 180 / PI;
+            if (altaz && x < 0)
+                x += 360;
+            v.push_back({x, o.ad * 180 / PI, f.r0[j] * RAD2AS, f.r1[j] * RAD2AS,
+                         o.pier < 0 ? 1 : 0});
+        }
+        return v;
+    };
+    std::vector<std::string> groups = altaz ? std::vector<std::string>{"alt-az"}
+                                            : std::vector<std::string>{"pier east", "pier west"};
+    char t[256];
+    std::snprintf(t, sizeof t, "Residuals on the sky: baseline (sigma %.2f\") and after %zu "
+                               "finding%s (sigma %.2f\")",
+                  ex.base_sigma_arcsec, ex.findings.size(), ex.findings.size() == 1 ? "" : "s",
+                  ex.final_sigma_arcsec);
+    check(pmplot::sky_vectors_pair(dir + "/sky_before_after.svg", t, xl, yl, vecs(ex.baseline),
+                                   vecs(ex.final), "baseline", "explained model", 0, groups, &err));
+    for (const Periodogram &pg : ex.periodograms) {
+        std::snprintf(t, sizeof t, "Periodogram of the baseline residuals, %s axis",
+                      pg.axis == "ha" ? (altaz ? "azimuth" : "hour-angle")
+                                      : (altaz ? "elevation" : "declination"));
+        char lab[64];
+        std::snprintf(lab, sizeof lab, "false-alarm 1%% over %zu periods", pg.g.size());
+        check(pmplot::periodogram(dir + "/periodogram_" + pg.axis + ".svg", t,
+                                  "chi^2 reduction / sigma^2", pg.g, pg.power, pg.threshold, lab,
+                                  pg.peak_g, true, &err));
+    }
+    std::vector<std::string> labels = {"baseline"};
+    std::vector<double> sig = {ex.base_sigma_arcsec}, cv = {ex.base_cv_rms_arcsec};
+    for (const Finding &f : ex.findings) {
+        labels.push_back("+ " + f.effect);
+        sig.push_back(f.sigma_after_arcsec);
+        cv.push_back(f.cv_rms_after_arcsec);
+    }
+    check(pmplot::steps(dir + "/steps.svg", "Unbiased sigma and cross-validated RMS per step",
+                        labels, sig, cv, &err));
+    // each finding: the baseline residual against its variable
+    const FitOut &b = ex.baseline;
+    for (size_t k = 0; k < ex.findings.size(); k++) {
+        const Finding &f = ex.findings[k];
+        pmplot::Series s1{"axis 1 (along HA/az)", {}, {}, false};
+        pmplot::Series s2{"axis 2 (along Dec/el)", {}, {}, false};
+        std::string xlab;
+        for (size_t j = 0; j < b.idx.size(); j++) {
+            const Obs &o = run.obs[b.idx[j]];
+            double x = NAN;
+            if (f.effect == "ha_periodic" || f.effect == "dec_periodic") {
+                double th = f.effect == "ha_periodic" ? o.eh : o.ed;
+                x = std::fmod(std::fmod(f.cycles_per_rev * th * 180 / PI, 360) + 360, 360);
+                xlab = "phase of the period, G * raw " +
+                       std::string(f.effect == "ha_periodic" ? "HA" : "Dec") + " (deg)";
+            } else if (f.effect == "refraction" || f.effect == "tube_flexure") {
+                double el = altaz ? o.ad
+                                  : std::asin(std::sin(run.latitude) * std::sin(o.ad) +
+                                              std::cos(run.latitude) * std::cos(o.ad) *
+                                                  std::cos(o.ah));
+                x = el * 180 / PI;
+                xlab = "elevation (deg)";
+            } else if (f.effect == "temperature") {
+                x = o.ctx.temp_c;
+                xlab = "temperature (deg C)";
+            } else if (f.effect == "time_drift") {
+                x = o.ctx.time_h;
+                xlab = "time (h)";
+            } else if (f.effect == "hysteresis") {
+                x = o.ctx.dir + 0.1 * ((double)(j % 7) - 3) / 3; // jitter to see the spread
+                xlab = "direction of the last slew on axis 1 (-1, +1; jittered)";
+            } else if (f.effect == "pier_side") {
+                x = std::remainder(o.ah, 2 * PI) * 12 / PI;
+                xlab = "apparent hour angle (h); west pier = beyond the pole";
+            } else {
+                x = (double)o.line;
+                xlab = "line in the run file";
+            }
+            double y0 = b.r0[j] * RAD2AS, y1 = b.r1[j] * RAD2AS;
+            if (f.effect == "ha_periodic" && std::fabs(std::cos(o.ad)) > 0.2)
+                y0 /= std::fabs(std::cos(o.ad)); // along the axis, not on the sky
+            s1.x.push_back(x);
+            s1.y.push_back(y0);
+            s2.x.push_back(x);
+            s2.y.push_back(y1);
+        }
+        std::snprintf(t, sizeof t, "Finding %zu, %s: baseline residuals", k + 1, f.effect.c_str());
+        check(pmplot::xy(dir + "/finding" + std::to_string(k + 1) + "_" + f.effect + ".svg", t, xlab,
+                         "residual (arcsec)", {s1, s2}, &err));
+    }
+}
+
+// pmfit explain: report, JSON, plots.
+int cmd_explain(const Options &o, const Run &run)
+{
+    ExplainOptions eo;
+    eo.order = o.order;
+    eo.adds = o.adds;
+    eo.alpha = o.alpha;
+    Explanation ex = explain(run, eo);
+    auto num = [](double v) {
+        char b[40];
+        std::snprintf(b, sizeof b, std::isfinite(v) ? "%.6g" : "null", v);
+        return std::string(b);
+    };
+    if (o.json) {
+        std::string j = "{\"n_obs\": " + std::to_string(run.obs.size()) +
+                        ", \"baseline\": {\"order\": " + std::to_string(o.order) +
+                        ", \"sigma_arcsec\": " + num(ex.base_sigma_arcsec) +
+                        ", \"cv_rms_arcsec\": " + num(ex.base_cv_rms_arcsec) +
+                        ", \"n_params\": " + std::to_string(ex.base_n_params) + "}, \"located\": [";
+        for (size_t i = 0; i < ex.located.size() && i < 8; i++)
+            j += std::string(i ? ", " : "") + "{\"what\": \"" + json_escape(ex.located[i].what) +
+                 "\", \"value\": " + num(ex.located[i].rms_arcsec) + ", \"ratio\": " +
+                 num(ex.located[i].ratio) + ", \"p\": " + num(ex.located[i].p) + "}";
+        j += "], \"periodograms\": [";
+        for (size_t i = 0; i < ex.periodograms.size(); i++)
+            j += std::string(i ? ", " : "") + "{\"axis\": \"" + ex.periodograms[i].axis +
+                 "\", \"peak_cycles_per_rev\": " + num(ex.periodograms[i].peak_g) +
+                 ", \"peak_power\": " + num(ex.periodograms[i].peak_power) +
+                 ", \"threshold\": " + num(ex.periodograms[i].threshold) + "}";
+        j += "], \"findings\": [";
+        for (size_t i = 0; i < ex.findings.size(); i++) {
+            const Finding &f = ex.findings[i];
+            j += std::string(i ? ", " : "") + "{\"effect\": \"" + f.effect + "\"";
+            if (f.effect == "ha_periodic" || f.effect == "dec_periodic")
+                j += ", \"cycles_per_rev\": " + num(f.cycles_per_rev) + ", \"phase_deg\": " +
+                     num(f.phase_deg);
+            j += ", \"amplitude_arcsec\": " + num(f.amplitude_arcsec) +
+                 ", \"amplitude_error_arcsec\": " + num(f.amplitude_err_arcsec) +
+                 ", \"false_alarm_probability\": " + num(f.false_alarm_probability) +
+                 ", \"log10_false_alarm_probability\": " + num(f.log10_p) +
+                 ", \"sigma_after_arcsec\": " + num(f.sigma_after_arcsec) +
+                 ", \"cv_rms_after_arcsec\": " + num(f.cv_rms_after_arcsec) +
+                 ", \"n_params_after\": " + std::to_string(f.n_params_after) + ", \"terms\": [";
+            for (size_t k = 0; k < f.adds.size(); k++)
+                j += std::string(k ? ", " : "") + "\"" + json_escape(f.adds[k]) + "\"";
+            j += "]";
+            if (!f.lines.empty()) {
+                j += ", \"lines\": [";
+                for (size_t k = 0; k < f.lines.size(); k++)
+                    j += std::string(k ? ", " : "") + std::to_string(f.lines[k]);
+                j += "]";
+            }
+            j += ", \"text\": \"" + json_escape(f.text) + "\", \"where\": \"" +
+                 json_escape(f.where) + "\"}";
+        }
+        j += "], \"final\": {\"sigma_arcsec\": " + num(ex.final_sigma_arcsec) +
+             ", \"cv_rms_arcsec\": " + num(ex.final_cv_rms_arcsec) +
+             ", \"n_params\": " + std::to_string(ex.final_n_params) + "}}";
+        std::printf("%s\n", j.c_str());
+    } else {
+        std::printf("pmfit explain %s: %s mount, %zu observations\n\n", run.path.c_str(),
+                    run.mount == PM_MOUNT_ALTAZ ? "alt-az" : "equatorial", run.obs.size());
+        std::printf("baseline: order %d%s, P = %d, unbiased sigma %.3f\", cross-validated RMS "
+                    "%.3f\"\n",
+                    o.order, o.adds.empty() ? "" : " + added terms", ex.base_n_params,
+                    ex.base_sigma_arcsec, ex.base_cv_rms_arcsec);
+        std::printf("\nwhere the baseline residuals are too large (p: chance of so much, "
+                    "uncorrected):\n");
+        int shown = 0;
+        for (const Located &l : ex.located) {
+            if (shown >= 6 || l.p > 0.05)
+                break;
+            if (l.what.find(" vs ") != std::string::npos)
+                std::printf("  %-44s correlation %+.2f (|t| = %.1f), p = %.2g\n", l.what.c_str(),
+                            l.rms_arcsec, l.ratio, l.p);
+            else
+                std::printf("  %-44s RMS %.2f\" (%.2f x typical), p = %.2g\n", l.what.c_str(),
+                            l.rms_arcsec, l.ratio, l.p);
+            shown++;
+        }
+        if (!shown)
+            std::printf("  nowhere in particular (no group or variable at p < 0.05)\n");
+        for (const Periodogram &pg : ex.periodograms)
+            std::printf("  periodogram of the %s axis: highest peak at G = %.6g cycles/rev, power "
+                        "%.1f (false-alarm %g level: %.1f)\n",
+                        pg.axis.c_str(), pg.peak_g, pg.peak_power, o.alpha, pg.threshold);
+        std::printf("\nfindings:\n");
+        if (ex.findings.empty())
+            std::printf("  none: nothing significant is left out (false-alarm probability "
+                        "below %g and a better cross-validated RMS were required)\n",
+                        o.alpha);
+        for (size_t i = 0; i < ex.findings.size(); i++) {
+            const Finding &f = ex.findings[i];
+            std::printf("  %zu. %s: %s\n     where: %s\n     false-alarm probability %.2g "
+                        "(10^%.1f); with it sigma %.3f\", CV RMS %.3f\", P = %d\n",
+                        i + 1, f.effect.c_str(), f.text.c_str(), f.where.c_str(),
+                        f.false_alarm_probability, f.log10_p, f.sigma_after_arcsec,
+                        f.cv_rms_after_arcsec, f.n_params_after);
+        }
+        std::printf("\n  %-22s %5s %10s %10s\n", "step", "P", "sigma(\")", "CV RMS(\")");
+        std::printf("  %-22s %5d %10.3f %10.3f\n", "baseline", ex.base_n_params,
+                    ex.base_sigma_arcsec, ex.base_cv_rms_arcsec);
+        for (const Finding &f : ex.findings)
+            std::printf("  %-22s %5d %10.3f %10.3f\n", ("+ " + f.effect).c_str(), f.n_params_after,
+                        f.sigma_after_arcsec, f.cv_rms_after_arcsec);
+        std::printf("\n  pmfit fit %s --order %d", run.path.c_str(), ex.final_order);
+        for (const std::string &a : ex.final_adds)
+            std::printf(" --add '%s'", a.c_str());
+        std::printf("   # fits the explained model\n");
+    }
+    if (!o.plots.empty())
+        write_explain_plots(o.plots, run, ex);
+    return 0;
+}
+
 int cmd_simulate(const Options &o, int argc, char **argv)
 {
     pmsim_spec spec;
@@ -410,38 +656,12 @@ int cmd_simulate(const Options &o, int argc, char **argv)
     m.latitude = o.lat * PI / 180;
     if (pm_model_prepare(&m) != PM_OK)
         die("simulate: the true model is invalid", 1);
-    // physical effects: the terms fit --add would add, with the given size
+    // physical effects (pmsim_add_effect)
     for (const auto &e : o.effects) {
-        Options one = o;
-        one.adds = {e.first};
-        Obs ref{0, 0, 0, 0, 1, 0, pm_context()};
-        std::memset(&ref.ctx, 0, sizeof ref.ctx);
-        ref.ctx.temp_c = spec.temp_start_c;
-        ref.ctx.time_h = spec.start_time_h;
-        ref.ctx.dir = 1;
-        pm_model with = build_model(o.order, one.adds, {ref}, m.mount, m.latitude, {});
-        int first = m.n_terms;
-        for (int i = m.n_base; i < with.n_terms; i++) {
-            pm_term t = with.term[i];
-            if (t.kind == PM_TERM_AUX) // references: the run's start, no direction
-                t.param = t.aux == PM_AUX_TEMP ? spec.temp_start_c
-                          : t.aux == PM_AUX_TIME ? spec.start_time_h : 0.0;
-            if (pm_model_add_term(&m, &t, 0.0, nullptr) != PM_OK)
-                die("simulate: cannot add --effect " + e.first, 1);
-        }
-        double v = e.second / RAD2AS;
-        bool periodic = m.n_terms > first && (m.term[first].kind == PM_TERM_FOURIER ||
-                                              m.term[first].kind == PM_TERM_SECTORAL);
-        if (periodic) { // first harmonic: amplitude and phase
-            double ph = o.phase_deg * PI / 180;
-            m.coef[first] = v * std::cos(ph);
-            m.coef[first + 1] = v * std::sin(ph);
-        } else {
-            for (int i = first; i < m.n_terms; i++)
-                m.coef[i] = v;
-        }
-        if (pm_model_prepare(&m) != PM_OK)
-            die("simulate: the true model is invalid", 1);
+        char err[512];
+        if (pmsim_add_effect(&spec, e.first.c_str(), e.second, o.phase_deg, o.seed, err,
+                             sizeof err) != 0)
+            die(std::string("simulate: ") + err, 1);
     }
     std::string cmd = "made by:";
     for (int i = 0; i < argc; i++)
@@ -469,6 +689,8 @@ int run_main(int argc, char **argv)
     int mount = run.mount;
     if (o.cmd == "eval")
         return cmd_eval(o, obs, mount);
+    if (o.cmd == "explain")
+        return cmd_explain(o, run);
 
     pm_model start = build_model(o.order, o.adds, obs, mount, run.latitude, aux_names);
     bool side_terms = false;

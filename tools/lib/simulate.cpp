@@ -1,6 +1,7 @@
 // simulate.cpp - simulated pointing runs (host side).
 #include "simulate.h"
 #include "hostutil.hpp"
+#include "fitrun.hpp"
 
 #include <cerrno>
 #include <cmath>
@@ -8,6 +9,7 @@
 #include <cstring>
 #include <random>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -47,6 +49,7 @@ extern "C" void pmsim_default(pmsim_spec *s)
     s->el_limit_deg = 15.0;
     s->noise_arcsec = 1.0;
     s->gem = 1;
+    s->overlap_deg = 15.0;
     s->start_time_h = 20.0;
     s->minutes_per_point = 2.0;
     s->temp_start_c = 12.0;
@@ -67,6 +70,8 @@ extern "C" int pmsim_write(const pmsim_spec *s, const char *path, const char *co
     }
     if (!(std::fabs(s->latitude_deg) <= 90) || !(s->el_limit_deg > -90 && s->el_limit_deg < 85) ||
         !(s->noise_arcsec >= 0) || !std::isfinite(s->minutes_per_point) ||
+        !(s->overlap_deg >= 0 && s->overlap_deg <= 90) ||
+        s->n_outliers < 0 || !std::isfinite(s->outlier_arcsec) ||
         !std::isfinite(s->temp_start_c) || !std::isfinite(s->temp_rate_c_per_h)) {
         set_err(err, errlen, "simulate: latitude, elevation limit, noise, cadence or "
                              "temperature out of range");
@@ -123,13 +128,34 @@ extern "C" int pmsim_write(const pmsim_spec *s, const char *path, const char *co
     out << "# mount: " << (altaz ? "altaz" : "equatorial") << "\n";
     out << (altaz ? "# tau delta T D temp time dir\n" : "# tau delta T D pier temp time dir\n");
     char buf[256];
+    std::mt19937_64 rng_t(s->seed * 7919 + 17); // temperature walk, separate stream
+    std::normal_distribution<double> gauss_t(0.0, 1.0);
+    double temp_walk = 0;
+    std::vector<char> is_outlier((size_t)s->n, 0);
+    {
+        std::mt19937_64 rng_o(s->seed * 104729 + 3);
+        for (int k = 0; k < s->n_outliers && k < s->n; k++) {
+            size_t j;
+            do
+                j = (size_t)(rng_o() % (unsigned long long)s->n);
+            while (is_outlier[j]);
+            is_outlier[j] = 1;
+        }
+    }
     for (long i = 0; i < s->n; i++) {
         const Target &t = seq[(size_t)i];
         int side = 0; // pm side for the inverse
-        if (!altaz && s->gem)
-            side = t.ha > 0 ? PM_SIDE_FLIPPED : PM_SIDE_NORMAL; // west of the meridian: flipped
+        if (!altaz && s->gem) { // west of the meridian: flipped; both sides near it
+            if (std::fabs(t.ha) < s->overlap_deg * DEG)
+                side = uni(rng) < 0.5 ? PM_SIDE_FLIPPED : PM_SIDE_NORMAL;
+            else
+                side = t.ha > 0 ? PM_SIDE_FLIPPED : PM_SIDE_NORMAL;
+        }
         double time_h = s->start_time_h + (double)i * s->minutes_per_point / 60.0;
-        double temp = s->temp_start_c + s->temp_rate_c_per_h * (time_h - s->start_time_h);
+        double el_h = time_h - s->start_time_h;
+        temp_walk += 0.08 * gauss_t(rng_t);
+        double temp = s->temp_start_c + s->temp_rate_c_per_h * 3.0 * (1 - std::exp(-el_h / 3.0)) +
+                      temp_walk;
         // the slew direction on axis 1 is the commanded one: toward the new target
         int dir = 0;
         if (i > 0) {
@@ -153,8 +179,14 @@ extern "C" int pmsim_write(const pmsim_spec *s, const char *path, const char *co
         if (st == PM_WARN_UNREACHABLE)
             continue; // the mount cannot point there; a real run would skip it too
         // measured (apparent) position: the target plus noise on the sky
-        double D = t.dec + s->noise_arcsec * ARCSEC * gauss(rng);
-        double T = t.ha + s->noise_arcsec * ARCSEC * gauss(rng) / std::cos(t.dec);
+        double nd = s->noise_arcsec * ARCSEC * gauss(rng), nt = s->noise_arcsec * ARCSEC * gauss(rng);
+        if (is_outlier[(size_t)i]) { // a gross error: failed plate solve, wrong star
+            double a = 2 * PI * uni(rng);
+            nd += s->outlier_arcsec * ARCSEC * std::sin(a);
+            nt += s->outlier_arcsec * ARCSEC * std::cos(a);
+        }
+        double D = t.dec + nd;
+        double T = t.ha + nt / std::cos(t.dec);
         if (D > PI / 2)
             D = PI - D, T += PI;
         if (D < -PI / 2)
@@ -172,4 +204,87 @@ extern "C" int pmsim_write(const pmsim_spec *s, const char *path, const char *co
         out << buf;
     }
     return pmhost::write_atomic(path, out.str(), err, errlen);
+}
+
+extern "C" int pmsim_add_effect(pmsim_spec *spec, const char *effect, double arcsec,
+                                double phase_deg, unsigned long long seed, char *err,
+                                size_t errlen)
+{
+    if (!spec || !effect) {
+        set_err(err, errlen, "pmsim_add_effect: invalid arguments");
+        return -1;
+    }
+    std::string e = effect;
+    pm_model &m = spec->truth;
+    if (!std::isfinite(arcsec) || !std::isfinite(phase_deg)) {
+        set_err(err, errlen, std::string("effect ") + e + ": size and phase must be finite");
+        return -1;
+    }
+    const double as = ARCSEC;
+    try {
+        if (e == "outlier" || e.rfind("outlier:", 0) == 0) {
+            int n = e == "outlier" ? 1 : std::atoi(e.c_str() + 8);
+            if (n < 1)
+                throw std::runtime_error("outlier:N needs N >= 1");
+            spec->n_outliers += n;
+            spec->outlier_arcsec = arcsec;
+            return 0;
+        }
+        if (e == "higher_order") {
+            if (m.order + 1 > PM_MAX_L)
+                throw std::runtime_error("higher_order: the truth is already at PM_MAX_L");
+            pm_model h;
+            pm_model_init(&h, m.mount, m.order + 1);
+            h.latitude = m.latitude;
+            for (int i = 0; i < m.n_base; i++) {
+                int idx;
+                if (pm_model_find(&h, m.term[i].k, m.term[i].l, m.term[i].m, &idx) == PM_OK)
+                    h.coef[idx] = m.coef[i];
+            }
+            std::mt19937_64 rng(seed ^ 0x4849ULL);
+            std::normal_distribution<double> g(0.0, 1.0);
+            for (int i = 0; i < h.n_base; i++)
+                if (h.term[i].l == h.order)
+                    h.coef[i] = arcsec * as * g(rng);
+            pm_model_prepare(&h);
+            for (int i = m.n_base; i < m.n_terms; i++)
+                if (pm_model_add_term(&h, &m.term[i], m.coef[i], nullptr) != PM_OK)
+                    throw std::runtime_error("higher_order: cannot carry over the added terms");
+            m = h;
+            return 0;
+        }
+        // the terms pmfit fit --add would add, with the given size
+        pmhost::Obs ref{0, 0, 0, 0, 1, 0, pm_context()};
+        std::memset(&ref.ctx, 0, sizeof ref.ctx);
+        ref.ctx.temp_c = spec->temp_start_c;
+        ref.ctx.time_h = spec->start_time_h;
+        ref.ctx.dir = 1;
+        pm_model with = pmhost::build_model(m.order, {e}, {ref}, m.mount, m.latitude, {});
+        int first = m.n_terms;
+        for (int i = with.n_base; i < with.n_terms; i++) {
+            pm_term t = with.term[i];
+            if (t.kind == PM_TERM_AUX) // references: the run's start, no direction
+                t.param = t.aux == PM_AUX_TEMP ? spec->temp_start_c
+                          : t.aux == PM_AUX_TIME ? spec->start_time_h : 0.0;
+            if (pm_model_add_term(&m, &t, 0.0, nullptr) != PM_OK)
+                throw std::runtime_error("cannot add the effect's terms to the truth");
+        }
+        double v = arcsec * as;
+        bool periodic = m.n_terms > first && (m.term[first].kind == PM_TERM_FOURIER ||
+                                              m.term[first].kind == PM_TERM_SECTORAL);
+        if (periodic) { // first harmonic: amplitude and phase
+            double ph = phase_deg * PI / 180;
+            m.coef[first] = v * std::cos(ph);
+            m.coef[first + 1] = v * std::sin(ph);
+        } else {
+            for (int i = first; i < m.n_terms; i++)
+                m.coef[i] = v;
+        }
+        if (pm_model_prepare(&m) != PM_OK)
+            throw std::runtime_error("the true model is invalid");
+    } catch (const std::exception &x) {
+        set_err(err, errlen, std::string("effect ") + e + ": " + x.what());
+        return -1;
+    }
+    return 0;
 }

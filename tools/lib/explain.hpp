@@ -1,0 +1,86 @@
+// explain.hpp - find the physics a pointing model left out (host side).
+//
+// Fit a baseline model, locate where the residuals are systematically too
+// large, name the left-out effect from a catalogue of candidates (each a set
+// of core terms), add it, refit, and repeat while something significant is
+// left; significance controls false alarms (F-test p-value times the number
+// of periods scanned and of candidates tried) and is confirmed by k-fold
+// cross-validated prediction error.  docs/explain.md describes the method.
+#ifndef PM_EXPLAIN_HPP
+#define PM_EXPLAIN_HPP
+
+#include "fitrun.hpp"
+
+#include <string>
+#include <vector>
+
+namespace pmhost {
+
+struct ExplainOptions {
+    int order = 1;                 // baseline harmonic order
+    std::vector<std::string> adds; // baseline added terms (--add)
+    double alpha = 0.01;           // false-alarm probability to accept a finding
+    int folds = 5;                 // k of the k-fold cross-validation
+    int max_findings = 8;
+    double g_min = 2, g_max = 720; // periodogram range (cycles per revolution)
+    unsigned seed = 1;             // fold assignment
+};
+
+// One located statistic: a part of the data whose residuals are too large.
+struct Located {
+    std::string what;   // "axis 2", "elevation 10-25 deg", "pier west", "temperature" ...
+    double rms_arcsec;  // RMS there (or correlation coefficient for variables)
+    double ratio;       // RMS there / overall RMS (or |t| statistic)
+    double p;           // probability of so much excess by chance (not corrected)
+};
+
+struct Periodogram {
+    std::string axis;              // "ha" or "dec"
+    std::vector<double> g, power;  // power: chi^2 reduction / sigma^2 (arcsec^2 / sigma^2)
+    double peak_g = 0, peak_power = 0, threshold = 0; // threshold: false alarm alpha
+};
+
+struct Finding {
+    std::string effect;       // vocabulary: ha_periodic, dec_periodic, pier_side, refraction,
+                              // tube_flexure, temperature, time_drift, hysteresis,
+                              // higher_order, outlier
+    std::string text;         // what it is, in plain words, with its size
+    std::string where;        // where on the sky (or when) it matters
+    std::vector<std::string> adds; // the terms added (pmfit --add syntax)
+    double cycles_per_rev = 0, amplitude_arcsec = 0, amplitude_err_arcsec = 0, phase_deg = 0;
+    double f_stat = 0, log10_p = 0, false_alarm_probability = 1;
+    double sigma_after_arcsec = 0, cv_rms_after_arcsec = 0;
+    int n_params_after = 0;
+    std::vector<int> lines;   // outliers: their file lines
+};
+
+struct Explanation {
+    double base_sigma_arcsec = 0, base_cv_rms_arcsec = 0;
+    int base_n_params = 0;
+    double final_sigma_arcsec = 0, final_cv_rms_arcsec = 0;
+    int final_n_params = 0;
+    std::vector<Located> located;        // before any finding
+    std::vector<Periodogram> periodograms; // of the baseline residuals
+    std::vector<Finding> findings;
+    std::vector<std::string> candidates_tried; // per step, for the report
+    FitOut baseline, final;              // the two fits (residuals for plots)
+    std::vector<int> kept;               // observations used by the final fit
+    std::vector<std::string> final_adds;
+    int final_order = 1;
+};
+
+Explanation explain(const Run &run, const ExplainOptions &opt);
+
+// Natural log of the F distribution's upper tail (no underflow for huge F).
+double log_f_tail(double f, double d1, double d2);
+
+// k-fold cross-validated RMS per axis (radians) of a model spec on the
+// observations `use`; train_also are added to every training fold, never
+// predicted (to measure what outliers do to the others).
+double cv_rms(const Run &run, const std::vector<int> &use, int order,
+              const std::vector<std::string> &adds, int folds, unsigned seed,
+              const std::vector<int> &train_also = {});
+
+} // namespace pmhost
+
+#endif
