@@ -617,7 +617,8 @@ int cmd_explain(const Options &o, const Run &run)
                         f.sigma_after_arcsec, f.cv_rms_after_arcsec);
         std::printf("\n  pmfit fit %s --order %d", run.path.c_str(), ex.final_order);
         for (const std::string &a : ex.final_adds)
-            std::printf(" --add '%s'", a.c_str());
+            std::printf(a.find('\'') == std::string::npos ? " --add '%s'" : " --add \"%s\"",
+                        a.c_str());
         std::printf("   # fits the explained model\n");
     }
     if (!o.plots.empty())

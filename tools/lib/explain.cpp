@@ -382,6 +382,21 @@ std::vector<Located> locate(const Run &run, const FitOut &f, double sigma)
     return out;
 }
 
+// A term's name with a user input shown by its column name.
+std::string input_name(const Run &run, const pm_model &m, int i)
+{
+    std::string n = term_name(m, i);
+    const pm_term &t = m.term[i];
+    if (t.kind == PM_TERM_AUX && t.aux >= PM_AUX_USER &&
+        (size_t)(t.aux - PM_AUX_USER) < run.aux_names.size()) {
+        std::string tag = "aux" + std::to_string(t.aux - PM_AUX_USER);
+        size_t p = n.find(tag);
+        if (p != std::string::npos)
+            n.replace(p, tag.size(), run.aux_names[(size_t)(t.aux - PM_AUX_USER)]);
+    }
+    return n;
+}
+
 struct Candidate {
     std::string effect;
     int order;
@@ -508,8 +523,17 @@ Explanation explain(const Run &run, const ExplainOptions &opt)
             with("temperature", {"temperature"});
         if (input_usable(run, use, 1))
             with("time_drift", {"time_drift"});
-        if (input_usable(run, use, 2))
-            with("hysteresis", {"hysteresis"});
+        {
+            // backlash: the last slew direction on axis 1 (HA index) and, when
+            // known, on axis 2 (the derived "dec_dir" input, Dec index)
+            std::vector<std::string> h;
+            if (input_usable(run, use, 2))
+                h.push_back("hysteresis");
+            if (has(run.aux_names, "dec_dir"))
+                h.push_back("aux:dec_dir:e'");
+            if (!h.empty())
+                with("hysteresis", h);
+        }
         // outliers: points beyond the Bonferroni-corrected chi^2(2) tail
         {
             Candidate c;
@@ -678,9 +702,10 @@ Explanation explain(const Run &run, const ExplainOptions &opt)
                 fd.amplitude_err_arcsec = big >= 0 ? arcsec(res.err[big]) : 0;
                 std::string vals;
                 for (int i : newi) {
-                    char v[96];
+                    char v[160];
                     std::snprintf(v, sizeof v, "%s%s = %.2f +- %.2f", vals.empty() ? "" : ", ",
-                                  term_name(m, i).c_str(), arcsec(m.coef[i]), arcsec(res.err[i]));
+                                  input_name(run, m, i).c_str(), arcsec(m.coef[i]),
+                                  arcsec(res.err[i]));
                     vals += v;
                 }
                 const char *what =

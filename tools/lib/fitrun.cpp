@@ -50,6 +50,21 @@ Run load_run(const std::string &path, bool refraction, bool skip_bad)
     }
     for (int j = 0; j < pmrun_n_aux(run); j++)
         r.aux_names.push_back(pmrun_aux_name(run, j));
+    // The slew direction on axis 2, likewise from the sequence, as the input
+    // "dec_dir" (backlash of the declination/elevation drive), when the run
+    // has no such column and a context slot is free.
+    bool have_dec_dir = false;
+    for (const std::string &n : r.aux_names)
+        have_dec_dir = have_dec_dir || n == "dec_dir";
+    if (!have_dec_dir && (int)r.aux_names.size() < PM_MAX_AUX && r.obs.size() > 1) {
+        int j = (int)r.aux_names.size();
+        r.aux_names.push_back("dec_dir");
+        r.obs[0].ctx.aux[j] = 0;
+        for (size_t i = 1; i < r.obs.size(); i++) {
+            double dd = r.obs[i].ed - r.obs[i - 1].ed;
+            r.obs[i].ctx.aux[j] = dd > 0 ? 1 : (dd < 0 ? -1 : 0);
+        }
+    }
     return r;
 }
 
