@@ -93,8 +93,8 @@ demo: deps
 demo-run: all
 	@echo "== bundled example: a simulated German equatorial mount (examples/sim_gem.dat)"
 	$(B)/pmfit fit examples/sim_gem.dat --order 1 --residuals $(B)/sim_gem.res --save $(B)/sim_gem.pm
-	@for L in 0 2; do printf 'order %s: ' $$L; $(B)/pmfit fit examples/sim_gem.dat --order $$L --json | \
-	  sed -E 's/.*"n_params": ([0-9]+).*"sigma_arcsec": ([0-9.]+).*/P = \1, sigma = \2 arcsec/'; done
+	@echo; echo "== what did the model leave out? (plots in $(B)/sim_gem_plots)"
+	$(B)/pmfit explain examples/sim_gem.dat --plots $(B)/sim_gem_plots
 	@if [ -d $(DATA) ]; then \
 	  echo "== real runs in $(DATA)"; \
 	  $(B)/pmfit fit $(DATA)/mmt/k_and_e.dat --order 1; \
@@ -152,3 +152,22 @@ install: all
 
 clean:
 	rm -rf $(B)
+
+# ---------------------------------------------------------------------------
+# Benchmarks and the firmware demo (docs/performance.md).
+#   make firmware   the mount-controller demo on the host and, under QEMU, on
+#                   Cortex-M4F and Cortex-M7; compares with the host, reports
+#                   flash, RAM and stack (rules: firmware_demo/firmware.mk)
+#   make bench      per-tick cost on the host and the Cortex-M cores, against a
+#                   naive evaluation, and fit scaling against LAPACK dgels;
+#                   prints a table, writes build/bench/results.json
+#                   (rules: bench/bench.mk)
+include firmware_demo/firmware.mk
+include bench/bench.mk
+
+firmware: deps
+	@$(MAKE) --no-print-directory firmware-run
+
+bench: deps
+	@$(MAKE) --no-print-directory bench-run
+# ---------------------------------------------------------------------------

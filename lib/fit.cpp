@@ -21,6 +21,11 @@ const double PIVOT_MIN = 1e-11;
 
 inline int pidx(int i, int j) { return i * (i + 1) / 2 + j; } /* i >= j */
 
+/* chi^2 changes below this (rad^2, i.e. (1e-15 rad)^2) are rounding: with
+** exactly consistent data chi^2 itself is zero and the statistical tests
+** scaled by it could never be met. */
+const double CHI2_FLOOR = 1e-30;
+
 /* Derivative of the log map at unit vector q (2 x 3). */
 void dlog(const V3<double> &q, double D[2][3], double *ly, double *lz)
 {
@@ -346,7 +351,8 @@ pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res)
         ** is left of it could not matter statistically, or after 40 cuts */
         long dof_r = 2 * fit->n_obs - P;
         bool give_up = fit->halvings >= 40 ||
-                       0.5 * frac * fit->base_pred <= 1e-6 * fit->base_chi2 / (double)dof_r;
+                       0.5 * frac * fit->base_pred <=
+                           1e-6 * fit->base_chi2 / (double)dof_r + CHI2_FLOOR;
         for (int i = 0; i < P; i++) {
             if (!give_up)
                 fit->step[i] *= 0.5;
@@ -420,7 +426,7 @@ pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res)
     ** decrease of chi^2 below 1e-4 sigma^2 (the step then moves every
     ** coefficient by less than 1% of its 1-sigma error). */
     long dof_c = 2 * fit->n_obs - P;
-    int converged = pred <= 1e-4 * fit->chi2 / (double)dof_c ? 1 : 0;
+    int converged = pred <= 1e-4 * fit->chi2 / (double)dof_c + CHI2_FLOOR ? 1 : 0;
     int small = 1;
     double err[PM_MAX_TERMS];
     for (int i = 0; i < P; i++) {

@@ -1058,6 +1058,32 @@ START_TEST(test_pm_fit_covariance_after_failed_solve)
 }
 END_TEST
 
+/* Exactly consistent data (chi^2 = 0 at the solution): pm_fit_run must
+** converge, not report PM_ERR_DIVERGED because statistical tests scaled by
+** chi^2 can never be met (regression: the firmware demo's noiseless refit). */
+START_TEST(test_pm_fit_run_noiseless_converges)
+{
+    static pm_model truth, m;
+    pm_fit_result res;
+    double eh[400], ed[400], ah[400], ad[400];
+    int i;
+    ck_assert_int_eq(pm_model_init(&truth, PM_MOUNT_EQUATORIAL, 2), PM_OK);
+    for (i = 0; i < truth.n_terms; i++)
+        truth.coef[i] = 1e-4 * (double)((i * 37) % 11 - 5);
+    truth.coef[2] = 0.1;
+    ck_assert_int_eq(pm_model_prepare(&truth), PM_OK);
+    for (i = 0; i < 400; i++) {
+        eh[i] = -3 + 6.0 * (i % 40) / 40;
+        ed[i] = -1 + 2.4 * (double)(i / 40) / 10.0;
+        ck_assert_int_eq(pm_model_apply(&truth, NULL, eh[i], ed[i], &ah[i], &ad[i]), PM_OK);
+    }
+    ck_assert_int_eq(pm_model_init(&m, PM_MOUNT_EQUATORIAL, 2), PM_OK);
+    ck_assert_int_eq(pm_fit_run(&g_fit, &m, NULL, 400, eh, ed, ah, ad, 20, &res), PM_OK);
+    for (i = 0; i < m.n_terms; i++)
+        ck_assert_double_le(fabs(m.coef[i] - truth.coef[i]), 1e-12);
+}
+END_TEST
+
 /* ---------------------------------------------------------------------- */
 
 static Suite *fit_suite(void)
@@ -1113,6 +1139,7 @@ static Suite *fit_suite(void)
     tcase_add_test(tc, test_pm_fit_solve_zero_obs);
     tcase_add_test(tc, test_pm_fit_solve_singular_keeps_pass);
     tcase_add_test(tc, test_pm_fit_covariance_after_failed_solve);
+    tcase_add_test(tc, test_pm_fit_run_noiseless_converges);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -1,0 +1,74 @@
+# bench/bench.mk - build and run rules of "make bench" (included by the
+# top-level Makefile after firmware_demo/firmware.mk, whose toolchain
+# variables, target flags and fw_core template it uses).
+#
+#   build/bench/pmbench          host per-call cost (TSC ticks; --callgrind)
+#   build/bench/pmbench_fit      fit scaling, ours vs LAPACK dgels
+#   build/bench/<t>/bench.elf    Cortex-M per-call instructions (t = m4f, m7),
+#                                with the core at PM_MAX_L=4
+#   build/bench/results.json     everything, merged by bench/report.py
+#
+# The host programs link build/libpm.a, the library as shipped (CORE_FLAGS,
+# PM_MAX_L=4).  naive.c is compiled with the compiler's default
+# floating-point flags: the paper's formulas as a user would write them.
+# BENCH_MAX_N (default 1000000) bounds the fit sizes; BENCH_BATCHES (31) the
+# timing batches.
+
+BN            := $(B)/bench
+BENCH_MAX_N   ?= 1000000
+BENCH_BATCHES ?= 31
+# each Cortex-M bench ELF measures both the double and the float build
+BENCH_TARGETS := m4f m7
+BENCH_CFLAGS  := -std=gnu99 $(OPT) -g -Wall -Wextra -Iinclude -Ibench -Ifirmware_demo
+BENCH_SRC_H   := bench/bench_common.h bench/naive.h include/pm.h
+
+$(BN)/host/naive.o: bench/naive.c $(BENCH_SRC_H)
+	@mkdir -p $(@D)
+	$(CC) $(BENCH_CFLAGS) -c $< -o $@
+
+$(BN)/pmbench: bench/bench_host.c bench/bench_common.c $(BN)/host/naive.o $(BENCH_SRC_H) $(B)/libpm.a
+	$(CC) $(BENCH_CFLAGS) bench/bench_host.c bench/bench_common.c $(BN)/host/naive.o \
+	  $(B)/libpm.a -lm -o $@
+
+$(BN)/pmbench_fit: bench/bench_fit.c include/pm.h $(B)/libpm.a
+	@mkdir -p $(@D)
+	$(CC) $(BENCH_CFLAGS) $< $(B)/libpm.a -llapacke -llapack -lblas -lm -o $@
+
+# $(call bench_target,T): the Cortex-M bench of target T.
+define bench_target
+$(call fw_core,$(BN)/$(1),$$(ARM_CXX),$$(FW_ARM_CXXFLAGS) $$(FW_CPU_$(1)),4)
+
+$(BN)/$(1)/%.o: bench/%.c $$(BENCH_SRC_H) firmware_demo/fw_platform.h
+	@mkdir -p $$(@D)
+	$$(ARM_CC) $$(BENCH_CFLAGS) $$(FW_CPU_$(1)) -ffunction-sections -fdata-sections \
+	  -DPM_MAX_L=4 -c $$< -o $$@
+
+$(BN)/$(1)/platform_cm.o: firmware_demo/platform_cm.c firmware_demo/fw_platform.h
+	@mkdir -p $$(@D)
+	$$(ARM_CC) $$(FW_ARM_PLATFLAGS) $$(FW_CPU_$(1)) -DFW_TARGET_NAME='"$(1)"' -c $$< -o $$@
+
+$(BN)/$(1)/bench.elf: $(addprefix $(BN)/$(1)/,bench_cm.o bench_common.o naive.o platform_cm.o) \
+                      $(addprefix $(BN)/$(1)/core/,$(FW_CORE_NAMES)) firmware_demo/cortex_m.ld
+	$$(ARM_CC) $$(FW_CPU_$(1)) $$(filter %.o,$$^) -o $$@ $$(FW_ARM_LDFLAGS) -lm
+endef
+$(foreach t,$(BENCH_TARGETS),$(eval $(call bench_target,$(t))))
+
+BENCH_ELFS := $(foreach t,$(BENCH_TARGETS),$(BN)/$(t)/bench.elf)
+
+bench-run: fw-toolchain $(BN)/pmbench $(BN)/pmbench_fit $(BENCH_ELFS)
+	@command -v valgrind > /dev/null || { echo "bench: valgrind not found (tools/deps.sh)"; exit 1; }
+	@echo "== host: TSC ticks per call ($(BENCH_BATCHES) batches of 256 calls, median)"
+	$(BN)/pmbench --batches $(BENCH_BATCHES) --out $(BN)/host.jsonl
+	@echo "== host: instructions per call (callgrind)"
+	@rm -rf $(BN)/callgrind && mkdir -p $(BN)/callgrind
+	valgrind --tool=callgrind --callgrind-out-file=$(BN)/callgrind/cg.out \
+	  $(BN)/pmbench --callgrind > $(BN)/callgrind/log.txt 2>&1
+	@$(foreach t,$(BENCH_TARGETS),echo "== $(t): instructions per call under QEMU" && \
+	  timeout 600 $(QEMU_ARM) -M $(FW_MACHINE_$(t)) \
+	  -nographic -semihosting -icount shift=0,align=off,sleep=off -kernel $(BN)/$(t)/bench.elf \
+	  > $(BN)/$(t).out 2>&1 || { cat $(BN)/$(t).out; exit 1; };)
+	@echo "== fit scaling (N up to $(BENCH_MAX_N)); ours vs LAPACK dgels"
+	$(BN)/pmbench_fit --max-n $(BENCH_MAX_N) --out $(BN)/fit.jsonl
+	@$(PYTHON) bench/report.py --dir $(BN) --targets "$(BENCH_TARGETS)"
+
+.PHONY: bench-run

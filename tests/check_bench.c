@@ -1,0 +1,74 @@
+/*
+**  check_bench.c - a smoke run of the bench: pmbench runs every case once
+**  (one batch: no timing is judged here, timings belong in bench/), every
+**  call returns PM_OK, the naive evaluation matches the library's terms,
+**  and bench/report.py turns the output into a valid results.json with an
+**  entry per case.
+*/
+#define _POSIX_C_SOURCE 200809L
+#include <check.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+
+static const char *top(void)
+{
+    const char *t = getenv("PM_TOP");
+    return t ? t : ".";
+}
+
+static int sh(const char *cmd)
+{
+    int st = system(cmd);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+START_TEST(test_bench_smoke_json)
+{
+    char cmd[4096];
+    const char *d = "build/bench/smoke";
+    unsetenv("MAKEFLAGS");
+    unsetenv("MFLAGS");
+    unsetenv("MAKELEVEL");
+    snprintf(cmd, sizeof cmd, "cd '%s' && make -s build/bench/pmbench > /dev/null 2>&1", top());
+    ck_assert_int_eq(sh(cmd), 0);
+    snprintf(cmd, sizeof cmd, "cd '%s' && rm -rf %s && mkdir -p %s && "
+             "build/bench/pmbench --batches 1 --out %s/host.jsonl 2> %s/log.txt && "
+             "/usr/bin/python3 bench/report.py --dir %s --targets '' > %s/report.txt",
+             top(), d, d, d, d, d, d);
+    ck_assert_int_eq(sh(cmd), 0);
+    /* a JSON list with the ticks of every op and order of the double API */
+    snprintf(cmd, sizeof cmd, "cd '%s' && /usr/bin/python3 -c '"
+             "import json, sys\n"
+             "r = json.load(open(\"%s/results.json\"))\n"
+             "n = {e[\"name\"]: e for e in r}\n"
+             "for op in (\"fwd\", \"inv\", \"inv_near\", \"naive_fwd\", \"naive_inv\"):\n"
+             "  for L in (0, 1, 2, 4):\n"
+             "    e = n[\"host_%%s_L%%d_double\" %% (op, L)]\n"
+             "    assert isinstance(e[\"ticks_median\"], float)\n"
+             "    assert (\"ratio\" in e) == (not op.startswith(\"naive\"))\n"
+             "' > %s/check.txt 2>&1", top(), d, d);
+    ck_assert_msg(sh(cmd) == 0, "results.json malformed: see %s/check.txt", d);
+}
+END_TEST
+
+static Suite *suite(void)
+{
+    Suite *s = suite_create("bench");
+    TCase *tc = tcase_create("smoke");
+    tcase_add_test(tc, test_bench_smoke_json);
+    tcase_set_timeout(tc, 120);
+    suite_add_tcase(s, tc);
+    return s;
+}
+
+int main(void)
+{
+    SRunner *sr = srunner_create(suite());
+    int failed;
+    srunner_run_all(sr, CK_NORMAL);
+    failed = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+}
