@@ -26,16 +26,6 @@ bool dropped(int k, int l, int m)
     return false;
 }
 
-/* Wrap an angle into (-pi, pi]. */
-double wrap_pi(double a)
-{
-    while (a > PI)
-        a -= 2 * PI;
-    while (a <= -PI)
-        a += 2 * PI;
-    return a;
-}
-
 /* Round-trip residual of encoder trig g against target q, measured as the
 ** tangent offset (radians) of q seen from the model's position. */
 double miss(const pm_model *m, const Iso<double> &k, const pm_context *ctx,
@@ -279,12 +269,7 @@ pm_status invert(const pm_model *m, const pm_context *ctx, double app_ha,
             }
         }
     }
-    if (start) {
-        t = start[0] + wrap_pi(t - start[0]);
-        d = start[1] + wrap_pi(d - start[1]);
-    } else {
-        t = wrap_pi(t);
-    }
+    finish_angles(start, &t, &d);
     *enc_ha = t;
     *enc_dec = d;
     return result;

@@ -20,16 +20,6 @@ using namespace pm::detail;
 
 namespace {
 
-/* Wrap into (-pi, pi] (double; one or two steps for finite inputs). */
-double wrap(double a)
-{
-    while (a > PI)
-        a -= 2 * PI;
-    while (a <= -PI)
-        a += 2 * PI;
-    return a;
-}
-
 /* The added terms' view of a position, in float (cf. site_of). */
 Site<float> site_f(const pm_model_f *m, const Trig<float> &ge, int side,
                    float ia, float ib, float ic) /* omega' = (ia, ib, ic) */
@@ -84,11 +74,11 @@ void forward_f(const pm_model_f *m, const pm_context *ctx, double t, double d, d
 {
     /* frame angles: exact index shifts; beyond the pole, the equivalent
     ** position (t_r, d_r) = (t_c + pi, pi - d_e) with |d_r| <= pi/2 */
-    double tc = t + m->c, de = wrap(d - m->e);
+    double tc = t + m->c, de = wrap_pi(d - m->e);
     bool flip = de > PI / 2 || de < -PI / 2;
     double tr = flip ? tc + PI : tc;
     double dr = flip ? (de > 0 ? PI - de : -PI - de) : de;
-    float st = m_sin((float)wrap(tr)), ct = m_cos((float)wrap(tr));
+    float st = m_sin((float)wrap_pi(tr)), ct = m_cos((float)wrap_pi(tr));
     /* cos d_r from the complement pi/2 - |d_r|, formed in double: near the
     ** pole cos((float)d_r) would carry the angle's own rounding (1e-7 rad),
     ** which the HA correction (~ offset / cos d) magnifies */
@@ -172,14 +162,14 @@ void forward_f(const pm_model_f *m, const pm_context *ctx, double t, double d, d
     float rmc = rho + cd > 0 ? (2 * cd * eta + eta * eta + o.y * o.y) / (rho + cd) : rho - cd;
     float dT = m_atan2(o.y, q);
     float dD = m_atan2(zeta * cd - rmc * sd, rho * cd + (sd + zeta) * sd);
-    *T = wrap(tr + (double)dT);
+    *T = wrap_pi(tr + (double)dT);
     *D = dr + (double)dD;
 }
 
 /* Offset of apparent (T1, D1) from (T2, D2), in the frame at (T2, D2). */
 void sky_offset(double T1, double D1, double T2, double D2, float *x, float *y)
 {
-    float dT = (float)wrap(T1 - T2), dD = (float)(D1 - D2);
+    float dT = (float)wrap_pi(T1 - T2), dD = (float)(D1 - D2);
     float c1 = m_cos((float)D1), s2 = m_sin((float)D2);
     float h = m_sin(dT / 2);
     *x = c1 * m_sin(dT);
@@ -192,14 +182,7 @@ pm_status check_f(const pm_model_f *m, const pm_context *ctx)
         return PM_ERR_ARG;
     if (m->prepared != 1 || m->n_terms < 6 || m->n_terms > PM_MAX_TERMS)
         return PM_ERR_STATE;
-    if (m->needs_ctx) {
-        if (!ctx)
-            return PM_ERR_ARG;
-        for (int i = m->n_base; i < m->n_terms; i++)
-            if (m->term[i].kind == PM_TERM_AUX && !finite(aux_input(ctx, m->term[i].aux)))
-                return PM_ERR_NONFINITE;
-    }
-    return PM_OK;
+    return context_ok(m, ctx);
 }
 
 pm_status invert_f(const pm_model_f *m, const pm_context *ctx, double T, double D, int side,
@@ -284,14 +267,9 @@ pm_status invert_f(const pm_model_f *m, const pm_context *ctx, double T, double 
         fn = nfn;
     }
     /* the solution must be on the requested side of the mount's pole */
-    if (result == PM_OK && !start && (m_cos((float)wrap(d - m->e)) >= 0 ? 1 : -1) != side)
+    if (result == PM_OK && !start && (m_cos((float)wrap_pi(d - m->e)) >= 0 ? 1 : -1) != side)
         result = PM_WARN_NOT_CONVERGED;
-    if (start) {
-        t = start[0] + wrap(t - start[0]);
-        d = start[1] + wrap(d - start[1]);
-    } else {
-        t = wrap(t);
-    }
+    finish_angles(start, &t, &d);
     *enc_ha = t;
     *enc_dec = d;
     return result;

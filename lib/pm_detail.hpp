@@ -210,6 +210,28 @@ template <typename T> inline void logmap(const V3<T> &q, T *a, T *b)
     *b = q.z * f;
 }
 
+/* Wrap an angle into (-pi, pi]. */
+inline double wrap_pi(double a)
+{
+    while (a > PI)
+        a -= 2 * PI;
+    while (a <= -PI)
+        a += 2 * PI;
+    return a;
+}
+
+/* The inverse's result: continuous with the start position when there is
+** one (both angles within pi of it), else the hour angle in (-pi, pi]. */
+inline void finish_angles(const double *start, double *t, double *d)
+{
+    if (start) {
+        *t = start[0] + wrap_pi(*t - start[0]);
+        *d = start[1] + wrap_pi(*d - start[1]);
+    } else {
+        *t = wrap_pi(*t);
+    }
+}
+
 /* Is the model ready for evaluation: prepared, and no coefficient changed
 ** since (a stale model would be silently wrong). */
 inline pm_status model_ready(const pm_model *m)
@@ -318,8 +340,9 @@ inline double aux_input(const pm_context *ctx, int aux)
     }
 }
 
-/* Does the context carry what the model's AUX terms read, finite? */
-inline pm_status context_ok(const pm_model *m, const pm_context *ctx)
+/* Does the context carry what the model's AUX terms read, finite?  (For
+** pm_model and pm_model_f alike.) */
+template <typename M> inline pm_status context_ok(const M *m, const pm_context *ctx)
 {
     if (!m->needs_ctx)
         return PM_OK;

@@ -18,35 +18,6 @@ namespace {
 
 const double LN10 = 2.302585092994046;
 
-// log of the regularised incomplete beta I_x(a, b), direct continued fraction
-// branch (x < (a+1)/(a+b+2)), no underflow.
-double log_inc_beta_cf(double a, double b, double x)
-{
-    double lbeta = std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b);
-    double logfront = lbeta + a * std::log(x) + b * std::log1p(-x) - std::log(a);
-    const double tiny = 1e-300;
-    double f = 1, c = 1, d = 0;
-    for (int i = 0; i <= 600; i++) {
-        int m = i / 2;
-        double num;
-        if (i == 0)
-            num = 1;
-        else if (i % 2 == 0)
-            num = m * (b - m) * x / ((a + 2 * m - 1) * (a + 2 * m));
-        else
-            num = -(a + m) * (a + b + m) * x / ((a + 2 * m) * (a + 2 * m + 1));
-        d = 1 + num * d;
-        d = std::fabs(d) < tiny ? tiny : d;
-        d = 1 / d;
-        c = 1 + num / c;
-        c = std::fabs(c) < tiny ? tiny : c;
-        f *= c * d;
-        if (std::fabs(1 - c * d) < 1e-15)
-            break;
-    }
-    return logfront + std::log(f - 1);
-}
-
 struct Fit {
     bool ok = false;
     FitOut f;
@@ -410,17 +381,6 @@ struct Candidate {
 };
 
 } // namespace
-
-double log_f_tail(double f, double d1, double d2)
-{
-    if (!(f > 0))
-        return 0;
-    double a = d2 / 2, b = d1 / 2, x = d2 / (d2 + d1 * f);
-    if (x < (a + 1) / (a + b + 2))
-        return log_inc_beta_cf(a, b, x);
-    double q = std::exp(log_inc_beta_cf(b, a, 1 - x));
-    return std::log1p(-std::min(q, 1.0));
-}
 
 double cv_rms(const Run &run, const std::vector<int> &use, int order,
               const std::vector<std::string> &adds, int folds, unsigned seed,

@@ -71,9 +71,6 @@ struct Explanation {
 
 Explanation explain(const Run &run, const ExplainOptions &opt);
 
-// Natural log of the F distribution's upper tail (no underflow for huge F).
-double log_f_tail(double f, double d1, double d2);
-
 // k-fold cross-validated RMS per axis (radians) of a model spec on the
 // observations `use`; train_also are added to every training fold, never
 // predicted (to measure what outliers do to the others).

@@ -2,6 +2,7 @@
 #include "fitrun.hpp"
 #include "runfile.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -132,21 +133,16 @@ std::string json_escape(const std::string &s)
     return o;
 }
 
-// Regularised incomplete beta I_x(a, b) by its continued fraction (modified
-// Lentz), for the F distribution's tail.
-double inc_beta(double a, double b, double x)
+// log of the regularised incomplete beta I_x(a, b) by its continued fraction
+// (modified Lentz), in logarithms so that tiny tails do not underflow; the
+// direct branch, valid for x < (a+1)/(a+b+2).
+static double log_inc_beta_cf(double a, double b, double x)
 {
-    if (x <= 0)
-        return 0;
-    if (x >= 1)
-        return 1;
-    if (x > (a + 1) / (a + b + 2))
-        return 1 - inc_beta(b, a, 1 - x);
     double lbeta = std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b);
-    double front = std::exp(lbeta + a * std::log(x) + b * std::log(1 - x)) / a;
+    double logfront = lbeta + a * std::log(x) + b * std::log1p(-x) - std::log(a);
     const double tiny = 1e-300;
     double f = 1, c = 1, d = 0;
-    for (int i = 0; i <= 400; i++) {
+    for (int i = 0; i <= 600; i++) {
         int mm = i / 2;
         double num;
         if (i == 0)
@@ -164,19 +160,33 @@ double inc_beta(double a, double b, double x)
         if (std::fabs(1 - c * d) < 1e-15)
             break;
     }
-    return front * (f - 1);
+    return logfront + std::log(f - 1);
 }
 
-// P(F > f) for the F distribution with (d1, d2) degrees of freedom.
-double f_tail(double f, double d1, double d2)
+double inc_beta(double a, double b, double x)
+{
+    if (x <= 0)
+        return 0;
+    if (x >= 1)
+        return 1;
+    if (x > (a + 1) / (a + b + 2))
+        return 1 - std::exp(log_inc_beta_cf(b, a, 1 - x));
+    return std::exp(log_inc_beta_cf(a, b, x));
+}
+
+double log_f_tail(double f, double d1, double d2)
 {
     if (!(f > 0))
-        return 1;
-    return inc_beta(d2 / 2, d1 / 2, d2 / (d2 + d1 * f));
+        return 0;
+    double a = d2 / 2, b = d1 / 2, x = d2 / (d2 + d1 * f);
+    if (x < (a + 1) / (a + b + 2))
+        return log_inc_beta_cf(a, b, x);
+    double q = std::exp(log_inc_beta_cf(b, a, 1 - x));
+    return std::log1p(-std::min(q, 1.0));
 }
 
-// Do the extra parameters of `big` over `small` (nested models, same data)
-// reduce chi^2 more than noise would?
+double f_tail(double f, double d1, double d2) { return std::exp(log_f_tail(f, d1, d2)); }
+
 FTest f_test(double chi2_small, int p_small, double chi2_big, int p_big, long n_obs,
              const std::string &what)
 {

@@ -68,9 +68,11 @@ FitOut do_fit(const std::vector<Obs> &obs, const std::vector<int> &use, const pm
               int max_passes = 100);
 void residuals(FitOut &f, const std::vector<Obs> &obs, const std::vector<int> &use);
 
-// The F distribution's upper tail, and the nested-model F-test.
+// The F distribution's upper tail (and its natural log, which does not
+// underflow for huge F), and the nested-model F-test.
 double inc_beta(double a, double b, double x);
 double f_tail(double f, double d1, double d2);
+double log_f_tail(double f, double d1, double d2);
 struct FTest {
     bool done = false;
     double f = 0, p = 1;
