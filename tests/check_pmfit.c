@@ -14,6 +14,7 @@
 #include "pm.h"
 #include "modelfile.h"
 #include "testutil.h"
+#include "tu_tool.h"
 
 /* MMT k_and_e.dat: an independent reference fit gets 0.747" (L=1) and
 ** 0.560" (L=2); the issue's acceptance bounds are 0.76" and 0.57". */
@@ -23,46 +24,15 @@
 static char tmpdir[256];
 static char out[1 << 20];
 
-static void make_tmpdir(void)
-{
-    strcpy(tmpdir, "/tmp/pm_pmfit_XXXXXX");
-    ck_assert_ptr_nonnull(mkdtemp(tmpdir));
-}
+static void make_tmpdir(void) { tu_tmpdir(tmpdir, "pm_pmfit_"); }
 
-static const char *pmfit(void)
-{
-    static char path[512];
-    const char *top = getenv("PM_TOP");
-    snprintf(path, sizeof path, "%s/build/pmfit", top ? top : ".");
-    return path;
-}
-
-/* Run a shell command, capture stdout+stderr into out; return exit code. */
+/* Run pmfit: fmt has three %s, the program and two arguments; stdout and
+** stderr into out; the exit code. */
 static int run(const char *fmt, const char *a, const char *b)
 {
     char cmd[4096];
-    FILE *p;
-    size_t n;
-    int st;
-    snprintf(cmd, sizeof cmd, fmt, pmfit(), a ? a : "", b ? b : "");
-    strncat(cmd, " 2>&1", sizeof cmd - strlen(cmd) - 1);
-    p = popen(cmd, "r");
-    ck_assert_ptr_nonnull(p);
-    n = fread(out, 1, sizeof out - 1, p);
-    out[n] = 0;
-    st = pclose(p);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
-/* A number after "key": in the JSON output. */
-static double json_num(const char *json, const char *key)
-{
-    char pat[128];
-    const char *p;
-    snprintf(pat, sizeof pat, "\"%s\": ", key);
-    p = strstr(json, pat);
-    ck_assert_msg(p != NULL, "no %s in: %.300s", key, json);
-    return atof(p + strlen(pat));
+    snprintf(cmd, sizeof cmd, fmt, tu_pmfit_path(), a ? a : "", b ? b : "");
+    return tu_capture(cmd, out, sizeof out);
 }
 
 static int have_data(const char *rel, char *path, size_t len)
@@ -85,12 +55,12 @@ START_TEST(test_pmfit_mmt_sigma)
         return;
     }
     ck_assert_int_eq(run("%s fit %s --order 1 --json", path, NULL), 0);
-    s1 = json_num(out, "sigma_arcsec");
-    ck_assert_int_eq((int)json_num(out, "n_obs"), 80);
-    ck_assert_int_eq((int)json_num(out, "n_params"), 22);
+    s1 = tu_json_num(out, "sigma_arcsec");
+    ck_assert_int_eq((int)tu_json_num(out, "n_obs"), 80);
+    ck_assert_int_eq((int)tu_json_num(out, "n_params"), 22);
     ck_assert_int_eq(run("%s fit %s --order 2 --json", path, NULL), 0);
-    s2 = json_num(out, "sigma_arcsec");
-    ck_assert_int_eq((int)json_num(out, "n_params"), 46);
+    s2 = tu_json_num(out, "sigma_arcsec");
+    ck_assert_int_eq((int)tu_json_num(out, "n_params"), 46);
     printf("MMT k_and_e: sigma L=1 %.4f\" (ref 0.747), L=2 %.4f\" (ref 0.560)\n", s1, s2);
     ck_assert_double_le(s1, MMT_SIGMA_MAX_L1);
     ck_assert_double_le(s2, MMT_SIGMA_MAX_L2);
@@ -120,7 +90,7 @@ START_TEST(test_pmfit_gem_converges)
             ck_assert_ptr_nonnull(p);
             cp = atof(p + strlen("\"name\": \"c'\", \"value_arcsec\": "));
             printf("%s L=%d joint: sigma %.2f\", c' = %.3f deg\n", files[f], L,
-                   json_num(out, "sigma_arcsec"), cp / 3600);
+                   tu_json_num(out, "sigma_arcsec"), cp / 3600);
             ck_assert_double_gt(fabs(cp) / 3600, 2.0);  /* degrees, not arcseconds */
             ck_assert_double_lt(fabs(cp) / 3600, 10.0);
         }
@@ -156,13 +126,13 @@ START_TEST(test_pmfit_simulate_fit_roundtrip)
     snprintf(args, sizeof args, "%s --order 1 --save %s --emit-c %s --json", run_path,
              model_path, hdr_path);
     ck_assert_msg(run("%s fit %s%s", args, "") == 0, "%s", out);
-    ck_assert_double_lt(fabs(json_num(out, "sigma_arcsec") - 0.5), 0.05);
-    rms_fit = json_num(out, "rms_arcsec");
+    ck_assert_double_lt(fabs(tu_json_num(out, "sigma_arcsec") - 0.5), 0.05);
+    rms_fit = tu_json_num(out, "rms_arcsec");
     /* pmfit reads its own model file back: eval on the same run gives the
     ** fit's sky RMS (same model, same residuals) */
     snprintf(args, sizeof args, "%s %s --json", model_path, run_path);
     ck_assert_msg(run("%s eval %s%s", args, "") == 0, "%s", out);
-    ck_assert_double_eq_tol(json_num(out, "rms_arcsec"), rms_fit, 1e-6);
+    ck_assert_double_eq_tol(tu_json_num(out, "rms_arcsec"), rms_fit, 1e-6);
     ck_assert_int_eq(pmmodel_load(model_path, &m, err, sizeof err), 0);
     ck_assert_int_eq(m.order, 1);
     /* c' within 1 arcsec (its error is ~0.05") */

@@ -40,6 +40,7 @@
 #include "pm.h"
 #include "modelfile.h"
 #include "testutil.h"
+#include "tu_tool.h"
 
 /* ---------------------------------------------------------------------- */
 /* Tolerances and test constants.                                         */
@@ -1299,46 +1300,15 @@ END_TEST
 static char tmpdir[256];
 static char out[1 << 20];
 
-static const char *pmfit_path(void)
-{
-    static char path[512];
-    const char *top = getenv("PM_TOP");
-    snprintf(path, sizeof path, "%s/build/pmfit", top ? top : ".");
-    return path;
-}
-
-/* Run pmfit with the arguments, capture stdout+stderr into out; return the
-** exit code. */
+/* Run pmfit with the arguments; stdout and stderr into out; the exit code. */
 static int pmfit(const char *args)
 {
     char cmd[4096];
-    FILE *p;
-    size_t n;
-    int st;
-    snprintf(cmd, sizeof cmd, "%s %s 2>&1", pmfit_path(), args);
-    p = popen(cmd, "r");
-    ck_assert_ptr_nonnull(p);
-    n = fread(out, 1, sizeof out - 1, p);
-    out[n] = 0;
-    st = pclose(p);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+    snprintf(cmd, sizeof cmd, "%s %s", tu_pmfit_path(), args);
+    return tu_capture(cmd, out, sizeof out);
 }
 
-static double json_num(const char *json, const char *key)
-{
-    char pat[128];
-    const char *p;
-    snprintf(pat, sizeof pat, "\"%s\": ", key);
-    p = strstr(json, pat);
-    ck_assert_msg(p != NULL, "no %s in: %.400s", key, json);
-    return atof(p + strlen(pat));
-}
-
-static void make_tmpdir(void)
-{
-    strcpy(tmpdir, "/tmp/pm_terms_XXXXXX");
-    ck_assert_ptr_nonnull(mkdtemp(tmpdir));
-}
+static void make_tmpdir(void) { tu_tmpdir(tmpdir, "pm_terms_"); }
 
 /* p of the pier F-test of `pmfit fit RUN OPTS --json`. */
 static double f_test_p(const char *run, const char *opts)
@@ -1349,7 +1319,7 @@ static double f_test_p(const char *run, const char *opts)
     ck_assert_msg(pmfit(args) == 0, "pmfit %s: %s", args, out);
     f = strstr(out, "\"pier_f_test\"");
     ck_assert_msg(f != NULL, "no F-test in: %.400s", out);
-    return json_num(f, "p");
+    return tu_json_num(f, "p");
 }
 
 /* A real west-only collimation of 5" (1" noise, 400 points): the joint fit
@@ -1367,8 +1337,8 @@ START_TEST(test_pmfit_pier_f_test_real_difference)
     p_joint = f_test_p(run, "--add i@W");
     term = strstr(out, "\"i@W\"");
     ck_assert_ptr_nonnull(term);
-    ck_assert_double_le(fabs(json_num(term, "value_arcsec") - 5.0),
-                        Z_MAX * json_num(term, "error_arcsec"));
+    ck_assert_double_le(fabs(tu_json_num(term, "value_arcsec") - 5.0),
+                        Z_MAX * tu_json_num(term, "error_arcsec"));
     p_split = f_test_p(run, "--pier split");
     printf("check_terms: pmfit F-test, 5\" west-only collimation: p = %.3g (joint, i@W), "
            "%.3g (split)\n", p_joint, p_split);
@@ -1458,7 +1428,7 @@ START_TEST(test_pmfit_refraction_term_is_refraction)
             snprintf(args, sizeof args, "fit %s --order %d --add refraction --json%s", path, L,
                      nr ? " --no-refraction" : "");
             ck_assert_msg(pmfit(args) == 0, "pmfit %s: %s", args, out);
-            c[L][nr] = json_num(strstr(out, "\"cot(el)\""), "value_arcsec");
+            c[L][nr] = tu_json_num(strstr(out, "\"cot(el)\""), "value_arcsec");
         }
         printf("check_terms: gem-28 L=%d: cot(el) %.2f\" with the reduction's refraction, "
                "%.2f\" without: change %.2f\" (-A = %.2f\")\n", L, c[L][0], c[L][1],
@@ -1486,8 +1456,8 @@ START_TEST(test_pmfit_add_singular_named)
     ck_assert_msg(pmfit(args) == 0, "%s", out);
     term = strstr(out, "\"cos(el)\"");
     ck_assert_ptr_nonnull(term);
-    ck_assert_double_le(fabs(json_num(term, "value_arcsec") - 20.0),
-                        Z_MAX * json_num(term, "error_arcsec"));
+    ck_assert_double_le(fabs(tu_json_num(term, "value_arcsec") - 20.0),
+                        Z_MAX * tu_json_num(term, "error_arcsec"));
     unlink(run);
     rmdir(tmpdir);
 }
