@@ -36,6 +36,11 @@ namespace {
 
 using namespace pmhost;
 
+// Gauss-Newton passes pmfit fit allows: nearly degenerate term sets (one
+// pier side at L=2) creep along a flat valley for a thousand passes; each
+// pass is cheap, and a warning names the pair (print_table).
+const int MAX_PASSES = 2000;
+
 struct Options {
     std::string cmd, run, model; // model: eval's MODEL
     int order = 1;
@@ -298,6 +303,11 @@ void print_table(const char *title, const FitOut &f, const std::vector<Obs> &obs
         std::printf("  %-12s %-38s %13.2f %10.2f %6.1f%s\n", term_name(m, i).c_str(),
                     meaning(m, i).c_str(), v, e, z, z >= 3 ? " *" : "");
     }
+    if (std::fabs(f.corr) > 0.999)
+        std::printf("\n  warning: %s and %s are nearly degenerate for this sky coverage "
+                    "(correlation %+.5f):\n  their values are not meaningful one by one, only "
+                    "together; sigma is.\n",
+                    term_name(m, f.corr_j).c_str(), term_name(m, f.corr_i).c_str(), f.corr);
     // worst points
     std::vector<size_t> order(f.idx.size());
     for (size_t j = 0; j < order.size(); j++)
@@ -325,7 +335,12 @@ void print_json_fit(const FitOut &f, const std::string &extra)
         std::printf("%s{\"name\": \"%s\", \"value_arcsec\": %.6f, \"error_arcsec\": %.6f}",
                     i ? ", " : "", json_escape(term_name(m, i)).c_str(), m.coef[i] * RAD2AS,
                     f.res.err[i] * RAD2AS);
-    std::printf("]%s%s}", extra.empty() ? "" : ", ", extra.c_str());
+    std::printf("]");
+    if (f.corr_i >= 0)
+        std::printf(", \"max_correlation\": {\"terms\": [\"%s\", \"%s\"], \"value\": %.6f}",
+                    json_escape(term_name(m, f.corr_j)).c_str(),
+                    json_escape(term_name(m, f.corr_i)).c_str(), f.corr);
+    std::printf("%s%s}", extra.empty() ? "" : ", ", extra.c_str());
 }
 
 void fail_fit(const FitOut &f, const std::string &what)
@@ -341,7 +356,8 @@ void fail_fit(const FitOut &f, const std::string &what)
     if (f.status == PM_ERR_DIVERGED && f.corr_i >= 0) {
         char buf[64];
         std::snprintf(buf, sizeof buf, "%.6f", f.corr);
-        msg += " in 100 passes: the sky coverage hardly separates " + term_name(m, f.corr_j) +
+        msg += " in " + std::to_string(MAX_PASSES) +
+               " passes: the sky coverage hardly separates " + term_name(m, f.corr_j) +
                " from " + term_name(m, f.corr_i) + " (correlation " + buf +
                "); lower --order or use both pier sides";
     }
@@ -709,7 +725,7 @@ int run_main(int argc, char **argv)
     std::vector<std::string> titles;
     FTest ftest;
     if (!o.split) {
-        FitOut f = do_fit(obs, all, start);
+        FitOut f = do_fit(obs, all, start, MAX_PASSES);
         if (f.status != PM_OK)
             fail_fit(f, o.run);
         fits.push_back(f);
@@ -729,7 +745,7 @@ int run_main(int argc, char **argv)
             std::string t = side > 0 ? "pier side east (normal)" : "pier side west (beyond the pole)";
             if (use.empty())
                 die(o.run + ": --pier split: no observations on the " + t, 1);
-            FitOut f = do_fit(obs, use, start);
+            FitOut f = do_fit(obs, use, start, MAX_PASSES);
             if (f.status != PM_OK)
                 fail_fit(f, o.run + " (" + t + ")");
             fits.push_back(f);

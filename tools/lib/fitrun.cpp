@@ -236,26 +236,25 @@ FitOut do_fit(const std::vector<Obs> &obs, const std::vector<int> &use, const pm
     }
     f.status = pm_fit_run(&fit, &f.model, ctx.data(), (long)use.size(), eh.data(), ed.data(),
                           ah.data(), ad.data(), max_passes, &f.res);
-    if (f.status != PM_OK) {
-        f.bad_term = fit.bad_term;
-        if (f.status == PM_ERR_DIVERGED && fit.iterations > 0) {
-            // name the most nearly degenerate pair of the last accepted pass
-            pm_fit_result unit;
-            std::memset(&unit, 0, sizeof unit);
-            unit.sigma = 1;
-            for (int i = 0; i < fit.n_par; i++)
-                for (int j = 0; j < i; j++) {
-                    double c, r;
-                    if (pm_fit_covariance(&fit, &unit, i, j, &c, &r) == PM_OK &&
-                        std::fabs(r) > std::fabs(f.corr)) {
-                        f.corr = r;
-                        f.corr_i = i;
-                        f.corr_j = j;
-                    }
+    f.bad_term = f.status == PM_OK ? -1 : fit.bad_term;
+    if (f.status == PM_OK || (f.status == PM_ERR_DIVERGED && fit.iterations > 0)) {
+        // the most nearly degenerate pair of the last accepted pass
+        pm_fit_result unit;
+        std::memset(&unit, 0, sizeof unit);
+        unit.sigma = 1;
+        for (int i = 0; i < fit.n_par; i++)
+            for (int j = 0; j < i; j++) {
+                double c, r;
+                if (pm_fit_covariance(&fit, &unit, i, j, &c, &r) == PM_OK &&
+                    std::fabs(r) > std::fabs(f.corr)) {
+                    f.corr = r;
+                    f.corr_i = i;
+                    f.corr_j = j;
                 }
-        }
-        return f;
+            }
     }
+    if (f.status != PM_OK)
+        return f;
     residuals(f, obs, use);
     return f;
 }

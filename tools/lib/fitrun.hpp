@@ -63,7 +63,8 @@ pm_model build_model(int order, const std::vector<std::string> &adds,
 pm_model without_side_terms(const pm_model &m);
 
 // Fit `start` to the observations `use` (Gauss-Newton, at most max_passes);
-// on success the residuals are filled in.
+// on success the residuals are filled in.  corr, corr_i, corr_j: the most
+// correlated pair of terms (also after PM_ERR_DIVERGED).
 FitOut do_fit(const std::vector<Obs> &obs, const std::vector<int> &use, const pm_model &start,
               int max_passes = 100);
 void residuals(FitOut &f, const std::vector<Obs> &obs, const std::vector<int> &use);
