@@ -519,10 +519,7 @@ pm_status pm_fit_row(const pm_model *m, const pm_context *ctx, double enc_ha,
                      double enc_dec, double app_ha, double app_dec,
                      double *row0, double *row1, double r[2])
 {
-    pm_status st = model_ready(m);
-    if (st != PM_OK)
-        return st;
-    st = context_ok(m, ctx);
+    pm_status st = eval_ready(m, ctx);
     if (st != PM_OK)
         return st;
     if (!row0 || !row1 || !r)

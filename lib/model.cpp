@@ -189,10 +189,7 @@ pm_status invert(const pm_model *m, const pm_context *ctx, double app_ha,
                  double app_dec, int side, const double *start, double *enc_ha,
                  double *enc_dec)
 {
-    pm_status st = model_ready(m);
-    if (st != PM_OK)
-        return st;
-    st = context_ok(m, ctx);
+    pm_status st = eval_ready(m, ctx);
     if (st != PM_OK)
         return st;
     if (!enc_ha || !enc_dec)
@@ -543,10 +540,7 @@ pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
                          double enc_ha, double enc_dec, double *app_ha,
                          double *app_dec)
 {
-    pm_status st = model_ready(m);
-    if (st != PM_OK)
-        return st;
-    st = context_ok(m, ctx);
+    pm_status st = eval_ready(m, ctx);
     if (st != PM_OK)
         return st;
     if (!app_ha || !app_dec)
@@ -585,10 +579,7 @@ pm_status pm_model_residual(const pm_model *m, const pm_context *ctx,
                             double enc_ha, double enc_dec, double app_ha,
                             double app_dec, double res[2])
 {
-    pm_status st = model_ready(m);
-    if (st != PM_OK)
-        return st;
-    st = context_ok(m, ctx);
+    pm_status st = eval_ready(m, ctx);
     if (st != PM_OK)
         return st;
     if (!res)

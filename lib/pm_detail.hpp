@@ -357,6 +357,13 @@ template <typename M> inline pm_status context_ok(const M *m, const pm_context *
     return PM_OK;
 }
 
+/* Ready for an evaluation with this context: model_ready, then context_ok. */
+inline pm_status eval_ready(const pm_model *m, const pm_context *ctx)
+{
+    pm_status st = model_ready(m);
+    return st != PM_OK ? st : context_ok(m, ctx);
+}
+
 /* Displacement per unit coefficient of an added term t at position g. */
 template <typename T>
 inline void term_uv(const pm_term &t, const Trig<T> &g, const Site<T> &s,
