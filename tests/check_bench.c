@@ -7,6 +7,7 @@
 */
 #define _POSIX_C_SOURCE 200809L
 #include <check.h>
+#include "tu_check.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -63,12 +64,4 @@ static Suite *suite(void)
     return s;
 }
 
-int main(void)
-{
-    SRunner *sr = srunner_create(suite());
-    int failed;
-    srunner_run_all(sr, CK_NORMAL);
-    failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
-}
+int main(void) { return tu_run_suite(suite()); }

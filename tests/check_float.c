@@ -4,6 +4,7 @@
 **  index terms and with added physical terms; argument checks.
 */
 #include <check.h>
+#include "tu_check.h"
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -212,12 +213,4 @@ static Suite *suite(void)
     return s;
 }
 
-int main(void)
-{
-    SRunner *sr = srunner_create(suite());
-    int failed;
-    srunner_run_all(sr, CK_NORMAL);
-    failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
-}
+int main(void) { return tu_run_suite(suite()); }
