@@ -130,7 +130,7 @@ test-run: all check-c89 check-freestanding check-example check-install $(TESTS)
 	@$(PYTHON) -c 'import numpy' 2>/dev/null || echo "note: numpy missing; reference tables are committed, regeneration needs python3-numpy"
 	@fail=0; total_run=0; total_fail=0; \
 	for t in $(TESTS); do \
-	  out=$$(PM_DATA_DIR=$(CURDIR)/../shared/data PM_TOP=$(CURDIR) $$t 2>&1); rc=$$?; echo "$$out" | grep -v '^Running suite' ; \
+	  out=$$(PM_DATA_DIR=$(CURDIR)/../shared/data PM_TOP=$(CURDIR) PM_BUILD=$(B) $$t 2>&1); rc=$$?; echo "$$out" | grep -v '^Running suite' ; \
 	  line=$$(echo "$$out" | grep -E '^[0-9]+%: Checks: ' | tail -1); \
 	  r=$$(echo "$$line" | sed -E 's/.*Checks: ([0-9]+).*/\1/'); f=$$(echo "$$line" | sed -E 's/.*Failures: ([0-9]+), Errors: ([0-9]+).*/\1+\2/'); \
 	  total_run=$$((total_run + $${r:-0})); total_fail=$$((total_fail + $${f:-1})); \
@@ -164,6 +164,10 @@ clean:
 #                   (rules: bench/bench.mk)
 include firmware_demo/firmware.mk
 include bench/bench.mk
+# Reliability (docs/reliability.md): make fuzz (libFuzzer targets, bounded
+# time; rules: fuzz/fuzz.mk) and make sanitize (the Check suite under ASan +
+# UBSan).
+-include fuzz/fuzz.mk
 
 firmware: deps
 	@$(MAKE) --no-print-directory firmware-run

@@ -13,12 +13,14 @@
 #include <string.h>
 #include <sys/wait.h>
 
-/* build/pmfit of the tree under test (PM_TOP, set by make test). */
+/* pmfit of the tree under test: $PM_TOP/$PM_BUILD/pmfit (both set by make
+** test; PM_BUILD is the build directory, "build" unless make sanitize). */
 static inline const char *tu_pmfit_path(void)
 {
     static char path[512];
     const char *top = getenv("PM_TOP");
-    snprintf(path, sizeof path, "%s/build/pmfit", top ? top : ".");
+    const char *b = getenv("PM_BUILD");
+    snprintf(path, sizeof path, "%s/%s/pmfit", top ? top : ".", b ? b : "build");
     return path;
 }
 
