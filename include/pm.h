@@ -63,6 +63,15 @@ extern "C" {
 #define PM_INVERT_MAX_FIXED 8
 #define PM_INVERT_MAX_NEWTON 8
 #define PM_INVERT_POLE_STARTS 8
+/* Worst-case model evaluations per call, from the bounds above (each
+** evaluation is about one pm_model_apply): pm_model_invert_near (131),
+** pm_model_invert (2,341).  pm_model_apply makes exactly one.  tests/check_bounded.c counts them on adversarial
+** inputs. */
+#define PM_INVERT_NEAR_MAX_EVALS \
+    (PM_INVERT_MAX_FIXED + 3 + 15 * PM_INVERT_MAX_NEWTON)
+#define PM_INVERT_MAX_EVALS \
+    ((2 + 2 * PM_INVERT_POLE_STARTS) * \
+     (PM_INVERT_MAX_FIXED + 2 + 15 * PM_INVERT_MAX_NEWTON) + 1)
 
 /* Round-trip tolerance the inverse iterates to (radians). */
 #define PM_INVERT_TOL 1e-13
@@ -77,7 +86,10 @@ typedef enum pm_status {
     PM_WARN_UNREACHABLE = 2,   /* target outside what the mount can point to;
                                   the nearest reachable position is returned */
     PM_ERR_ARG = -1,           /* NULL pointer, bad enum or index */
-    PM_ERR_NONFINITE = -2,     /* NaN or infinity in an input */
+    PM_ERR_NONFINITE = -2,     /* NaN or infinity in an input, or an
+                                  evaluation overflowed (huge coefficients
+                                  or context values; the float build at
+                                  3e38): nothing is written */
     PM_ERR_CAPACITY = -3,      /* order or term count beyond PM_MAX_L/PM_MAX_TERMS */
     PM_ERR_TOO_FEW = -4,       /* not enough observations: need 2N > P */
     PM_ERR_SINGULAR = -5,      /* a term cannot be determined from the data;
@@ -349,10 +361,11 @@ pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
 **     branches need not match the two sides of the pole (the anisotropic
 **     terms fold the sky there), so the other branch is tried, then
 **     side-locked Newton runs from PM_INVERT_POLE_STARTS points on the
-**     pole's edge.  Hard bound: at most (2 + 2 * PM_INVERT_POLE_STARTS) *
-**     (PM_INVERT_MAX_FIXED + 2 + 15 * PM_INVERT_MAX_NEWTON) model
-**     evaluations (2,340); elsewhere a few.  For tracking use
-**     pm_model_invert_near, which never needs the rescue (at most 130).
+**     pole's edge.  Hard bound, whatever the inputs: PM_INVERT_MAX_EVALS
+**     = (2 + 2 * PM_INVERT_POLE_STARTS) * (PM_INVERT_MAX_FIXED + 2 + 15 *
+**     PM_INVERT_MAX_NEWTON) + 1 model evaluations (2,341); elsewhere a
+**     few.  For tracking use pm_model_invert_near, which never needs the
+**     rescue (at most PM_INVERT_NEAR_MAX_EVALS, 131).
 **  3) PM_WARN_NOT_CONVERGED: a bound was reached; the best position found
 **     is returned.  PM_WARN_UNREACHABLE: no position on the requested side
 **     points at the target: it lies in the cap around the mount's pole
@@ -378,9 +391,17 @@ pm_status pm_model_invert(const pm_model *m, const pm_context *ctx,
 **                                  continuous with it, and enc_ha, enc_dec
 **                                  are returned within pi of start_ha,
 **                                  start_dec (no jump at +-pi when
-**                                  tracking).  At most 130 evaluations.
+**                                  tracking).  |start_ha|, |start_dec|
+**                                  at most PM_START_MAX, else
+**                                  PM_ERR_ARG.  At most
+**                                  PM_INVERT_NEAR_MAX_EVALS (131) model
+**                                  evaluations, whatever the inputs.
 **  Other arguments, return values and notes as pm_model_invert.
 */
+/* Largest start angle pm_model_invert_near(_f) accepts (radians; about
+** 160,000 turns): the result is returned within pi of the start, and
+** beyond this a double no longer holds an angle to 1e-10 rad. */
+#define PM_START_MAX 1e6
 pm_status pm_model_invert_near(const pm_model *m, const pm_context *ctx,
                                double app_ha, double app_dec,
                                double start_ha, double start_dec,
@@ -468,15 +489,18 @@ pm_status pm_model_f_prepare(pm_model_f *mf, const pm_model *m);
 **     agrees with the double build to 0.01" over the sky (tested at L=2).
 **  2) The inverse is a Newton iteration on sky offsets at the target
 **     (Jacobian by differences, kept while steps gain a factor 10, steps
-**     cut back when they do not help): at most 1 + 6 * PM_INVERT_F_MAX
-**     model evaluations, usually 4; it iterates to PM_INVERT_F_TOL (0.002",
-**     above the float forward's own noise of ~0.0002"), not 1e-13.
+**     cut back when they do not help): at most PM_INVERT_F_MAX_EVALS =
+**     2 + 6 * PM_INVERT_F_MAX model evaluations whatever the inputs,
+**     usually 4; it iterates to PM_INVERT_F_TOL (0.002", above the float
+**     forward's own noise of ~0.0002"), not 1e-13.
 **     PM_WARN_NOT_CONVERGED if the bound is reached or the solution found
 **     is on the other side of the mount's pole; this happens only within
 **     about a degree of the mount's pole (use the double build there).
 */
 #define PM_INVERT_F_MAX 12
 #define PM_INVERT_F_TOL 1e-8
+/* Worst-case model evaluations of the float inverse (74). */
+#define PM_INVERT_F_MAX_EVALS (2 + 6 * PM_INVERT_F_MAX)
 pm_status pm_model_apply_f(const pm_model_f *m, const pm_context *ctx,
                            double enc_ha, double enc_dec,
                            double *app_ha, double *app_dec);

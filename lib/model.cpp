@@ -45,11 +45,13 @@ int side_of(const pm_model *m, double d) { return m_cos(d - m->coef[4]) >= 0 ? 1
 ** target.  Used where the fixed point does not contract (close to the
 ** mount's pole).  x = (t, d) encoder angles, updated in place.  With
 ** lock = +1/-1 a trial point beyond the pole from that side is moved back
-** onto the pole's edge (projected steps: the nearest point on one side). */
+** onto the pole's edge (projected steps: the nearest point on one side).
+** Trial points are kept on the turn the result is returned on
+** (finish_angles with the caller's start), since periodic terms of
+** non-integer G read the raw angle and jump between turns. */
 pm_status newton(const pm_model *m, const Iso<double> &k, const pm_context *ctx,
-                 const V3<double> &q,
-                 double tq, double dq, double *t, double *d, double *err,
-                 int lock = 0)
+                 const V3<double> &q, double tq, double dq, const double *start,
+                 double *t, double *d, double *err, int lock = 0)
 {
     /* frame at the target: e1 along increasing axis 1, e2 along axis 2 */
     double st = m_sin(tq), ct = m_cos(tq), sd = m_sin(dq), cd = m_cos(dq);
@@ -85,6 +87,7 @@ pm_status newton(const pm_model *m, const Iso<double> &k, const pm_context *ctx,
                 double pole = m_sin(nd - m->coef[4]) >= 0 ? PI / 2 : -PI / 2;
                 nd = pole + m->coef[4] - (pole > 0 ? 1 : -1) * lock * 1e-12;
             }
+            finish_angles(start, &nt, &nd);
             double e = miss(m, k, ctx, trig_of(nt, nd), q);
             if (e < best) {
                 best = e;
@@ -148,6 +151,8 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
     for (int it = 0; it < PM_INVERT_MAX_FIXED; it++) {
         double dt, dd;
         aniso<double>(m, k, g, ctx, &dt, &dd);
+        if (!finite(dt * dt + dd * dd))
+            break; /* the forward model overflows here: not converged */
         change = m_sqrt((dt - dt_prev) * (dt - dt_prev) +
                         (dd - dd_prev) * (dd - dd_prev));
         if (change < best_change) {
@@ -175,7 +180,7 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
     pm_status result = PM_OK;
     if (!converged || !reachable) {
         double err;
-        result = newton(m, k, ctx, q, app_ha, app_dec, &t, &d, &err);
+        result = newton(m, k, ctx, q, app_ha, app_dec, start, &t, &d, &err);
         if (result != PM_OK && !reachable)
             result = PM_WARN_UNREACHABLE;
     }
@@ -198,6 +203,8 @@ pm_status invert(const pm_model *m, const pm_context *ctx, double app_ha,
         (start && (!finite(start[0]) || !finite(start[1]))))
         return PM_ERR_NONFINITE;
     if (m_fabs(app_dec) > PI / 2 + 1e-12)
+        return PM_ERR_ARG;
+    if (start && (m_fabs(start[0]) > PM_START_MAX || m_fabs(start[1]) > PM_START_MAX))
         return PM_ERR_ARG;
 
     Iso<double> k;
@@ -241,7 +248,7 @@ pm_status invert(const pm_model *m, const pm_context *ctx, double app_ha,
                     double dj = hemi * pole + m->coef[4] - hemi * side * 1e-9;
                     double err;
                     pm_status sj =
-                        newton(m, k, ctx, q, app_ha, app_dec, &tj, &dj, &err, side);
+                        newton(m, k, ctx, q, app_ha, app_dec, 0, &tj, &dj, &err, side);
                     if (side_of(m, dj) != side)
                         continue;
                     if (sj == PM_OK) {
@@ -266,6 +273,13 @@ pm_status invert(const pm_model *m, const pm_context *ctx, double app_ha,
             }
         }
     }
+    /* A warning returns the best position found: the model must still be
+    ** finite there (coefficients or context values can overflow it, and
+    ** then no position is any good).  One more evaluation, counted in
+    ** PM_INVERT_MAX_EVALS; PM_OK already passed the round trip. */
+    if (!finite(t) || !finite(d) ||
+        (result != PM_OK && !finite(miss(m, k, ctx, trig_of(t, d), q))))
+        return PM_ERR_NONFINITE; /* outputs untouched */
     finish_angles(start, &t, &d);
     *enc_ha = t;
     *enc_dec = d;
@@ -551,8 +565,11 @@ pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
     iso_from_model<double>(m, &k);
     V3<double> p = forward_vec<double>(m, k, trig_of(enc_ha, enc_dec), ctx);
     double t = m_atan2(p.y, p.x);
+    double d = m_atan2(p.z, m_sqrt(p.x * p.x + p.y * p.y));
+    if (!finite(t) || !finite(d))
+        return PM_ERR_NONFINITE; /* overflow in the terms: outputs untouched */
     *app_ha = t <= -PI ? PI : t; /* atan2(-0, -1) = -pi */
-    *app_dec = m_atan2(p.z, m_sqrt(p.x * p.x + p.y * p.y));
+    *app_dec = d;
     return PM_OK;
 }
 

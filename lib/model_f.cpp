@@ -72,6 +72,7 @@ V3<float> rotate_offset(const V3<float> &n, float s1, float s2, const V3<float> 
 void forward_f(const pm_model_f *m, const pm_context *ctx, double t, double d, double *T,
                double *D)
 {
+    PM_EVAL_PROBE();
     /* frame angles: exact index shifts; beyond the pole, the equivalent
     ** position (t_r, d_r) = (t_c + pi, pi - d_e) with |d_r| <= pi/2 */
     double tc = t + m->c, de = wrap_pi(d - m->e);
@@ -166,14 +167,22 @@ void forward_f(const pm_model_f *m, const pm_context *ctx, double t, double d, d
     *D = dr + (double)dD;
 }
 
-/* Offset of apparent (T1, D1) from (T2, D2), in the frame at (T2, D2). */
-void sky_offset(double T1, double D1, double T2, double D2, float *x, float *y)
+/* Offset of apparent (T1, D1) from (T2, D2), in the frame at (T2, D2):
+** the tangent components (x, y) of the direction (T1, D1) and, returned,
+** a size that grows with the angle between them: |(x, y)| = sin(angle)
+** in the near hemisphere, 2 - sin(angle) in the far one (the tangent
+** components alone vanish at the antipode too). */
+float sky_offset(double T1, double D1, double T2, double D2, float *x, float *y)
 {
     float dT = (float)wrap_pi(T1 - T2), dD = (float)(D1 - D2);
     float c1 = m_cos((float)D1), s2 = m_sin((float)D2);
     float h = m_sin(dT / 2);
     *x = c1 * m_sin(dT);
     *y = m_sin(dD) + c1 * s2 * 2 * h * h;
+    /* cos(angle) = cos(dD) - 2 cos(D1) cos(D2) sin^2(dT/2) */
+    float z = m_cos(dD) - 2 * c1 * m_cos((float)D2) * h * h;
+    float n = m_sqrt(*x * *x + *y * *y);
+    return z >= 0 ? n : 2 - n;
 }
 
 pm_status check_f(const pm_model_f *m, const pm_context *ctx)
@@ -197,6 +206,8 @@ pm_status invert_f(const pm_model_f *m, const pm_context *ctx, double T, double 
         return PM_ERR_NONFINITE;
     if (m_fabs(D) > PI / 2 + 1e-12)
         return PM_ERR_ARG;
+    if (start && (m_fabs(start[0]) > PM_START_MAX || m_fabs(start[1]) > PM_START_MAX))
+        return PM_ERR_ARG;
     double t, d;
     if (start) {
         t = start[0];
@@ -212,12 +223,14 @@ pm_status invert_f(const pm_model_f *m, const pm_context *ctx, double T, double 
     ** kept while each step gains a factor 10 (chord steps, one evaluation
     ** each), refreshed otherwise; a step that does not reduce the offset is
     ** cut back (at most 3 times). */
+    /* iterate on the turn the result is returned on: periodic terms of
+    ** non-integer G read the raw angle and jump between turns */
+    finish_angles(start, &t, &d);
     const double h = 1e-5;
     double T0, D0, T1, D1;
     float fx, fy, ax, ay, j00 = 0, j01 = 0, j10 = 0, j11 = 0, det = 0;
     forward_f(m, ctx, t, d, &T0, &D0);
-    sky_offset(T0, D0, T, D, &fx, &fy);
-    float fn = m_sqrt(fx * fx + fy * fy);
+    float fn = sky_offset(T0, D0, T, D, &fx, &fy);
     bool refresh = true;
     pm_status result = PM_WARN_NOT_CONVERGED;
     for (int it = 0; it <= PM_INVERT_F_MAX; it++) {
@@ -247,9 +260,9 @@ pm_status invert_f(const pm_model_f *m, const pm_context *ctx, double T, double 
         for (int cut = 0; cut < 4; cut++, lam *= 0.25f) {
             nt = t - lam * ds_t;
             nd = d - lam * ds_d;
+            finish_angles(start, &nt, &nd);
             forward_f(m, ctx, nt, nd, &T0, &D0);
-            sky_offset(T0, D0, T, D, &nfx, &nfy);
-            nfn = m_sqrt(nfx * nfx + nfy * nfy);
+            nfn = sky_offset(T0, D0, T, D, &nfx, &nfy);
             if (nfn < fn)
                 break;
         }
@@ -269,6 +282,14 @@ pm_status invert_f(const pm_model_f *m, const pm_context *ctx, double T, double 
     /* the solution must be on the requested side of the mount's pole */
     if (result == PM_OK && !start && (m_cos((float)wrap_pi(d - m->e)) >= 0 ? 1 : -1) != side)
         result = PM_WARN_NOT_CONVERGED;
+    if (result != PM_OK && finite(t) && finite(d)) {
+        /* the best position of a warning: is the model finite there? */
+        forward_f(m, ctx, t, d, &T0, &D0);
+        if (!finite(T0) || !finite(D0))
+            t = T0;
+    }
+    if (!finite(t) || !finite(d))
+        return PM_ERR_NONFINITE; /* float overflow in the terms: outputs untouched */
     finish_angles(start, &t, &d);
     *enc_ha = t;
     *enc_dec = d;
@@ -333,7 +354,12 @@ pm_status pm_model_apply_f(const pm_model_f *m, const pm_context *ctx, double en
         return PM_ERR_ARG;
     if (!finite(enc_ha) || !finite(enc_dec))
         return PM_ERR_NONFINITE;
-    forward_f(m, ctx, enc_ha, enc_dec, app_ha, app_dec);
+    double t, d;
+    forward_f(m, ctx, enc_ha, enc_dec, &t, &d);
+    if (!finite(t) || !finite(d))
+        return PM_ERR_NONFINITE; /* float overflow in the terms: outputs untouched */
+    *app_ha = t;
+    *app_dec = d;
     return PM_OK;
 }
 

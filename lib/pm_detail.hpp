@@ -14,6 +14,13 @@ namespace detail {
 
 /* Math through the compiler builtins: the library stays freestanding and
 ** the calls resolve to libm (or to instructions). */
+/* A hook called once per model evaluation (aniso): nothing in the library;
+** tests/check_bounded.c builds the core again with a counter here to check
+** the evaluation bounds documented in include/pm.h. */
+#ifndef PM_EVAL_PROBE
+#define PM_EVAL_PROBE() ((void)0)
+#endif
+
 inline double m_sin(double x) { return __builtin_sin(x); }
 inline double m_cos(double x) { return __builtin_cos(x); }
 inline double m_atan2(double y, double x) { return __builtin_atan2(y, x); }
@@ -213,10 +220,14 @@ template <typename T> inline void logmap(const V3<T> &q, T *a, T *b)
 /* Wrap an angle into (-pi, pi]. */
 inline double wrap_pi(double a)
 {
-    while (a > PI)
-        a -= 2 * PI;
-    while (a <= -PI)
-        a += 2 * PI;
+    if (a > PI || a <= -PI) {
+        /* one remainder, not a loop: bounded time for any finite a */
+        a = __builtin_fmod(a, 2 * PI); /* |a| < 2 pi, the sign of a */
+        if (a > PI)
+            a -= 2 * PI;
+        else if (a <= -PI)
+            a += 2 * PI;
+    }
     return a;
 }
 
@@ -422,6 +433,7 @@ template <typename T>
 inline void aniso(const pm_model *m, const Iso<T> &k, const Trig<T> &g0,
                   const pm_context *ctx, T *dt, T *dd)
 {
+    PM_EVAL_PROBE();
     T Y[PM_N_HARM(PM_MAX_L)];
     T S[6] = {0, 0, 0, 0, 0, 0};
     int nh = PM_N_HARM(m->order);

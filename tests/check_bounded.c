@@ -1,0 +1,362 @@
+/*
+**  check_bounded.c - bounded time per tick: every per-tick function returns
+**  within the worst-case number of model evaluations its header comment
+**  states, with a valid status, on adversarial inputs.
+**
+**  The core is built again for this suite with a counter in its one model
+**  evaluation (PM_EVAL_PROBE in lib/pm_detail.hpp, tests/probe.h; the
+**  library itself has no counter and no globals).  The bounds come from
+**  include/pm.h: pm_model_apply 1, pm_model_invert_near
+**  PM_INVERT_NEAR_MAX_EVALS, pm_model_invert PM_INVERT_MAX_EVALS, the float
+**  build PM_INVERT_F_MAX_EVALS.
+**
+**  Adversarial inputs: the celestial poles (dec exactly +-90 deg), the
+**  mount's pole (encoder dec - e' = +-90 deg, where the inverse folds),
+**  hour angles at and next to +-180 deg and far outside (-pi, pi], huge
+**  start positions for the near inverse, huge and nonfinite coefficients
+**  and context values, every term kind, every order.  Outputs must be
+**  finite whenever the status is not an error, and a PM_OK inverse must
+**  round-trip within its tolerance.
+*/
+#include "tu_check.h"
+#include "testutil.h"
+#include "probe.h"
+#include <float.h>
+#include <stdio.h>
+#include <string.h>
+
+static unsigned long probe_count;
+void pm_probe_hit(void) { probe_count++; }
+
+/* The statuses an evaluation entry point may return. */
+static int valid_status(pm_status st)
+{
+    return st == PM_OK || st == PM_WARN_NOT_CONVERGED || st == PM_WARN_UNREACHABLE ||
+           st == PM_ERR_ARG || st == PM_ERR_NONFINITE || st == PM_ERR_STATE;
+}
+
+/* Coefficient scales: ordinary mounts, badly built ones, and absurd. */
+enum { SCALE_NORMAL, SCALE_LARGE, SCALE_HUGE, N_SCALES };
+
+/* A random model of every term kind at the given scale. */
+static void random_model(pm_model *m, tu_rng *r, int scale)
+{
+    static const double iso_scale[N_SCALES] = {1e-2, 0.3, 1e3};
+    static const double an_scale[N_SCALES] = {1e-3, 3e-2, 10.0};
+    int mount = tu_uniform(r) < 0.5 ? PM_MOUNT_EQUATORIAL : PM_MOUNT_ALTAZ;
+    int order = (int)(tu_uniform(r) * (PM_MAX_L + 1));
+    int i, n_extra;
+    ck_assert_int_eq(pm_model_init(m, mount, order), PM_OK);
+    m->latitude = (tu_uniform(r) * 2 - 1) * M_PI / 2;
+    for (i = 0; i < m->n_terms; i++)
+        m->coef[i] = tu_gauss(r) * (i < 6 ? iso_scale[scale] : an_scale[scale]);
+    ck_assert_int_eq(pm_model_prepare(m), PM_OK);
+    n_extra = (int)(tu_uniform(r) * 6);
+    for (i = 0; i < n_extra; i++) {
+        pm_term t;
+        memset(&t, 0, sizeof t);
+        t.kind = (unsigned char)(1 + (int)(tu_uniform(r) * 4)); /* FOURIER..AUX */
+        t.k = (unsigned char)(1 + (int)(tu_uniform(r) * 6));
+        t.side = (signed char)((int)(tu_uniform(r) * 3) - 1);
+        t.m = (signed char)(tu_uniform(r) < 0.5);
+        switch (t.kind) {
+        case PM_TERM_FOURIER:
+            t.l = (signed char)(1 + (tu_uniform(r) < 0.5));
+            t.param = tu_uniform(r) < 0.3 ? 1e6 : 1 + tu_uniform(r) * 720;
+            break;
+        case PM_TERM_SECTORAL:
+            t.param = (double)(1 + (int)(tu_uniform(r) * 300));
+            break;
+        case PM_TERM_ZENITH:
+            t.l = (signed char)(tu_uniform(r) < 0.5);
+            t.m = 0;
+            break;
+        default:
+            t.aux = (unsigned char)(tu_uniform(r) * (PM_AUX_USER + PM_MAX_AUX));
+            t.param = tu_gauss(r) * 10;
+            break;
+        }
+        ck_assert_int_eq(pm_model_add_term(m, &t, tu_gauss(r) * an_scale[scale], NULL),
+                         PM_OK);
+    }
+}
+
+/* A context with ordinary, huge or denormal values. */
+static void random_context(pm_context *c, tu_rng *r)
+{
+    static const double vals[] = {0.0, 1e300, -1e300, 4.9e-324, 1e6, -40.0};
+    int j;
+    double u = tu_uniform(r);
+    c->temp_c = u < 0.7 ? tu_gauss(r) * 10 : vals[(int)(tu_uniform(r) * 6)];
+    c->time_h = u < 0.7 ? tu_gauss(r) * 5 : vals[(int)(tu_uniform(r) * 6)];
+    c->pier = (int)(tu_uniform(r) * 3) - 1;
+    c->dir = (int)(tu_uniform(r) * 3) - 1;
+    for (j = 0; j < PM_MAX_AUX; j++)
+        c->aux[j] = u < 0.7 ? tu_gauss(r) : vals[(int)(tu_uniform(r) * 6)];
+}
+
+/* An adversarial apparent position (ha, dec) for model m. */
+static void hard_target(const pm_model *m, tu_rng *r, double *ha, double *dec)
+{
+    static const double has[] = {M_PI, -M_PI, 3.141592653589793, -3.1415926535897927,
+                                 0.0, -0.0, 1e6, -1e300, 7 * M_PI};
+    double e = m->coef[4];
+    double u = tu_uniform(r);
+    *ha = tu_uniform(r) < 0.5 ? has[(int)(tu_uniform(r) * 9)]
+                              : (tu_uniform(r) * 2 - 1) * M_PI;
+    if (u < 0.2)
+        *dec = tu_uniform(r) < 0.5 ? M_PI / 2 : -M_PI / 2; /* celestial poles */
+    else if (u < 0.5) {
+        /* at the mount's pole, within the anisotropic amplitude of it */
+        double p = (tu_uniform(r) < 0.5 ? M_PI / 2 : -M_PI / 2) + e;
+        p += tu_gauss(r) * 1e-3 * (tu_uniform(r) < 0.5 ? 1.0 : 1e-6);
+        *dec = p;
+    } else
+        *dec = asin(tu_uniform(r) * 2 - 1);
+    if (*dec > M_PI / 2)
+        *dec = M_PI - *dec; /* keep it on the sphere */
+    if (*dec < -M_PI / 2)
+        *dec = -M_PI - *dec;
+}
+
+/* Angle between two apparent positions, rounding of sin/cos allowed for
+** positions given far outside (-pi, pi]. */
+#define ROUND_TRIP_SLACK 1e-14
+
+typedef struct stats {
+    unsigned long calls, worst_apply, worst_inv, worst_near, worst_f, worst_near_f;
+    unsigned long ok, warn, err;
+    double worst_rt_f;
+} stats;
+
+static void note(stats *s, pm_status st)
+{
+    ck_assert_msg(valid_status(st), "status %d is not a documented one", (int)st);
+    if (st == PM_OK)
+        s->ok++;
+    else if (st > 0)
+        s->warn++;
+    else
+        s->err++;
+    s->calls++;
+}
+
+/* One inverse call through every entry point, counted and checked. */
+static void check_point(const pm_model *m, const pm_model_f *mf, const pm_context *ctx,
+                        double ha, double dec, tu_rng *r, stats *s)
+{
+    static const double starts[] = {1e300, -1e300, 1e7, M_PI, -M_PI, 0.0};
+    double eh, ed, ah, ad, sh, sd;
+    pm_status st;
+    int side = tu_uniform(r) < 0.5 ? PM_SIDE_NORMAL : PM_SIDE_FLIPPED;
+
+    probe_count = 0;
+    st = pm_model_invert(m, ctx, ha, dec, side, &eh, &ed);
+    note(s, st);
+    ck_assert_msg(probe_count <= PM_INVERT_MAX_EVALS,
+                  "pm_model_invert: %lu evaluations > %d (ha %.17g dec %.17g)", probe_count,
+                  PM_INVERT_MAX_EVALS, ha, dec);
+    if (probe_count > s->worst_inv)
+        s->worst_inv = probe_count;
+    if (st >= 0) {
+        ck_assert_msg(isfinite(eh) && isfinite(ed), "pm_model_invert: status %d, nonfinite",
+                      (int)st);
+        probe_count = 0;
+        ck_assert_msg(pm_model_apply(m, ctx, eh, ed, &ah, &ad) == PM_OK,
+                      "pm_model_invert status %d at (%.17g, %.17g) but pm_model_apply "
+                      "fails at its result (%.17g, %.17g), ctx %s", (int)st, ha, dec, eh, ed,
+                      ctx ? "given" : "NULL");
+        ck_assert_uint_le(probe_count, 1);
+        ck_assert(isfinite(ah) && isfinite(ad));
+        if (st == PM_OK)
+            ck_assert_msg(tu_angle(ah, ad, ha, dec) <= PM_INVERT_TOL + ROUND_TRIP_SLACK,
+                          "pm_model_invert PM_OK but misses by %g rad",
+                          tu_angle(ah, ad, ha, dec));
+    }
+
+    /* near: from the solution just found, or from absurd starts */
+    if (st >= 0 && tu_uniform(r) < 0.5) {
+        sh = eh + tu_gauss(r) * 1e-3;
+        sd = ed + tu_gauss(r) * 1e-3;
+    } else {
+        sh = starts[(int)(tu_uniform(r) * 6)];
+        sd = tu_uniform(r) < 0.5 ? starts[(int)(tu_uniform(r) * 6)] : tu_gauss(r);
+    }
+    probe_count = 0;
+    st = pm_model_invert_near(m, ctx, ha, dec, sh, sd, &eh, &ed);
+    note(s, st);
+    ck_assert_msg(probe_count <= PM_INVERT_NEAR_MAX_EVALS,
+                  "pm_model_invert_near: %lu evaluations > %d (start %g %g)", probe_count,
+                  PM_INVERT_NEAR_MAX_EVALS, sh, sd);
+    if (probe_count > s->worst_near)
+        s->worst_near = probe_count;
+    if (st >= 0) {
+        ck_assert_msg(isfinite(eh) && isfinite(ed), "pm_model_invert_near: nonfinite");
+        ck_assert_int_eq(pm_model_apply(m, ctx, eh, ed, &ah, &ad), PM_OK);
+        if (st == PM_OK)
+            ck_assert_msg(tu_angle(ah, ad, ha, dec) <= PM_INVERT_TOL + ROUND_TRIP_SLACK,
+                          "pm_model_invert_near PM_OK but misses by %g rad",
+                          tu_angle(ah, ad, ha, dec));
+    }
+
+    if (!mf)
+        return;
+    probe_count = 0;
+    st = pm_model_invert_f(mf, ctx, ha, dec, side, &eh, &ed);
+    note(s, st);
+    ck_assert_msg(probe_count <= PM_INVERT_F_MAX_EVALS,
+                  "pm_model_invert_f: %lu evaluations > %d", probe_count, PM_INVERT_F_MAX_EVALS);
+    if (probe_count > s->worst_f)
+        s->worst_f = probe_count;
+    if (st >= 0)
+        ck_assert_msg(isfinite(eh) && isfinite(ed), "pm_model_invert_f: nonfinite");
+    if (st == PM_OK) {
+        /* round trip through the float forward model */
+        ck_assert_int_eq(pm_model_apply_f(mf, ctx, eh, ed, &ah, &ad), PM_OK);
+        if (tu_angle(ah, ad, ha, dec) > s->worst_rt_f)
+            s->worst_rt_f = tu_angle(ah, ad, ha, dec);
+        ck_assert_msg(tu_angle(ah, ad, ha, dec) <= 2 * PM_INVERT_F_TOL,
+                      "pm_model_invert_f PM_OK but misses (%.17g, %.17g) by %g rad", ha, dec,
+                      tu_angle(ah, ad, ha, dec));
+    }
+    probe_count = 0;
+    st = pm_model_invert_near_f(mf, ctx, ha, dec, sh, sd, &eh, &ed);
+    note(s, st);
+    ck_assert_msg(probe_count <= PM_INVERT_F_MAX_EVALS,
+                  "pm_model_invert_near_f: %lu evaluations > %d", probe_count,
+                  PM_INVERT_F_MAX_EVALS);
+    if (probe_count > s->worst_near_f)
+        s->worst_near_f = probe_count;
+    if (st >= 0)
+        ck_assert_msg(isfinite(eh) && isfinite(ed), "pm_model_invert_near_f: nonfinite");
+}
+
+/* The forward model: one evaluation, a valid status, finite output. */
+static void check_apply(const pm_model *m, const pm_model_f *mf, const pm_context *ctx,
+                        tu_rng *r, stats *s)
+{
+    static const double encs[] = {M_PI, -M_PI, M_PI / 2, -M_PI / 2, 1e300, -1e300, 0.0};
+    double h = tu_uniform(r) < 0.5 ? encs[(int)(tu_uniform(r) * 7)] : tu_gauss(r) * 3;
+    double d = tu_uniform(r) < 0.5 ? encs[(int)(tu_uniform(r) * 7)] : tu_gauss(r) * 3;
+    double ah, ad;
+    pm_status st;
+    probe_count = 0;
+    st = pm_model_apply(m, ctx, h, d, &ah, &ad);
+    note(s, st);
+    ck_assert_uint_le(probe_count, 1);
+    if (probe_count > s->worst_apply)
+        s->worst_apply = probe_count;
+    if (st >= 0)
+        ck_assert_msg(isfinite(ah) && isfinite(ad), "pm_model_apply: status %d, nonfinite "
+                      "output at %g %g", (int)st, h, d);
+    if (mf) {
+        probe_count = 0;
+        st = pm_model_apply_f(mf, ctx, h, d, &ah, &ad);
+        note(s, st);
+        ck_assert_uint_le(probe_count, 1);
+        if (st >= 0)
+            ck_assert_msg(isfinite(ah) && isfinite(ad), "pm_model_apply_f: nonfinite");
+    }
+}
+
+static void run_scale(int scale, int n_models, int n_points, unsigned long long seed)
+{
+    static const char *const names[N_SCALES] = {"ordinary", "large", "huge"};
+    tu_rng r;
+    stats s;
+    int i, j;
+    memset(&s, 0, sizeof s);
+    tu_seed(&r, seed);
+    for (i = 0; i < n_models; i++) {
+        pm_model m;
+        pm_model_f mf;
+        pm_context c;
+        const pm_context *ctx;
+        int have_f;
+        random_model(&m, &r, scale);
+        have_f = pm_model_f_prepare(&mf, &m) == PM_OK;
+        for (j = 0; j < n_points; j++) {
+            double ha, dec;
+            random_context(&c, &r);
+            ctx = m.needs_ctx || tu_uniform(&r) < 0.5 ? &c : NULL;
+            hard_target(&m, &r, &ha, &dec);
+            check_point(&m, have_f ? &mf : NULL, ctx, ha, dec, &r, &s);
+            check_apply(&m, have_f ? &mf : NULL, ctx, &r, &s);
+        }
+    }
+    printf("check_bounded: %-8s coefficients, %lu calls (%lu ok, %lu warnings, %lu errors); "
+           "worst evaluations: apply %lu, invert %lu (bound %d), invert_near %lu (%d), "
+           "invert_f %lu, invert_near_f %lu (%d); float round trip %.2g rad\n",
+           names[scale], s.calls, s.ok, s.warn, s.err, s.worst_apply, s.worst_inv,
+           PM_INVERT_MAX_EVALS, s.worst_near, PM_INVERT_NEAR_MAX_EVALS, s.worst_f,
+           s.worst_near_f, PM_INVERT_F_MAX_EVALS, s.worst_rt_f);
+    /* the suite must reach the hard paths, or it proves nothing */
+    ck_assert_uint_gt(s.ok, s.calls / 10);
+}
+
+START_TEST(test_bounded_ordinary)
+{
+    run_scale(SCALE_NORMAL, 200, 40, 101);
+}
+END_TEST
+
+START_TEST(test_bounded_large)
+{
+    run_scale(SCALE_LARGE, 200, 40, 202);
+}
+END_TEST
+
+START_TEST(test_bounded_huge)
+{
+    run_scale(SCALE_HUGE, 200, 40, 303);
+}
+END_TEST
+
+/* Nonfinite input anywhere: an error, no evaluation at all. */
+START_TEST(test_bounded_nonfinite_inputs)
+{
+    pm_model m;
+    pm_context c;
+    double bad[3], eh, ed;
+    int i, j;
+    bad[0] = NAN;
+    bad[1] = INFINITY;
+    bad[2] = -INFINITY;
+    ck_assert_int_eq(pm_model_init(&m, PM_MOUNT_EQUATORIAL, 2), PM_OK);
+    memset(&c, 0, sizeof c);
+    for (i = 0; i < 3; i++)
+        for (j = 0; j < 4; j++) {
+            double a[4] = {0.1, 0.2, 0.3, 0.4};
+            a[j] = bad[i];
+            probe_count = 0;
+            ck_assert_int_eq(pm_model_invert(&m, &c, a[0], a[1], 0, &eh, &ed), j < 2
+                             ? PM_ERR_NONFINITE : PM_OK);
+            ck_assert_int_eq(pm_model_invert_near(&m, &c, a[0], a[1], a[2], a[3], &eh, &ed),
+                             PM_ERR_NONFINITE);
+            if (j < 2)
+                ck_assert_int_eq(pm_model_apply(&m, &c, a[0], a[1], &eh, &ed),
+                                 PM_ERR_NONFINITE);
+        }
+    probe_count = 0;
+    ck_assert_int_eq(pm_model_invert(&m, NULL, NAN, 0, 0, &eh, &ed), PM_ERR_NONFINITE);
+    ck_assert_uint_eq(probe_count, 0);
+}
+END_TEST
+
+static Suite *suite(void)
+{
+    Suite *s = suite_create("bounded");
+    TCase *tc = tcase_create("per_tick");
+    tcase_set_timeout(tc, 600);
+    tcase_add_test(tc, test_bounded_ordinary);
+    tcase_add_test(tc, test_bounded_large);
+    tcase_add_test(tc, test_bounded_huge);
+    tcase_add_test(tc, test_bounded_nonfinite_inputs);
+    suite_add_tcase(s, tc);
+    return s;
+}
+
+int main(void)
+{
+    return tu_run_suite(suite());
+}
