@@ -105,6 +105,18 @@ pm_status newton(const pm_model *m, const Iso<double> &k, const pm_context *ctx,
     return best <= PM_INVERT_TOL ? PM_OK : PM_WARN_NOT_CONVERGED;
 }
 
+/* Does an evaluation of m read the raw axis angles, not only their sines
+** and cosines?  Periodic terms of non-integer G do (the angle's turn
+** matters); nothing else. */
+bool reads_raw_angles(const pm_model *m)
+{
+    for (int i = m->n_base; i < m->n_terms; i++)
+        if (m->term[i].kind == PM_TERM_FOURIER &&
+            m->term[i].param != (double)(long)m->term[i].param)
+            return true;
+    return false;
+}
+
 /* Give trig g the angles nearest the reference angles. */
 void on_turn(Trig<double> *g, double ref_t, double ref_d)
 {
@@ -140,8 +152,12 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
         V3<double> v = rot_z<double>(k.si, k.ci, expmap<double>(dt_prev, dd_prev));
         side = cdp * v.x - sdp * v.z >= 0 ? 1 : -1;
     }
+    /* the angles themselves (two atan2) only where a term reads them;
+    ** else once, at the end */
+    const bool raw = reads_raw_angles(m);
     bool reachable = iso_inverse<double>(k, q, dt_prev, dd_prev, side, &g);
-    on_turn(&g, ref_t, ref_d);
+    if (raw)
+        on_turn(&g, ref_t, ref_d);
 
     /* Fixed point: x_{n+1} = iso_inverse(D(x_n)).  x_n misses the target
     ** by |D(x_n) - D(x_{n-1})| (to first order), which is the test. */
@@ -170,10 +186,13 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
         dt_prev = dt;
         dd_prev = dd;
         reachable = iso_inverse<double>(k, q, dt, dd, side, &g);
-        on_turn(&g, ref_t, ref_d);
+        if (raw)
+            on_turn(&g, ref_t, ref_d);
     }
     g = best;
     reachable = best_reachable;
+    if (!raw)
+        on_turn(&g, ref_t, ref_d);
 
     double t = g.t; /* on the turn of ref_t, ref_d (on_turn) */
     double d = g.d;

@@ -243,6 +243,14 @@ inline void finish_angles(const double *start, double *t, double *d)
     }
 }
 
+/* The bit pattern of a double. */
+inline unsigned long long bits_of(double x)
+{
+    unsigned long long u;
+    __builtin_memcpy(&u, &x, sizeof u);
+    return u;
+}
+
 /* Is the model ready for evaluation: prepared, and no coefficient changed
 ** since (a stale model would be silently wrong). */
 inline pm_status model_ready(const pm_model *m)
@@ -251,10 +259,18 @@ inline pm_status model_ready(const pm_model *m)
         return PM_ERR_ARG;
     if (m->prepared != 1 || m->n_terms < 6 || m->n_terms > PM_MAX_TERMS)
         return PM_ERR_STATE;
-    for (int i = 0; i < m->n_terms; i++)
-        if (m->coef[i] != m->prep_coef[i])
-            return PM_ERR_STATE;
-    return PM_OK;
+    /* Bit patterns OR-ed together, four at a time, no early exit: a
+    ** quarter of the instructions of a compare-and-branch loop.  (Bitwise,
+    ** so writing -0.0 over 0.0 also asks for pm_model_prepare.) */
+    const int n = m->n_terms;
+    unsigned long long acc[4] = {0, 0, 0, 0};
+    int i = 0;
+    for (; i + 4 <= n; i += 4)
+        for (int j = 0; j < 4; j++)
+            acc[j] |= bits_of(m->coef[i + j]) ^ bits_of(m->prep_coef[i + j]);
+    for (; i < n; i++)
+        acc[0] |= bits_of(m->coef[i]) ^ bits_of(m->prep_coef[i]);
+    return (acc[0] | acc[1] | acc[2] | acc[3]) ? PM_ERR_STATE : PM_OK;
 }
 
 /* Model constants in working precision. */
