@@ -2,7 +2,9 @@
 //
 //   pmfit fit RUN [--order L] [--pier joint|split] [--json] [--residuals FILE]
 //                 [--save MODEL] [--emit-c HEADER] [--no-refraction] [--skip-bad]
+//                 [--robust [--clip K]]
 //   pmfit explain RUN [--order L] [--add EFFECT ...] [--json] [--plots DIR] [--alpha P]
+//                 [--robust [--clip K]]
 //   pmfit eval MODEL RUN [--json] [--residuals FILE] [--no-refraction] [--skip-bad]
 //   pmfit simulate OUT [--n N] [--seed S] [--lat DEG] [--mount equatorial|altaz]
 //                 [--fork] [--el-limit DEG] [--noise ARCSEC] [--order L]
@@ -18,6 +20,7 @@
 #include "fitrun.hpp"
 #include "explain.hpp"
 #include "plots.hpp"
+#include "robust.hpp"
 
 #include <cerrno>
 #include <cmath>
@@ -30,6 +33,7 @@
 #include <vector>
 #include <algorithm>
 #include <filesystem>
+#include <unistd.h>
 #include <stdexcept>
 
 namespace {
@@ -52,6 +56,10 @@ struct Options {
     std::vector<std::string> adds; // fit, explain: --add EFFECT
     std::string plots;             // explain: --plots DIR
     double alpha = 0.01;           // explain: --alpha
+    std::vector<double> gears_ha, gears_dec; // explain: --gear [ha:|dec:]G
+    bool robust = false;           // fit, explain: --robust (docs/robust.md)
+    double clip = ROBUST_DEFAULT_CLIP; // --clip K
+    bool clip_given = false;
     // simulate
     long n = 200;
     unsigned long long seed = 1;
@@ -67,7 +75,7 @@ void usage(FILE *f)
     std::fprintf(f,
         "usage: pmfit fit RUN [--order L] [--pier joint|split] [--add EFFECT ...] [--json]\n"
         "                     [--residuals FILE] [--save MODEL] [--emit-c HEADER]\n"
-        "                     [--no-refraction] [--skip-bad]\n"
+        "                     [--no-refraction] [--skip-bad] [--robust [--clip K]]\n"
         "\n"
         "  RUN              pointing run: four-column, named-column or TPOINT file\n"
         "                   (docs/formats.md)\n"
@@ -94,9 +102,15 @@ void usage(FILE *f)
         "  --emit-c HEADER  write the model as C constant data with a loader, for firmware\n"
         "  --no-refraction  leave refraction out of the TPOINT reduction\n"
         "  --skip-bad       skip malformed records (each is reported) instead of failing\n"
+        "  --robust         ignore gross outliers (failed plate solves): clip points whose\n"
+        "                   residual on the sky exceeds K robust sigmas, refit, repeat until\n"
+        "                   stable; the report lists them by line (docs/robust.md)\n"
+        "  --clip K         the threshold K (default %.2f: a clean point is rejected with\n"
+        "                   probability 1e-4)\n"
         "\n"
         "usage: pmfit explain RUN [--order L] [--add EFFECT ...] [--json] [--plots DIR]\n"
-        "                     [--alpha P] [--no-refraction] [--skip-bad]\n"
+        "                     [--alpha P] [--gear [ha:|dec:]G ...] [--no-refraction]\n"
+        "                     [--skip-bad] [--robust [--clip K]]\n"
         "\n"
         "  fits the baseline model (order L, default 1, plus --add terms), locates where the\n"
         "  residuals are too large, names the physics left out (ha_periodic, dec_periodic,\n"
@@ -104,7 +118,11 @@ void usage(FILE *f)
         "  higher_order, outlier), adds it and repeats while the false-alarm probability is\n"
         "  below P (default 0.01) and the cross-validated RMS improves (docs/explain.md);\n"
         "  --plots DIR writes SVG pictures: residuals on the sky before/after, residual vs the\n"
-        "  located variable, periodograms, sigma per step\n"
+        "  located variable, periodograms, sigma per step; --robust: explain the points a\n"
+        "  robust fit of the baseline keeps (the rejected ones are listed); --gear G: a known\n"
+        "  gear period (cycles per revolution, e.g. the worm's tooth count; ha:G or dec:G for\n"
+        "  one axis, repeatable): the periodic search looks at the given periods only, so a\n"
+        "  smaller periodic error is significant (docs/explain.md)\n"
         "\n"
         "usage: pmfit eval MODEL RUN [--json] [--residuals FILE] [--no-refraction] [--skip-bad]\n"
         "\n"
@@ -130,7 +148,7 @@ void usage(FILE *f)
         "                   unit of direction, i.e. half the backlash), or outlier[:N] (N\n"
         "                   points off by V) or higher_order (order L+1 terms of RMS V);\n"
         "                   repeatable\n",
-        PM_MAX_L);
+        PM_MAX_L, ROBUST_DEFAULT_CLIP);
 }
 
 [[noreturn]] void die(const std::string &msg, int code = 2)
@@ -201,6 +219,21 @@ Options parse_args(int argc, char **argv)
             o.plots = need("a directory");
         } else if (expl && a == "--alpha") {
             o.alpha = number(a, need("a probability"), 1e-12, 0.5);
+        } else if (expl && a == "--gear") {
+            std::string v = need("a gear period in cycles per revolution ([ha:|dec:]G)");
+            bool ha = true, dec = true;
+            if (v.rfind("ha:", 0) == 0) {
+                dec = false;
+                v = v.substr(3);
+            } else if (v.rfind("dec:", 0) == 0) {
+                ha = false;
+                v = v.substr(4);
+            }
+            double g = number(a, v.c_str(), 1e-6, 1e6);
+            if (ha)
+                o.gears_ha.push_back(g);
+            if (dec)
+                o.gears_dec.push_back(g);
         } else if (!sim && !eval && a == "--add") {
             o.adds.push_back(need("an effect (see pmfit --help)"));
         } else if (!sim && !eval && !expl && a == "--save") {
@@ -244,6 +277,11 @@ Options parse_args(int argc, char **argv)
             o.refraction = false;
         } else if (!sim && a == "--skip-bad") {
             o.skip_bad = true;
+        } else if (!sim && !eval && a == "--robust") {
+            o.robust = true;
+        } else if (!sim && !eval && a == "--clip") {
+            o.clip = number(a, need("a threshold in robust sigmas"), 2, 1000);
+            o.clip_given = true;
         } else if (!a.empty() && a[0] == '-') {
             die("unknown option '" + a + "'; see pmfit --help");
         } else if (eval && o.model.empty()) {
@@ -254,6 +292,8 @@ Options parse_args(int argc, char **argv)
             die("more than one run file given ('" + o.run + "', '" + a + "')");
         }
     }
+    if (o.clip_given && !o.robust)
+        die("--clip K sets the threshold of --robust; add --robust");
     if (eval && o.model.empty())
         die("no model file given; see pmfit --help");
     if (o.run.empty())
@@ -362,7 +402,9 @@ void fail_fit(const FitOut &f, const std::string &what)
                "); lower --order or use both pier sides";
     }
     if (f.status == PM_ERR_TOO_FEW)
-        msg += " (need more than P/2 observations; lower --order)";
+        msg += " (P = " + std::to_string(m.n_terms) + " terms need at least " +
+               std::to_string(m.n_terms / 2 + 1) + " observations, 2N > P; there are " +
+               std::to_string(f.res.n_obs) + "; lower --order)";
     die(msg, 1);
 }
 
@@ -389,6 +431,101 @@ void write_residuals(const std::string &path, const std::string &title,
     char err[1024];
     if (pmhost::write_atomic(path, text, err, sizeof err) != 0)
         die(err, 1);
+}
+
+// --robust: the residual file lists every observation, rejected ones flagged.
+void write_residuals_robust(const std::string &path, const std::string &title,
+                            const std::vector<RobustFit> &rfs, const std::vector<Obs> &obs)
+{
+    std::string text = "# " + title + ", arcsec on the sky; rejected = 1: left out by --robust "
+                       "(its residual is from the fit of the others)\n"
+                       "# line enc1_deg enc2_deg pier res1_arcsec res2_arcsec rejected\n";
+    char buf[160];
+    for (const RobustFit &rf : rfs)
+        for (size_t j = 0; j < rf.use.size(); j++) {
+            const Obs &ob = obs[rf.use[j]];
+            std::snprintf(buf, sizeof buf, "%d %.6f %.6f %d %.4f %.4f %d\n", ob.line,
+                          ob.eh * 180 / PI, ob.ed * 180 / PI, ob.pier, rf.r0[j] * RAD2AS,
+                          rf.r1[j] * RAD2AS, rf.rejected[j] ? 1 : 0);
+            text += buf;
+        }
+    char err[1024];
+    if (pmhost::write_atomic(path, text, err, sizeof err) != 0)
+        die(err, 1);
+}
+
+// The "robust" member of the JSON output.
+std::string robust_json(const RobustFit &rf, const std::vector<Obs> &obs)
+{
+    char b[256];
+    std::snprintf(b, sizeof b,
+                  "\"robust\": {\"clip\": %.6g, \"sigma_robust_arcsec\": %.6f, \"n_considered\": "
+                  "%zu, \"n_rejected\": %zu, \"rounds\": %d, \"stable\": %s, \"lts_start\": %s, "
+                  "\"outliers\": [",
+                  rf.clip, rf.sigma_robust * RAD2AS, rf.use.size(), rf.outliers.size(), rf.rounds,
+                  rf.stable ? "true" : "false", rf.lts_start ? "true" : "false");
+    std::string out = b;
+    for (size_t k = 0; k < rf.outliers.size(); k++) {
+        size_t j = 0;
+        while (rf.use[j] != rf.outliers[k])
+            j++;
+        std::snprintf(b, sizeof b,
+                      "%s{\"line\": %d, \"residual_arcsec\": %.4f, \"robust_sigmas\": %.3f}",
+                      k ? ", " : "", obs[rf.outliers[k]].line,
+                      std::hypot(rf.r0[j], rf.r1[j]) * RAD2AS, rf.dist[j] / rf.sigma_robust);
+        out += b;
+    }
+    return out + "]}";
+}
+
+// The table report's list of rejected observations.
+void print_robust(const RobustFit &rf, const std::vector<Obs> &obs, const std::string &path)
+{
+    std::printf("\n  robust fit (--robust, clip K = %.2f): robust sigma %.3f\", threshold %.2f\"\n"
+                "  (on the residual weighed by its leverage, docs/robust.md);\n"
+                "  %zu of %zu observations rejected, so N, sigma, the terms and the worst points\n"
+                "  above are of the %zu kept (%d clipping round%s%s)%s\n",
+                rf.clip, rf.sigma_robust * RAD2AS, rf.clip * rf.sigma_robust * RAD2AS,
+                rf.outliers.size(), rf.use.size(), rf.use.size() - rf.outliers.size(), rf.rounds,
+                rf.rounds == 1 ? "" : "s", rf.lts_start ? "" : ", started from all points",
+                rf.outliers.empty() ? "" : ":");
+    for (int i : rf.outliers) {
+        size_t j = 0;
+        while (rf.use[j] != i)
+            j++;
+        const Obs &o = obs[i];
+        std::printf("    %s:%d  rejected  axis1 %+9.2f  axis2 %+9.2f  |r| %8.2f  (%.1f robust "
+                    "sigma)\n",
+                    path.c_str(), o.line, rf.r0[j] * RAD2AS, rf.r1[j] * RAD2AS,
+                    std::hypot(rf.r0[j], rf.r1[j]) * RAD2AS, rf.dist[j] / rf.sigma_robust);
+    }
+    if (rf.outliers.size() > std::max<size_t>(3, rf.use.size() / 20))
+        std::printf("  warning: %.0f%% rejected, far more than failed plate solves explain: the "
+                    "residuals are not\n  noise plus a few gross errors; the model leaves "
+                    "something out (pmfit explain)\n",
+                    100.0 * (double)rf.outliers.size() / (double)rf.use.size());
+    if (!rf.stable)
+        std::printf("  warning: the rejected set still changed after %d rounds (points on the "
+                    "threshold);\n  the list is that of the last round\n",
+                    rf.rounds);
+}
+
+// Without --robust: name the points a robust fit would reject, if any.
+void print_robust_hint(const FitOut &f, const std::vector<Obs> &obs, const std::string &path)
+{
+    std::vector<int> s = robust_suspects(f, obs, ROBUST_DEFAULT_CLIP, MAX_PASSES);
+    if (s.empty())
+        return;
+    std::string lines;
+    for (size_t k = 0; k < s.size() && k < 20; k++)
+        lines += (k ? ", " : "") + std::to_string(obs[s[k]].line);
+    if (s.size() > 20)
+        lines += " and " + std::to_string(s.size() - 20) + " more";
+    std::printf("\n  hint: %zu point%s miss%s the fit of the others by more than %.2f robust "
+                "sigmas, line%s\n    %s\n  failed plate solves or wrong stars? pmfit fit %s "
+                "--robust fits without them\n  (docs/robust.md)\n",
+                s.size(), s.size() == 1 ? "" : "s", s.size() == 1 ? "es" : "",
+                ROBUST_DEFAULT_CLIP, s.size() == 1 ? "" : "s", lines.c_str(), path.c_str());
 }
 
 int cmd_eval(const Options &o, const std::vector<Obs> &obs, int mount)
@@ -527,12 +664,36 @@ void write_explain_plots(const std::string &dir, const Run &run, const Explanati
 }
 
 // pmfit explain: report, JSON, plots.
-int cmd_explain(const Options &o, const Run &run)
+int cmd_explain(const Options &o, const Run &full)
 {
     ExplainOptions eo;
     eo.order = o.order;
     eo.adds = o.adds;
     eo.alpha = o.alpha;
+    eo.gears_ha = o.gears_ha;
+    eo.gears_dec = o.gears_dec;
+    // --robust: explain the observations a robust fit of the baseline keeps
+    Run clean;
+    RobustFit rf;
+    if (o.robust) {
+        std::vector<int> all(full.obs.size());
+        for (size_t i = 0; i < all.size(); i++)
+            all[i] = (int)i;
+        rf = robust_fit(full.obs, all,
+                        build_model(o.order, o.adds, full.obs, full.mount, full.latitude,
+                                    full.aux_names),
+                        o.clip, MAX_PASSES);
+        if (!rf.error.empty())
+            die(full.path + ": --robust: " + rf.error, 1);
+        if (rf.fit.status != PM_OK)
+            fail_fit(rf.fit, full.path + " (robust fit of the baseline)");
+        clean = full;
+        clean.obs.clear();
+        for (size_t j = 0; j < rf.use.size(); j++)
+            if (!rf.rejected[j])
+                clean.obs.push_back(full.obs[rf.use[j]]);
+    }
+    const Run &run = o.robust ? clean : full;
     Explanation ex = explain(run, eo);
     auto num = [](double v) {
         char b[40];
@@ -541,6 +702,7 @@ int cmd_explain(const Options &o, const Run &run)
     };
     if (o.json) {
         std::string j = "{\"n_obs\": " + std::to_string(run.obs.size()) +
+                        (o.robust ? ", " + robust_json(rf, full.obs) : std::string()) +
                         ", \"baseline\": {\"order\": " + std::to_string(o.order) +
                         ", \"sigma_arcsec\": " + num(ex.base_sigma_arcsec) +
                         ", \"cv_rms_arcsec\": " + num(ex.base_cv_rms_arcsec) +
@@ -588,6 +750,19 @@ int cmd_explain(const Options &o, const Run &run)
     } else {
         std::printf("pmfit explain %s: %s mount, %zu observations\n\n", run.path.c_str(),
                     run.mount == PM_MOUNT_ALTAZ ? "alt-az" : "equatorial", run.obs.size());
+        if (o.robust) {
+            std::string lines;
+            for (int i : rf.outliers)
+                lines += (lines.empty() ? " (line" + std::string(rf.outliers.size() > 1 ? "s " : " ")
+                                        : std::string(", ")) +
+                         std::to_string(full.obs[i].line);
+            std::printf("robust: %zu of %zu observations rejected by a robust fit of the "
+                        "baseline%s%s;\n  explained below: the %zu kept (robust sigma %.3f\", "
+                        "clip K = %.2f)\n\n",
+                        rf.outliers.size(), full.obs.size(), lines.c_str(),
+                        lines.empty() ? "" : ")", run.obs.size(), rf.sigma_robust * RAD2AS,
+                        rf.clip);
+        }
         std::printf("baseline: order %d%s, P = %d, unbiased sigma %.3f\", cross-validated RMS "
                     "%.3f\"\n",
                     o.order, o.adds.empty() ? "" : " + added terms", ex.base_n_params,
@@ -609,9 +784,12 @@ int cmd_explain(const Options &o, const Run &run)
         if (!shown)
             std::printf("  nowhere in particular (no group or variable at p < 0.05)\n");
         for (const Periodogram &pg : ex.periodograms)
-            std::printf("  periodogram of the %s axis: highest peak at G = %.6g cycles/rev, power "
+            std::printf("  periodogram of the %s axis: highest peak at G = %.6g cycles/rev%s, power "
                         "%.1f (false-alarm %g level: %.1f)\n",
-                        pg.axis.c_str(), pg.peak_g, pg.peak_power, o.alpha, pg.threshold);
+                        pg.axis.c_str(), pg.peak_g,
+                        (pg.axis == "ha" ? o.gears_ha : o.gears_dec).empty()
+                            ? "" : " of the --gear periods",
+                        pg.peak_power, o.alpha, pg.threshold);
         std::printf("\nfindings:\n");
         if (ex.findings.empty())
             std::printf("  none: nothing significant is left out (false-alarm probability "
@@ -690,9 +868,40 @@ int cmd_simulate(const Options &o, int argc, char **argv)
     return 0;
 }
 
+// Output files must be writable before any work is done (a fit is not
+// computed and then lost): the directory exists and is writable, the path
+// is not a directory.
+void check_output(const std::string &opt, const std::string &path)
+{
+    if (path.empty())
+        return;
+    std::error_code ec;
+    std::filesystem::path p(path);
+    std::string dir = p.has_parent_path() ? p.parent_path().string() : std::string(".");
+    if (!std::filesystem::is_directory(dir, ec))
+        die(opt + " " + path + ": cannot write: the directory '" + dir +
+            "' does not exist (nothing was done)", 1);
+    if (std::filesystem::is_directory(p, ec))
+        die(opt + " " + path + ": cannot write: it is a directory (nothing was done)", 1);
+    if (access(dir.c_str(), W_OK) != 0)
+        die(opt + " " + path + ": cannot write into '" + dir + "': " + std::strerror(errno) +
+            " (nothing was done)", 1);
+}
+
 int run_main(int argc, char **argv)
 {
     Options o = parse_args(argc, argv);
+    for (const char *sfx : {"", "-east", "-west"}) {
+        if (!o.split && *sfx)
+            continue;
+        if (o.split && !*sfx)
+            continue;
+        check_output("--save", o.save.empty() ? o.save : o.save + sfx);
+        check_output("--emit-c", o.emit_c.empty() ? o.emit_c : o.emit_c + sfx);
+    }
+    check_output("--residuals", o.residuals);
+    if (o.cmd == "simulate")
+        check_output("simulate", o.run);
     if (PM_CHECK_CONFIG() != PM_OK)
         die("library and program were built with different PM_MAX_L/PM_MAX_EXTRA", 1);
     if (o.cmd == "simulate")
@@ -724,14 +933,33 @@ int run_main(int argc, char **argv)
     std::vector<FitOut> fits;
     std::vector<std::string> titles;
     FTest ftest;
+    // --robust: each fit is of the points its robust fit keeps (robs), and the
+    // F-tests compare models of the kept points only
+    std::vector<RobustFit> robs;
+    std::vector<int> kept;
+    auto fit_points = [&](const std::vector<int> &use, const std::string &what) {
+        if (!o.robust) {
+            FitOut f = do_fit(obs, use, start, MAX_PASSES);
+            if (f.status != PM_OK)
+                fail_fit(f, what);
+            kept.insert(kept.end(), use.begin(), use.end());
+            return f;
+        }
+        RobustFit rf = robust_fit(obs, use, start, o.clip, MAX_PASSES);
+        if (!rf.error.empty())
+            die(what + ": --robust: " + rf.error, 1);
+        if (rf.fit.status != PM_OK)
+            fail_fit(rf.fit, what + " (robust fit)");
+        kept.insert(kept.end(), rf.fit.idx.begin(), rf.fit.idx.end());
+        robs.push_back(rf);
+        return rf.fit;
+    };
     if (!o.split) {
-        FitOut f = do_fit(obs, all, start, MAX_PASSES);
-        if (f.status != PM_OK)
-            fail_fit(f, o.run);
+        FitOut f = fit_points(all, o.run);
         fits.push_back(f);
         titles.push_back("joint fit, both pier sides");
         if (side_terms) {
-            FitOut g = do_fit(obs, all, without_side_terms(start));
+            FitOut g = do_fit(obs, kept, without_side_terms(start));
             if (g.status == PM_OK)
                 ftest = f_test(g.res.chi2, g.res.n_par, f.res.chi2, f.res.n_par, f.res.n_obs,
                                "side-specific terms vs shared only");
@@ -745,39 +973,47 @@ int run_main(int argc, char **argv)
             std::string t = side > 0 ? "pier side east (normal)" : "pier side west (beyond the pole)";
             if (use.empty())
                 die(o.run + ": --pier split: no observations on the " + t, 1);
-            FitOut f = do_fit(obs, use, start, MAX_PASSES);
-            if (f.status != PM_OK)
-                fail_fit(f, o.run + " (" + t + ")");
+            FitOut f = fit_points(use, o.run + " (" + t + ")");
             fits.push_back(f);
             titles.push_back(t);
         }
-        FitOut g = do_fit(obs, all, start);
+        std::sort(kept.begin(), kept.end());
+        FitOut g = do_fit(obs, kept, start);
         if (g.status == PM_OK)
             ftest = f_test(g.res.chi2, g.res.n_par, fits[0].res.chi2 + fits[1].res.chi2,
                            fits[0].res.n_par + fits[1].res.n_par, g.res.n_obs,
                            "split (independent sides) vs joint");
     }
 
-    if (!o.residuals.empty())
-        write_residuals(o.residuals,
-                        "residuals of pmfit fit " + o.run + " (order " + std::to_string(o.order) +
-                            ", pier " + (o.split ? "split" : "joint") + ")",
-                        fits, obs);
+    if (!o.residuals.empty()) {
+        std::string title = "residuals of pmfit fit " + o.run + " (order " +
+                            std::to_string(o.order) + ", pier " + (o.split ? "split" : "joint") +
+                            (o.robust ? ", robust" : "") + ")";
+        if (o.robust)
+            write_residuals_robust(o.residuals, title, robs, obs);
+        else
+            write_residuals(o.residuals, title, fits, obs);
+    }
 
+    std::vector<std::string> write_errors;
     for (size_t k = 0; k < fits.size(); k++) {
         std::string suffix = fits.size() == 1 ? "" : (k == 0 ? "-east" : "-west");
         std::string note = "fitted by pmfit from " + o.run + " (" + titles[k] + ")\n" +
                            "N = " + std::to_string(fits[k].res.n_obs) + ", sigma = " +
-                           std::to_string(fits[k].res.sigma * RAD2AS) + " arcsec";
+                           std::to_string(fits[k].res.sigma * RAD2AS) + " arcsec" +
+                           (o.robust ? ", --robust: " + std::to_string(robs[k].outliers.size()) +
+                                           " outliers left out"
+                                     : std::string());
         char e[1024];
+        // a write that fails now still lets the report below be printed
         if (!o.save.empty() &&
             pmmodel_save((o.save + suffix).c_str(), &fits[k].model, note.c_str(), e, sizeof e) != 0)
-            die(e, 1);
+            write_errors.push_back(e);
         if (!o.emit_c.empty()) {
             std::string prefix = fits.size() == 1 ? "pm_fitted" : (k == 0 ? "pm_east" : "pm_west");
             if (pmmodel_emit_c((o.emit_c + suffix).c_str(), &fits[k].model, prefix.c_str(),
                                note.c_str(), e, sizeof e) != 0)
-                die(e, 1);
+                write_errors.push_back(e);
         }
     }
 
@@ -791,22 +1027,29 @@ int run_main(int argc, char **argv)
         fjson = b;
     }
     if (o.json) {
+        auto rj = [&](size_t k) { return o.robust ? robust_json(robs[k], obs) : std::string(); };
         if (fits.size() == 1) {
-            print_json_fit(fits[0], fjson);
+            std::string r = rj(0);
+            print_json_fit(fits[0], fjson + (fjson.empty() || r.empty() ? "" : ", ") + r);
         } else {
             std::printf("{\"pier\": \"split\", %s%s\"sides\": {\"east\": ", fjson.c_str(),
                         fjson.empty() ? "" : ", ");
-            print_json_fit(fits[0], "");
+            print_json_fit(fits[0], rj(0));
             std::printf(", \"west\": ");
-            print_json_fit(fits[1], "");
+            print_json_fit(fits[1], rj(1));
             std::printf("}}");
         }
         std::printf("\n");
     } else {
         std::printf("pmfit fit %s: %s mount, %zu observations\n", o.run.c_str(),
                     mount == PM_MOUNT_ALTAZ ? "alt-az" : "equatorial", obs.size());
-        for (size_t k = 0; k < fits.size(); k++)
+        for (size_t k = 0; k < fits.size(); k++) {
             print_table(titles[k].c_str(), fits[k], obs, o.run);
+            if (o.robust)
+                print_robust(robs[k], obs, o.run);
+            else
+                print_robust_hint(fits[k], obs, o.run);
+        }
         if (ftest.done)
             std::printf("\n  pier sides, %s: F = %.3g (%d, %ld dof), p = %.3g: %s\n",
                         ftest.what.c_str(), ftest.f, ftest.d1, ftest.d2, ftest.p,
@@ -814,6 +1057,12 @@ int run_main(int argc, char **argv)
                                        : "no significant difference between the sides");
         std::printf("\n  * = significant at 3 sigma. Values are radians x 206265 (arcsec);\n"
                     "    the model is defined in docs/model.md.\n");
+    }
+    if (!write_errors.empty()) {
+        std::fflush(stdout);
+        for (size_t k = 0; k + 1 < write_errors.size(); k++)
+            std::fprintf(stderr, "pmfit: %s\n", write_errors[k].c_str());
+        die(write_errors.back() + " (the fit is reported above)", 1);
     }
     return 0;
 }

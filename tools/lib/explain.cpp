@@ -117,6 +117,20 @@ Periodogram periodogram(const Run &run, const FitOut &f, int comp, const Explain
         pg.g.push_back(G);
         pg.power.push_back(period_power(run, f.idx, r, comp, G) / sigma2);
     }
+    const std::vector<double> &gears = comp == 0 ? opt.gears_ha : opt.gears_dec;
+    if (!gears.empty()) {
+        // known gear periods: the best of them, corrected for them alone
+        for (double G : gears) {
+            double p = period_power(run, f.idx, r, comp, G) / sigma2;
+            if (p > pg.peak_power || pg.peak_g == 0) {
+                pg.peak_power = p;
+                pg.peak_g = G;
+            }
+        }
+        pg.trials = (double)gears.size();
+        pg.threshold = -2 * std::log(opt.alpha / pg.trials);
+        return pg;
+    }
     // refine the three highest integer peaks to non-integer G
     std::vector<size_t> order(pg.g.size());
     std::iota(order.begin(), order.end(), 0);
@@ -142,8 +156,8 @@ Periodogram periodogram(const Run &run, const FitOut &f, int comp, const Explain
     double s2_after = (chi2 - red_peak) / (double)std::max(1L, dof - 2);
     if (std::fabs(pg.peak_g - gi) < 0.5 && s2_after > 0 && (red_peak - red_int) / s2_after <= 3.84)
         pg.peak_g = gi;
-    double M = (double)pg.g.size();
-    pg.threshold = -2 * std::log(opt.alpha / M); // chi^2(2) tail at alpha / M
+    pg.trials = (double)pg.g.size();
+    pg.threshold = -2 * std::log(opt.alpha / pg.trials); // chi^2(2) tail at alpha / M
     return pg;
 }
 
@@ -423,8 +437,18 @@ Explanation explain(const Run &run, const ExplainOptions &opt)
         // let the user see why (singular, too few, diverged): the plain fit
         FitOut f = do_fit(run.obs, use,
                           build_model(order, adds, run.obs, run.mount, run.latitude, run.aux_names));
-        throw std::runtime_error(std::string("the baseline fit failed (status ") +
-                                 std::to_string((int)f.status) + "); try pmfit fit for details");
+        std::string why = "status " + std::to_string((int)f.status);
+        if (f.status == PM_ERR_TOO_FEW)
+            why = "too few observations (P = " + std::to_string(f.model.n_terms) +
+                  " terms need at least " + std::to_string(f.model.n_terms / 2 + 1) +
+                  ", there are " + std::to_string(use.size()) + ")";
+        else if (f.status == PM_ERR_SINGULAR && f.bad_term >= 0)
+            why = "term " + term_name(f.model, f.bad_term) +
+                  " cannot be determined from these observations";
+        else if (f.status == PM_ERR_DIVERGED)
+            why = "the fit did not converge";
+        throw std::runtime_error(run.path + ": the baseline fit failed: " + why +
+                                 "; try pmfit fit for details");
     }
     ex.baseline = cur.f;
     double cur_cv = cv_rms(run, use, order, adds, opt.folds, opt.seed);
@@ -461,7 +485,7 @@ Explanation explain(const Run &run, const ExplainOptions &opt)
                 already = already || a.rfind(comp ? "dec_periodic:" : "ha_periodic:", 0) == 0;
             if (!already && pg.peak_g > 0) {
                 with(comp ? "dec_periodic" : "ha_periodic", {spec});
-                cands.back().trials = (double)pg.g.size();
+                cands.back().trials = pg.trials;
                 cands.back().peak_g = pg.peak_g;
             }
         }
@@ -724,8 +748,14 @@ Explanation explain(const Run &run, const ExplainOptions &opt)
 extern "C" int pmx_explain(const char *path, int order, double alpha, pmx_result *out,
                            char *err, size_t errlen)
 {
+    return pmx_explain_gears(path, order, alpha, NULL, 0, out, err, errlen);
+}
+
+extern "C" int pmx_explain_gears(const char *path, int order, double alpha, const double *gears,
+                                 int n_gears, pmx_result *out, char *err, size_t errlen)
+{
     using namespace pmhost;
-    if (!path || !out) {
+    if (!path || !out || n_gears < 0 || (n_gears > 0 && !gears)) {
         set_err(err, errlen, "pmx_explain: invalid arguments");
         return -1;
     }
@@ -734,6 +764,14 @@ extern "C" int pmx_explain(const char *path, int order, double alpha, pmx_result
         ExplainOptions o;
         o.order = order;
         o.alpha = alpha;
+        for (int i = 0; i < n_gears; i++) {
+            if (!(gears[i] > 0 && gears[i] <= 1e6)) {
+                set_err(err, errlen, "pmx_explain: a gear period must be in (0, 1e6]");
+                return -1;
+            }
+            o.gears_ha.push_back(gears[i]);
+            o.gears_dec.push_back(gears[i]);
+        }
         Explanation ex = explain(run, o);
         pmx_result r;
         std::memset(&r, 0, sizeof r);

@@ -39,6 +39,11 @@ typedef struct pmx_result {
 int pmx_explain(const char *path, int order, double alpha, pmx_result *out, char *err,
                 size_t errlen);
 
+/* As pmx_explain, with known gear periods (cycles per revolution, both
+** axes; pmfit explain --gear): the periodic search looks at these only. */
+int pmx_explain_gears(const char *path, int order, double alpha, const double *gears,
+                      int n_gears, pmx_result *out, char *err, size_t errlen);
+
 #ifdef __cplusplus
 }
 #endif

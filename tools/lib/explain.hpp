@@ -23,6 +23,10 @@ struct ExplainOptions {
     int folds = 5;                 // k of the k-fold cross-validation
     int max_findings = 8;
     double g_min = 2, g_max = 720; // periodogram range (cycles per revolution)
+    // Known gear periods (cycles per revolution, e.g. the worm's tooth
+    // count): when an axis has any, its periodic candidates are only these,
+    // and the false-alarm correction counts only them (--gear).
+    std::vector<double> gears_ha, gears_dec;
     unsigned seed = 1;             // fold assignment
 };
 
@@ -38,6 +42,7 @@ struct Periodogram {
     std::string axis;              // "ha" or "dec"
     std::vector<double> g, power;  // power: chi^2 reduction / sigma^2 (arcsec^2 / sigma^2)
     double peak_g = 0, peak_power = 0, threshold = 0; // threshold: false alarm alpha
+    double trials = 0;             // periods the peak was chosen among (known gears or the scan)
 };
 
 struct Finding {

@@ -237,6 +237,10 @@ FitOut do_fit(const std::vector<Obs> &obs, const std::vector<int> &use, const pm
     f.status = pm_fit_run(&fit, &f.model, ctx.data(), (long)use.size(), eh.data(), ed.data(),
                           ah.data(), ad.data(), max_passes, &f.res);
     f.bad_term = f.status == PM_OK ? -1 : fit.bad_term;
+    if (f.status != PM_OK) { // res is not filled in on error: N and P for the message
+        f.res.n_obs = (long)use.size();
+        f.res.n_par = start.n_terms;
+    }
     if (f.status == PM_OK || (f.status == PM_ERR_DIVERGED && fit.iterations > 0)) {
         // the most nearly degenerate pair of the last accepted pass
         pm_fit_result unit;

@@ -87,6 +87,23 @@ bool parse_int(const std::string &s, long lo, long hi, long *v)
     return true;
 }
 
+// One line of at most max bytes (without its '\n'): 1, 0 at the end of the
+// file, -1 when longer (the rest is not read: bounded memory and time).
+int read_line(std::istream &in, std::string &line, size_t max)
+{
+    line.clear();
+    bool any = false;
+    for (int c; (c = in.get()) != EOF;) {
+        any = true;
+        if (c == '\n')
+            return 1;
+        if (line.size() >= max)
+            return -1;
+        line.push_back((char)c);
+    }
+    return any ? 1 : 0;
+}
+
 } // namespace
 
 extern "C" int pmmodel_save(const char *path, const pm_model *m, const char *comment,
@@ -147,9 +164,11 @@ extern "C" int pmmodel_load(const char *path, pm_model *out, char *err, size_t e
     pm_model m;
     std::memset(&m, 0, sizeof m);
     int got = 0;
-    while (std::getline(in, line)) {
+    std::vector<int> term_line; // line of each term, for the term-list check
+    int end_line = 0;
+    for (int r; (r = read_line(in, line, MAX_LINE)) != 0;) {
         lineno++;
-        if (line.size() > MAX_LINE)
+        if (r < 0)
             return fail("line longer than " + std::to_string(MAX_LINE) + " bytes");
         if (line.find('\0') != std::string::npos)
             return fail("binary data (NUL byte); expected a text model file");
@@ -195,7 +214,8 @@ extern "C" int pmmodel_load(const char *path, pm_model *out, char *err, size_t e
                 return fail("expected 'terms P' with an integer P >= 6");
             if (nterms > PM_MAX_TERMS)
                 return fail(std::to_string(nterms) + " terms exceed this build's capacity of " +
-                            std::to_string(PM_MAX_TERMS));
+                            std::to_string(PM_MAX_TERMS) + " (rebuild with -DPM_MAX_EXTRA=" +
+                            std::to_string(nterms - PM_SH_TERMS(PM_MAX_L)) + ")");
             m.mount = mount;
             m.order = (int)order;
             m.n_terms = (int)nterms;
@@ -207,6 +227,7 @@ extern "C" int pmmodel_load(const char *path, pm_model *out, char *err, size_t e
                 if (got != nterms)
                     return fail("'end' after " + std::to_string(got) + " terms; the header says " +
                                 std::to_string(nterms));
+                end_line = lineno;
                 state = DONE;
                 break;
             }
@@ -241,6 +262,7 @@ extern "C" int pmmodel_load(const char *path, pm_model *out, char *err, size_t e
                 nt.aux = (unsigned char)aux;
                 nt.param = param;
                 m.coef[got] = v;
+                term_line.push_back(lineno);
                 got++;
                 break;
             }
@@ -261,6 +283,7 @@ extern "C" int pmmodel_load(const char *path, pm_model *out, char *err, size_t e
             m.term[got].l = (signed char)l;
             m.term[got].m = (signed char)mm;
             m.coef[got] = v;
+            term_line.push_back(lineno);
             got++;
             break;
         }
@@ -268,14 +291,42 @@ extern "C" int pmmodel_load(const char *path, pm_model *out, char *err, size_t e
             return fail("text after 'end'");
         }
     }
-    if (in.bad())
-        return fail("read error");
+    if (in.bad()) {
+        set_err(err, errlen, std::string(path) + ": cannot read: " + std::strerror(errno));
+        return -1;
+    }
     if (state != DONE) {
         lineno++;
         return fail(state == HEADER ? "empty file; expected a pm model file"
                                     : "file ends before 'end' (truncated?)");
     }
     m.n_base = base < 0 ? (int)nterms : base;
+    // The harmonic terms must be the set pm_model_init makes for the order,
+    // in its order (pm.h: the first n_base terms are that set).
+    pm_model ref;
+    if (pm_model_init(&ref, mount, (int)order) != PM_OK) {
+        lineno = 0;
+        return fail("cannot build the order-" + std::to_string(order) + " term list");
+    }
+    for (int i = 0; i < ref.n_terms || i < m.n_base; i++) {
+        if (i >= m.n_base || i >= ref.n_terms) {
+            lineno = i < m.n_base ? term_line[i] : (i < m.n_terms ? term_line[i] : end_line);
+            return fail("the term list does not match 'order " + std::to_string(order) +
+                        "': the order-" + std::to_string(order) + " model has " +
+                        std::to_string(ref.n_terms) + " harmonic terms, the file " +
+                        std::to_string(m.n_base) + " (expected the term lines pmfit writes)");
+        }
+        const pm_term &a = m.term[i], &b = ref.term[i];
+        if (a.k != b.k || a.l != b.l || a.m != b.m) {
+            lineno = term_line[i];
+            return fail("term " + std::to_string(i + 1) + " is k l m = " + std::to_string(a.k) +
+                        " " + std::to_string(a.l) + " " + std::to_string(a.m) + ", expected " +
+                        name_of(&ref, i) + " = " + std::to_string(b.k) + " " +
+                        std::to_string(b.l) + " " + std::to_string(b.m) +
+                        ": the term list does not match 'order " + std::to_string(order) +
+                        "' (expected the term lines pmfit writes)");
+        }
+    }
     pm_status st = pm_model_prepare(&m);
     if (st != PM_OK) {
         set_err(err, errlen, std::string(path) + ": the terms do not form a valid model "

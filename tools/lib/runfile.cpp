@@ -11,6 +11,7 @@
 #include <cstring>
 #include <limits>
 #include <new>
+#include <unordered_map>
 
 namespace pmrun_detail {
 
@@ -238,8 +239,10 @@ double standard_pressure_hpa(double height_m) { return 1013.25 * std::exp(-heigh
 
 namespace {
 
-// Reads lines of at most PMRUN_MAX_LINE bytes through a fixed buffer; a
-// longer line is consumed to its end without being stored.
+// Reads lines of at most PMRUN_MAX_LINE bytes through a fixed buffer.  A
+// longer line is reported as soon as the limit is passed, without reading
+// its rest: the next call skips the rest (bounded time and memory when the
+// caller stops at the error, e.g. a 1 GB or endless line).
 class LineReader {
 public:
     enum Result { kLine, kEof, kTooLong, kIoError };
@@ -250,7 +253,8 @@ public:
     {
         line.clear();
         nul = false;
-        bool too_long = false, any = false;
+        if (!skip_rest()) return kIoError;
+        bool any = false;
         for (;;) {
             if (pos_ == len_ && !fill()) {
                 if (err_) return kIoError;
@@ -262,15 +266,16 @@ public:
             size_t avail = len_ - pos_;
             const char *nl = static_cast<const char *>(std::memchr(start, '\n', avail));
             size_t n = nl ? static_cast<size_t>(nl - start) : avail;
-            if (!too_long) {
-                // +1: room for the CR of a CRLF line end.
-                if (line.size() + n > static_cast<size_t>(PMRUN_MAX_LINE) + 1) {
-                    too_long = true;
-                    std::string().swap(line);
-                } else {
-                    line.append(start, n);
-                }
+            // +1: room for the CR of a CRLF line end.
+            if (line.size() + n > static_cast<size_t>(PMRUN_MAX_LINE) + 1) {
+                std::string().swap(line);
+                pos_ += nl ? n + 1 : n;
+                rest_ = nl == nullptr;
+                if (number_ == INT_MAX) return kIoError;
+                ++number_;
+                return kTooLong;
             }
+            line.append(start, n);
             pos_ += n;
             if (nl) {
                 ++pos_;
@@ -280,7 +285,7 @@ public:
         if (number_ == INT_MAX) return kIoError;
         ++number_;
         if (!line.empty() && line.back() == '\r') line.pop_back();
-        if (too_long || line.size() > static_cast<size_t>(PMRUN_MAX_LINE)) return kTooLong;
+        if (line.size() > static_cast<size_t>(PMRUN_MAX_LINE)) return kTooLong;
         nul = std::memchr(line.data(), '\0', line.size()) != nullptr;
         return kLine;
     }
@@ -289,6 +294,23 @@ public:
     bool io_error() const { return err_; }
 
 private:
+    // Skips what is left of a too-long line; false on a read error.
+    bool skip_rest()
+    {
+        while (rest_) {
+            if (pos_ == len_ && !fill()) {
+                rest_ = false;
+                return !err_;
+            }
+            const char *start = buf_.data() + pos_;
+            size_t avail = len_ - pos_;
+            const char *nl = static_cast<const char *>(std::memchr(start, '\n', avail));
+            pos_ += nl ? static_cast<size_t>(nl - start) + 1 : avail;
+            rest_ = nl == nullptr;
+        }
+        return true;
+    }
+
     bool fill()
     {
         if (eof_) return false;
@@ -306,6 +328,7 @@ private:
     std::vector<char> buf_;
     size_t pos_ = 0, len_ = 0;
     bool eof_ = false, err_ = false;
+    bool rest_ = false;   // the rest of a too-long line is still unread
     int number_ = 0;
 };
 
@@ -336,6 +359,122 @@ std::unique_ptr<FormatParser> detect(Context &ctx, int n, const std::string &lin
         return nullptr;
     }
     return make_tpoint_parser(ctx);
+}
+
+// Records that repeat an earlier one exactly (same encoder and apparent
+// readings and time): one warning, the fit goes on (docs/reliability.md).
+void check_duplicates(Context &ctx)
+{
+    struct Key {
+        double v[5];
+        bool operator==(const Key &o) const { return std::memcmp(v, o.v, sizeof v) == 0; }
+    };
+    struct Hash {
+        size_t operator()(const Key &k) const
+        {
+            size_t h = 1469598103934665603ULL;
+            const unsigned char *p = reinterpret_cast<const unsigned char *>(k.v);
+            for (size_t i = 0; i < sizeof k.v; ++i) h = (h ^ p[i]) * 1099511628211ULL;
+            return h;
+        }
+    };
+    const std::vector<pmrun_obs> &obs = ctx.run()->obs;
+    std::unordered_map<Key, int, Hash> seen;
+    seen.reserve(obs.size());
+    long repeats = 0;
+    int first = 0, first_of = 0;
+    for (const pmrun_obs &o : obs) {
+        Key k;
+        std::memset(&k, 0, sizeof k);   // -0.0 vs 0.0 and NaN payloads: as read
+        k.v[0] = o.enc_ha;
+        k.v[1] = o.enc_dec;
+        k.v[2] = o.app_ha;
+        k.v[3] = o.app_dec;
+        k.v[4] = std::isnan(o.time_h) ? 0.0 : o.time_h;
+        auto ins = seen.emplace(k, o.line);
+        if (ins.second) continue;
+        if (repeats++ == 0) {
+            first = o.line;
+            first_of = ins.first->second;
+        }
+    }
+    if (repeats > 0)
+        ctx.warn(first,
+                 "record repeats line %d exactly (%ld record%s repeat an earlier one): each counts "
+                 "as an independent measurement in the fit; if they are copies, remove them (the "
+                 "fit's errors assume independent points)",
+                 first_of, repeats, repeats == 1 ? "" : "s");
+}
+
+// One encoder convention per run (docs/formats.md, "Beyond the pole"): a
+// pier column must relate to the encoder declination the same way for all
+// records of a side, and the encoder axis 1 (beyond the pole turned back by
+// 180 deg) must be near the apparent one for every record as for the run.
+bool check_conventions(Context &ctx)
+{
+    const pmrun *run = ctx.run();
+    const std::vector<pmrun_obs> &obs = run->obs;
+    bool altaz = run->mount == PMRUN_MOUNT_ALTAZ;
+    const double half = kPi / 2;
+    if (!altaz) {
+        const pmrun_obs *side[2] = {nullptr, nullptr};   // first E, first W record
+        for (const pmrun_obs &o : obs) {
+            if (o.pier == PMRUN_PIER_UNKNOWN) continue;
+            const pmrun_obs *&f = side[o.pier == PMRUN_PIER_WEST ? 1 : 0];
+            if (!f) {
+                f = &o;
+                continue;
+            }
+            bool b0 = std::fabs(f->enc_dec) > half, b1 = std::fabs(o.enc_dec) > half;
+            if (b0 != b1) {
+                const char *p = o.pier == PMRUN_PIER_WEST ? "W" : "E";
+                return ctx.fail(o.line,
+                                "pier %s with encoder dec %.4g deg (%s) but line %d has pier %s with "
+                                "encoder dec %.4g deg (%s): mixed encoder conventions? expected one "
+                                "convention for the run (this reader's: beyond the pole, an encoder "
+                                "dec beyond +-90 deg)",
+                                p, o.enc_dec / kDeg, b1 ? "beyond the pole" : "within +-90", f->line,
+                                p, f->enc_dec / kDeg, b0 ? "beyond the pole" : "within +-90");
+            }
+        }
+    }
+    // Axis-1 offsets of the records away from the pole / zenith, where the
+    // axis-1 angle is well defined.
+    const double kMaxLat = 75 * kDeg, kMaxOffset = 60 * kDeg;
+    std::vector<double> off(obs.size(), nan());
+    double s = 0, c = 0;
+    for (size_t i = 0; i < obs.size(); ++i) {
+        const pmrun_obs &o = obs[i];
+        double a1 = o.enc_ha, a2 = o.enc_dec;
+        if (!altaz && std::fabs(a2) > half) {
+            a1 += kPi;
+            a2 = (a2 > 0 ? kPi : -kPi) - a2;
+        }
+        if (std::fabs(a2) > kMaxLat || std::fabs(o.app_dec) > kMaxLat) continue;
+        off[i] = std::remainder(a1 - o.app_ha, 2 * kPi);
+        s += std::sin(off[i]);
+        c += std::cos(off[i]);
+    }
+    double mean = std::atan2(s, c);
+    for (size_t i = 0; i < obs.size(); ++i) {
+        if (std::isnan(off[i]) || std::fabs(std::remainder(off[i] - mean, 2 * kPi)) <= kMaxOffset)
+            continue;
+        const pmrun_obs &o = obs[i];
+        if (altaz)
+            return ctx.fail(o.line,
+                            "encoder azimuth is %.1f deg from the star's azimuth here but %.1f deg "
+                            "on average over the run: mixed azimuth conventions? expected azimuths "
+                            "of one convention (north through east in column files) for the run",
+                            off[i] / kDeg, mean / kDeg);
+        return ctx.fail(o.line,
+                        "encoder hour angle is %.1f deg from the star's here but %.1f deg on average "
+                        "over the run (an encoder dec beyond +-90 taken as beyond the pole, HA turned "
+                        "by 180 deg): mixed encoder conventions? expected one convention for the run "
+                        "(beyond the pole: encoder dec beyond +-90 and encoder HA 180 deg from the "
+                        "star's)",
+                        off[i] / kDeg, mean / kDeg);
+    }
+    return true;
 }
 
 int read_file(Context &ctx)
@@ -391,6 +530,8 @@ int read_file(Context &ctx)
         return ctx.status();
     }
     if (!parser->finish(rd.number())) return ctx.status();
+    if (!check_conventions(ctx)) return ctx.status();
+    check_duplicates(ctx);
     ctx.finish_messages();
     return PMRUN_OK;
 }

@@ -221,7 +221,7 @@ private:
                     return ctx_.fail(n, "run line field %zu (%s) '%s': expected a whole number", i + 1,
                                      kRunFields[i], tok[i].c_str());
             double d1, d2;
-            if (std::fabs(v[3]) > 100000 ||
+            if (std::fabs(v[3]) > 100000 || std::fabs(v[4]) > 100000 || std::fabs(v[5]) > 100000 ||
                 eraCal2jd(static_cast<int>(v[3]), static_cast<int>(v[4]), static_cast<int>(v[5]),
                           &d1, &d2) != 0)
                 return ctx_.fail(n, "run line date %s %s %s is not a valid date, expected year month "
