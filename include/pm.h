@@ -237,7 +237,9 @@ pm_status pm_model_init(pm_model *m, int mount, int order);
 **  1) pm_model_init and pm_fit_solve leave the model prepared.  After
 **     changing coef[] or term[] directly, call this again: apply, invert
 **     and the fit return PM_ERR_STATE if any coefficient differs from the
-**     ones last prepared (never a silently stale model).
+**     ones last prepared, bit for bit (never a silently stale model).
+**  2) On error the model is left unprepared: every evaluation returns
+**     PM_ERR_STATE until a pm_model_prepare succeeds.
 */
 pm_status pm_model_prepare(pm_model *m);
 
@@ -684,6 +686,8 @@ pm_status pm_fit_covariance(const pm_fit *fit, const pm_fit_result *res,
 **     exposed so that a caller can check the solver against another one.
 **     Both components are in the frame transported by the isotropic
 **     rotation (docs/model.md), so chi^2 is the same as in the sky frame.
+**  2) PM_ERR_NONFINITE also when the terms overflow at this observation
+**     (row0, row1 and r are then overwritten with meaningless values).
 */
 pm_status pm_fit_row(const pm_model *m, const pm_context *ctx,
                      double enc_ha, double enc_dec,

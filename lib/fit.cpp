@@ -528,6 +528,8 @@ pm_status pm_fit_row(const pm_model *m, const pm_context *ctx, double enc_ha,
         !finite(app_dec))
         return PM_ERR_NONFINITE;
     rows(m, ctx, enc_ha, enc_dec, app_ha, app_dec, row0, row1, r);
+    if (!finite(r[0]) || !finite(r[1]))
+        return PM_ERR_NONFINITE; /* the terms overflow here */
     return PM_OK;
 }
 

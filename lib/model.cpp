@@ -393,6 +393,7 @@ pm_status pm_model_prepare(pm_model *m)
 {
     if (!m)
         return PM_ERR_ARG;
+    m->prepared = 0; /* a refused model cannot be evaluated (PM_ERR_STATE) */
     if (m->mount != PM_MOUNT_EQUATORIAL && m->mount != PM_MOUNT_ALTAZ)
         return PM_ERR_ARG;
     if (m->order < 0 || m->order > PM_MAX_L)
@@ -641,6 +642,8 @@ pm_status pm_model_residual(const pm_model *m, const pm_context *ctx,
     double a = dot(q, e1), b = dot(q, e2);
     double s = m_sqrt(a * a + b * b);
     double f = s > 0 ? m_atan2(s, dot(p, q)) / s : 1.0;
+    if (!finite(a * f) || !finite(b * f))
+        return PM_ERR_NONFINITE; /* overflow in the terms: res untouched */
     res[0] = a * f;
     res[1] = b * f;
     return PM_OK;

@@ -359,7 +359,8 @@ pm_status pm_model_apply_f(const pm_model_f *m, const pm_context *ctx, double en
     if (!finite(t) || !finite(d))
         return PM_ERR_NONFINITE; /* float overflow in the terms: outputs untouched */
     *app_ha = t;
-    *app_dec = d;
+    /* float rounding can step past the pole by an ulp of float */
+    *app_dec = d > PI / 2 ? PI / 2 : d < -PI / 2 ? -PI / 2 : d;
     return PM_OK;
 }
 

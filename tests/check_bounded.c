@@ -246,16 +246,21 @@ static void check_apply(const pm_model *m, const pm_model_f *mf, const pm_contex
     ck_assert_uint_le(probe_count, 1);
     if (probe_count > s->worst_apply)
         s->worst_apply = probe_count;
-    if (st >= 0)
+    if (st >= 0) {
         ck_assert_msg(isfinite(ah) && isfinite(ad), "pm_model_apply: status %d, nonfinite "
                       "output at %g %g", (int)st, h, d);
+        ck_assert(ah > -M_PI && ah <= M_PI && fabs(ad) <= M_PI / 2);
+    }
     if (mf) {
         probe_count = 0;
         st = pm_model_apply_f(mf, ctx, h, d, &ah, &ad);
         note(s, st);
         ck_assert_uint_le(probe_count, 1);
-        if (st >= 0)
+        if (st >= 0) {
             ck_assert_msg(isfinite(ah) && isfinite(ad), "pm_model_apply_f: nonfinite");
+            ck_assert_msg(fabs(ad) <= M_PI / 2, "pm_model_apply_f: dec %.17g beyond the pole",
+                          ad);
+        }
     }
 }
 
@@ -343,6 +348,38 @@ START_TEST(test_bounded_nonfinite_inputs)
 }
 END_TEST
 
+/* Terms that overflow make the residual an error too (res untouched), and a
+** model pm_model_prepare refused cannot be evaluated. */
+START_TEST(test_bounded_overflow_and_refused_model)
+{
+    pm_model m;
+    pm_term t;
+    double res[2] = {7, 7}, h, d;
+    int i;
+    ck_assert_int_eq(pm_model_init(&m, PM_MOUNT_EQUATORIAL, 1), PM_OK);
+    for (i = 6; i < m.n_terms; i++)
+        m.coef[i] = 1e300;
+    ck_assert_int_eq(pm_model_prepare(&m), PM_OK);
+    ck_assert_int_eq(pm_model_residual(&m, NULL, 0.3, 0.3, 0.3, 0.3, res), PM_ERR_NONFINITE);
+    ck_assert(res[0] == 7 && res[1] == 7);
+    ck_assert_int_eq(pm_model_apply(&m, NULL, 0.3, 0.3, &h, &d), PM_ERR_NONFINITE);
+    /* an added term edited into an invalid one: prepare refuses, and then
+    ** every evaluation says PM_ERR_STATE instead of reading the bad term */
+    ck_assert_int_eq(pm_model_init(&m, PM_MOUNT_EQUATORIAL, 1), PM_OK);
+    memset(&t, 0, sizeof t);
+    t.kind = PM_TERM_SH;
+    t.k = 3;
+    t.l = 1;
+    t.m = 1;
+    t.side = -1;
+    ck_assert_int_eq(pm_model_add_term(&m, &t, 1e-4, NULL), PM_OK);
+    m.term[m.n_terms - 1].l = 100;
+    ck_assert_int_eq(pm_model_prepare(&m), PM_ERR_ARG);
+    ck_assert_int_eq(pm_model_apply(&m, NULL, 0.3, 0.3, &h, &d), PM_ERR_STATE);
+    ck_assert_int_eq(pm_model_invert(&m, NULL, 0.3, 0.3, 0, &h, &d), PM_ERR_STATE);
+}
+END_TEST
+
 static Suite *suite(void)
 {
     Suite *s = suite_create("bounded");
@@ -352,6 +389,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_bounded_large);
     tcase_add_test(tc, test_bounded_huge);
     tcase_add_test(tc, test_bounded_nonfinite_inputs);
+    tcase_add_test(tc, test_bounded_overflow_and_refused_model);
     suite_add_tcase(s, tc);
     return s;
 }
