@@ -1,0 +1,143 @@
+/*
+**  harness_modelfile.c - fuzz target body: the bytes as a model file read by
+**  pmmodel_load; a model that loads is evaluated (apply, invert), saved,
+**  emitted as C and loaded again, which must give the same model bit for
+**  bit.
+*/
+#ifndef _GNU_SOURCE
+#define _GNU_SOURCE
+#endif
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "pm.h"
+#include "modelfile.h"
+#include "harness.h"
+#include "fz_input.h"
+#include "fz_file.h"
+
+/* Round trip apply(invert(x)) promised by pm_model_invert with PM_OK, plus
+** the rounding of going from vectors to angles and back (a few 1e-16). */
+#define MF_TOL_ROUNDTRIP (PM_INVERT_TOL + 1e-14)
+
+static int mf_same(const pm_model *a, const pm_model *b)
+{
+    int i;
+    if (a->mount != b->mount || a->order != b->order || a->n_terms != b->n_terms ||
+        a->n_base != b->n_base || a->latitude != b->latitude)
+        return pmfz_fail("modelfile: reloaded header differs (mount %d/%d order %d/%d terms "
+                         "%d/%d base %d/%d latitude %.17g/%.17g)", a->mount, b->mount, a->order,
+                         b->order, a->n_terms, b->n_terms, a->n_base, b->n_base, a->latitude,
+                         b->latitude);
+    for (i = 0; i < a->n_terms; i++) {
+        const pm_term *s = &a->term[i], *t = &b->term[i];
+        if (memcmp(&a->coef[i], &b->coef[i], sizeof(double)) != 0)
+            return pmfz_fail("modelfile: reloaded coefficient %d is %.17g, saved %.17g", i,
+                             b->coef[i], a->coef[i]);
+        if (s->kind != t->kind || s->k != t->k || s->l != t->l || s->m != t->m ||
+            s->side != t->side || s->aux != t->aux ||
+            (i >= a->n_base && memcmp(&s->param, &t->param, sizeof(double)) != 0))
+            return pmfz_fail("modelfile: reloaded term %d differs", i);
+    }
+    return 0;
+}
+
+/* Evaluate a loaded (prepared) model at a few positions. */
+static int mf_evaluate(const pm_model *m)
+{
+    static const double pos[][2] = {
+        {0.3, 0.7}, {-2.5, -1.2}, {3.0, 1.5}, {1.0, 0.0}, {-0.5, 2.2}, {0.0, M_PI / 2}};
+    static const int apply_ok[] = {PM_OK, 99};
+    static const int inv_ok[] = {PM_OK, PM_WARN_NOT_CONVERGED, PM_WARN_UNREACHABLE, 99};
+    pm_context ctx;
+    size_t i;
+    if (!pmfz_sane_model(m) || !pmfz_plain_model(m)) { /* fz_input.h: statuses only */
+        static const int apply_st[] = {PM_OK, PM_ERR_NONFINITE, 99}; /* overflow */
+        double t, d;
+        memset(&ctx, 0, sizeof ctx);
+        if (!pmfz_status_in(pm_model_apply(m, &ctx, 0.3, 0.7, &t, &d), apply_st))
+            return pmfz_fail("modelfile: apply of a loaded model failed");
+        return 0;
+    }
+    memset(&ctx, 0, sizeof ctx);
+    ctx.temp_c = 12.5;
+    ctx.time_h = 3.25;
+    ctx.dir = 1;
+    for (i = 0; i < sizeof pos / sizeof pos[0]; i++) {
+        double t = 9, d = 9, et = 9, ed = 9, rt, rd;
+        int side;
+        pm_status st = pm_model_apply(m, &ctx, pos[i][0], pos[i][1], &t, &d);
+        if (!pmfz_status_in(st, apply_ok) || !pmfz_finite(t) || !pmfz_finite(d))
+            return pmfz_fail("modelfile: apply of a loaded model at (%g, %g): status %d, "
+                             "(%g, %g)", pos[i][0], pos[i][1], st, t, d);
+        side = i & 1 ? PM_SIDE_FLIPPED : PM_SIDE_NORMAL;
+        st = pm_model_invert(m, &ctx, t, d, side, &et, &ed);
+        if (!pmfz_status_in(st, inv_ok))
+            return pmfz_fail("modelfile: invert of a loaded model: status %d", st);
+        if (st == PM_OK) {
+            double miss;
+            if (!pmfz_finite(et) || !pmfz_finite(ed))
+                return pmfz_fail("modelfile: invert PM_OK with (%g, %g)", et, ed);
+            if (pm_model_apply(m, &ctx, et, ed, &rt, &rd) != PM_OK)
+                return pmfz_fail("modelfile: apply of the inverse failed");
+            miss = pmfz_sep(rt, rd, t, d);
+            if (!(miss <= MF_TOL_ROUNDTRIP))
+                return pmfz_fail("modelfile: invert PM_OK but round trip misses by %g rad", miss);
+        }
+    }
+    return 0;
+}
+
+int pmfz_modelfile(const unsigned char *data, size_t size)
+{
+    pm_model m, before, again;
+    char path[64], err[512], out[128], hdr[128];
+    const char *dir;
+    int fd, r, bad = 0;
+
+    if (pmmodel_load(NULL, &m, err, sizeof err) != -1)
+        return pmfz_fail("modelfile: pmmodel_load(NULL) accepted");
+    fd = pmfz_memfile(data, size, path, sizeof path);
+    if (fd < 0)
+        return 0;
+    if (pmmodel_load(path, NULL, err, sizeof err) != -1) {
+        close(fd);
+        return pmfz_fail("modelfile: pmmodel_load(path, NULL) accepted");
+    }
+    memset(&m, 0xA5, sizeof m);
+    before = m;
+    memset(err, 'x', sizeof err);
+    r = pmmodel_load(path, &m, err, sizeof err);
+    close(fd);
+    if (r != 0) {
+        if (r != -1)
+            return pmfz_fail("modelfile: pmmodel_load returned %d", r);
+        if (memcmp(&m, &before, sizeof m) != 0)
+            return pmfz_fail("modelfile: failed load changed the model");
+        if (!memchr(err, '\0', sizeof err) || strncmp(err, path, strlen(path)) != 0)
+            return pmfz_fail("modelfile: error message '%.80s' does not name the file", err);
+        return 0;
+    }
+    bad = mf_evaluate(&m);
+    if (bad)
+        return bad;
+
+    dir = pmfz_scratch();
+    if (!dir)
+        return 0;
+    snprintf(out, sizeof out, "%s/model.pm", dir);
+    snprintf(hdr, sizeof hdr, "%s/model.h", dir);
+    if (pmmodel_save(out, &m, "fuzz\nround trip", err, sizeof err) != 0)
+        bad = pmfz_fail("modelfile: saving a loaded model failed: %s", err);
+    else if (pmmodel_load(out, &again, err, sizeof err) != 0)
+        bad = pmfz_fail("modelfile: reloading a saved model failed: %s", err);
+    else
+        bad = mf_same(&m, &again);
+    if (!bad && pmmodel_emit_c(hdr, &m, "pm_fz", "fuzz", err, sizeof err) != 0)
+        bad = pmfz_fail("modelfile: emitting C for a loaded model failed: %s", err);
+    unlink(out);
+    unlink(hdr);
+    return bad;
+}

@@ -1,0 +1,75 @@
+#!/bin/sh
+# make_corpus.sh - (re)make the seed corpora in fuzz/corpus/ from the
+# repository's own files (tests/data, examples) and fixed pseudo-random
+# bytes.  Run from the top of the repository after `make` (it uses
+# build/pmfit to write model files):   sh fuzz/make_corpus.sh [BUILD_DIR]
+# Nothing from ../shared/data is copied (licences); make fuzz adds those
+# files at run time when the directory exists.
+set -e
+B=${1:-build}
+C=fuzz/corpus
+rm -rf $C
+mkdir -p $C/runfile $C/modelfile $C/capi $C/fit
+
+# ---- run files: one option byte (fuzz/harness_runfile.c), then the file.
+opt() { # opt BYTE SRC NAME
+    { printf "\\$(printf '%03o' "$1")"; cat "$2"; } > $C/runfile/$3
+}
+for f in tests/data/*.dat; do
+    opt 0 "$f" "$(basename "$f" .dat)"
+done
+head -n 12 examples/sim_gem.dat > $B/sim_gem_head.dat
+opt 0 $B/sim_gem_head.dat sim_gem_head
+opt 1 tests/data/bad_records_skip.dat skip_bad_records          # skip_bad
+opt 1 tests/data/bad_all_skipped.dat skip_bad_all               # skip_bad
+opt 2 tests/data/tpoint_equat.dat no_refraction                 # refraction off
+opt 4 tests/data/tpoint_weather.dat override_plausible          # overrides
+opt 8 tests/data/tpoint_south.dat override_absurd
+opt 12 tests/data/tpoint_nomet.dat override_extreme
+opt 48 tests/data/bad_minutes.dat err_17_bytes                 # 17-byte error buffer
+opt 32 tests/data/bad_ra_hours.dat err_1_byte
+opt 16 tests/data/bad_first_line.dat err_null
+printf '\101# tau delta T D\n1 2 3 4\n5 6 \001 8\n' > $C/runfile/long_line_skip   # 0x41: 70000-digit field
+printf '\201# tau delta T D\n1 2 x 4\n' > $C/runfile/repeat_skip_messages          # 0x81: 1001 copies
+printf '\000\357\273\277# tau delta T D\r\n1 2 3 4\r\n5 6 7 8\r\n' > $C/runfile/bom_crlf
+
+# ---- model files: written by pmfit, and by hand.
+$B/pmfit fit examples/sim_gem.dat --order 0 --save $C/modelfile/order0.pm > /dev/null
+$B/pmfit fit examples/sim_gem.dat --order 1 --add ha_periodic:144 --add refraction \
+    --add temperature --add hysteresis --add 'i@W' --add ha_periodic_paper:2 --save $C/modelfile/order1_physical.pm > /dev/null
+cat > $C/modelfile/altaz_latitude.pm <<'MODEL'
+# by hand: an alt-az model with a latitude, comments and blank lines
+pm-model 1
+mount altaz
+order 0
+latitude 0.55301
+
+terms 8
+term a 1 0 0 1e-4
+term b 2 0 0 -2e-4
+term c' 3 0 0 0.001
+term d 4 0 0 0
+term e' 5 0 0 -0.0005
+term i 6 0 0 3.5e-05
+xterm cot(el) zenith 0 0 0 0 0 0 1e-5
+xterm c'*aux1 aux 3 0 0 1 4 0.5 -2e-6
+end
+MODEL
+printf 'pm-model 1\r\nmount equatorial\r\norder 0\r\nterms 6\r\nterm a 1 0 0 0\r\nterm b 2 0 0 0\r\nterm c 3 0 0 0\r\nterm d 4 0 0 0\r\nterm e 5 0 0 0\r\nterm i 6 0 0 0\r\nend\r\n' \
+    > $C/modelfile/crlf_zero.pm
+
+# ---- the API targets: fixed pseudo-random bytes (the harnesses read any
+# bytes; these only give the fuzzer a start of several lengths).
+python3 - "$C" <<'PY'
+import random, sys
+c = sys.argv[1]
+r = random.Random(2026)
+for target, lens in (("capi", (24, 64, 128, 256, 512, 1024)), ("fit", (48, 160, 400, 800, 1600))):
+    for n in lens:
+        b = bytearray(r.getrandbits(8) for _ in range(n))
+        if target == "capi":
+            b[0], b[1] = n % 2, 3   # a valid mount, order 1
+        with open("%s/%s/seed_%d" % (c, target, n), "wb") as f:
+            f.write(bytes(b))
+PY
+du -sh $C/*
