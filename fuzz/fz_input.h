@@ -198,8 +198,9 @@ static inline double pmfz_sep(double t1, double d1, double t2, double d2)
 **     interval (the side, the sign of cos(enc_dec - e'), is right);
 **   - pm_fit_add accepts a residual whose square overflows (models with
 **     coefficients near 1e300); pm_fit_solve then gives PM_OK with
-**     chi2 = sigma = inf, or PM_ERR_NONFINITE (not among its documented
-**     statuses) when the step overflows.
+**     chi2 = sigma = inf (and pm_fit_covariance then +-inf), or
+**     PM_ERR_NONFINITE (not among its documented statuses) when the step
+**     overflows.
 ** Plain evaluations (within the same bounds, whatever the switch) must
 ** also give PM_OK where PM_ERR_NONFINITE (overflow) is allowed.  Build
 ** with -DPMFZ_CORE_OPEN_ISSUES=0 (make fuzz B=build-strict

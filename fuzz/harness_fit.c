@@ -47,6 +47,7 @@ static struct {
     pm_model truth, model, out, snap_model;
     pm_fit fit, snap_fit;
     pm_fit_result res, snap_res;
+    int res_sane; /* ft.res comes from a sane linearisation point */
     ft_obs obs[FT_MAX_OBS];
     double eh[FT_MAX_OBS], ed[FT_MAX_OBS], ah[FT_MAX_OBS], ad[FT_MAX_OBS];
     pm_context ctxs[FT_MAX_OBS];
@@ -185,8 +186,10 @@ static int ft_solve(int *solved)
     if (ft_model_ok(&ft.out, "fit_solve"))
         return 1;
     ft.res = res;
-    if (ft.res.accepted)
+    if (ft.res.accepted) {
         *solved = 1;
+        ft.res_sane = sane;
+    }
     if (ft.res.accepted && sane) {
         if (!pmfz_finite(ft.res.chi2) || ft.res.chi2 < 0 || !pmfz_finite(ft.res.sigma) ||
             ft.res.sigma < 0 || ft.res.n_par != ft.fit.n_par)
@@ -214,8 +217,9 @@ static int ft_cov(pmfz_in *in, int solved)
     }
     if (i < 0 || j < 0 || i >= n || j >= n)
         return pmfz_fail("covariance: PM_OK for (%d, %d) of %d", i, j, n);
-    if (!pmfz_finite(cov) || !pmfz_finite(corr) || !(fabs(corr) <= 1 + FT_CORR_SLACK) ||
-        (i == j && cov < 0))
+    /* fz_input.h, PMFZ_CORE_OPEN_ISSUES: sigma = inf after chi2 overflowed */
+    if ((ft.res_sane && !pmfz_finite(cov)) || !pmfz_finite(corr) ||
+        !(fabs(corr) <= 1 + FT_CORR_SLACK) || (i == j && cov < 0))
         return pmfz_fail("covariance: (%d, %d) cov %g corr %g", i, j, cov, corr);
     return 0;
 }
@@ -289,6 +293,7 @@ int pmfz_fit(const unsigned char *data, size_t size)
     if (st != PM_OK)
         return pmfz_fail("fit_init of a prepared model gave %d", st);
     memset(&ft.res, 0, sizeof ft.res);
+    ft.res_sane = 1;
     for (ops = 0; ops < FT_MAX_OPS && !r; ops++) {
         unsigned op = pmfz_u8(&in) % 8u;
         if (!pmfz_left(&in))
