@@ -18,10 +18,7 @@
 #include <string.h>
 
 #include "pm.h"
-
-#ifndef M_PI
-#define M_PI 3.14159265358979323846
-#endif
+#include "../tests/testutil.h"
 
 /* The bytes still to be read.  Past the end every read gives 0. */
 typedef struct pmfz_in {
@@ -170,19 +167,9 @@ static inline int pmfz_status_in(pm_status st, const int *allowed)
     return 0;
 }
 
-/* Angle between two (axis 1, axis 2) directions, accurate when small. */
-static inline double pmfz_sep(double t1, double d1, double t2, double d2)
-{
-    double a[3], b[3], c[3], s, cs;
-    a[0] = cos(d1) * cos(t1); a[1] = cos(d1) * sin(t1); a[2] = sin(d1);
-    b[0] = cos(d2) * cos(t2); b[1] = cos(d2) * sin(t2); b[2] = sin(d2);
-    c[0] = a[1] * b[2] - a[2] * b[1];
-    c[1] = a[2] * b[0] - a[0] * b[2];
-    c[2] = a[0] * b[1] - a[1] * b[0];
-    s = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-    cs = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    return atan2(s, cs);
-}
+/* Angle between two (axis 1, axis 2) directions, accurate when small: the
+** test suites' tu_angle. */
+#define pmfz_sep tu_angle
 
 
 /* Open issues of the core that the fuzzer found (fuzz/README.md,

@@ -38,6 +38,7 @@
 #include "modelfile.h"
 #include "testutil.h"
 #include "tu_tool.h"
+#include "tu_runfile.h"
 
 /* Two fits of the same points, one with some hour angles written 360 deg
 ** apart, agree to rounding. */
@@ -215,25 +216,6 @@ static void pmfit_eval_fails(const char *model, const char *run, int rc, const c
     outputs_unchanged();
 }
 
-/* pmrun_read(path) must fail with status, an error starting "path:LINE: "
-** (line 0: "path: ") and holding needle, and return no run. */
-static void read_fails(const char *path, const pmrun_options *opt, int status, int line,
-                       const char *needle)
-{
-    char err[2048], where[600];
-    pmrun *run = (pmrun *)err; /* anything but NULL: must come back NULL */
-    int st = pmrun_read(path, opt, &run, err, sizeof err);
-    ck_assert_msg(st == status, "%s: status %d, expected %d (%s)", path, st, status, err);
-    ck_assert_ptr_null(run);
-    if (line > 0)
-        snprintf(where, sizeof where, "%s:%d: ", path, line);
-    else
-        snprintf(where, sizeof where, "%s: ", path);
-    ck_assert_msg(strncmp(err, where, strlen(where)) == 0, "error '%s' does not start with '%s'",
-                  err, where);
-    ck_assert_msg(strstr(err, needle) != NULL, "error '%s' lacks '%s'", err, needle);
-}
-
 static pmrun *read_ok(const char *path, const pmrun_options *opt)
 {
     char err[2048];
@@ -405,17 +387,17 @@ START_TEST(test_badinput_nonfinite_four_column)
             write_four(path, o, 30, 7, f, NONFINITE[t]);
             snprintf(needle, sizeof needle, "field %d (%s) '%s': NaN/Inf is not accepted", f + 1,
                      names[f], NONFINITE[t]);
-            read_fails(path, NULL, PMRUN_ERR_FORMAT, 9, needle);
+            tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 9, needle);
             if (t == 0)
                 pmfit_fit_fails(path, "", 1, 9, "NaN/Inf is not accepted");
         }
     /* the committed example (bad_nan.dat: 'nan' as the 2nd field of line 2) */
     data_path(path, sizeof path, "bad_nan.dat");
-    read_fails(path, NULL, PMRUN_ERR_FORMAT, 2, "field 2 (delta) 'nan': NaN/Inf");
+    tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 2, "field 2 (delta) 'nan': NaN/Inf");
     pmfit_fit_fails(path, "", 1, 2, "NaN/Inf is not accepted");
     /* a number too big for a double is no way round it */
     data_path(path, sizeof path, "bad_overflow.dat");
-    read_fails(path, NULL, PMRUN_ERR_FORMAT, 2, "number out of range");
+    tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 2, "number out of range");
 }
 END_TEST
 
@@ -440,7 +422,7 @@ START_TEST(test_badinput_nonfinite_named_columns)
         else
             snprintf(needle, sizeof needle, "field %d (%s) '%s': NaN/Inf is not accepted", f + 1,
                      names[f], f % 2 ? "inf" : "nan");
-        read_fails(path, NULL, PMRUN_ERR_FORMAT, 7, needle);
+        tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 7, needle);
         pmfit_fit_fails(path, "", 1, 7, needle);
     }
     /* '-' is the way to say "no value" in the extra columns */
@@ -488,8 +470,8 @@ START_TEST(test_badinput_nonfinite_tpoint_equatorial)
     for (f = 0; f < 15; f++) {
         write_tpoint_eq(path, -1, f, f % 2 ? "Inf" : "nan");
         snprintf(needle, sizeof needle, "field %d (", f + 1);
-        read_fails(path, NULL, PMRUN_ERR_FORMAT, 4, needle);
-        read_fails(path, NULL, PMRUN_ERR_FORMAT, 4, "NaN/Inf is not accepted");
+        tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 4, needle);
+        tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 4, "NaN/Inf is not accepted");
         if (f == 0 || f == 14)
             pmfit_fit_fails(path, "", 1, 4, "NaN/Inf is not accepted");
     }
@@ -497,13 +479,13 @@ START_TEST(test_badinput_nonfinite_tpoint_equatorial)
         /* (a run line starts with a number or sign: "NAN" first is a caption) */
         write_tpoint_eq(path, f, -1, f % 2 ? "NAN" : "-inf");
         snprintf(needle, sizeof needle, "run line field %d (", f + 1);
-        read_fails(path, NULL, PMRUN_ERR_FORMAT, 3, needle);
-        read_fails(path, NULL, PMRUN_ERR_FORMAT, 3, "NaN/Inf is not accepted");
+        tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 3, needle);
+        tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 3, "NaN/Inf is not accepted");
     }
     pmfit_fit_fails(path, "", 1, 3, "run line field 12");
     /* the committed example: -Inf as the raw RA seconds */
     data_path(path, sizeof path, "bad_inf.dat");
-    read_fails(path, NULL, PMRUN_ERR_FORMAT, 4, "field 9 (raw RA seconds) '-Inf'");
+    tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 4, "field 9 (raw RA seconds) '-Inf'");
 }
 END_TEST
 
@@ -523,8 +505,8 @@ START_TEST(test_badinput_nonfinite_tpoint_altaz)
         strcat(text, "\n90.0 45.0 90.1 45.02\nEND\n");
         write_text(path, text);
         snprintf(needle, sizeof needle, "field %d (", f + 1);
-        read_fails(path, NULL, PMRUN_ERR_FORMAT, 4, needle);
-        read_fails(path, NULL, PMRUN_ERR_FORMAT, 4, "NaN/Inf is not accepted");
+        tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 4, needle);
+        tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 4, "NaN/Inf is not accepted");
         pmfit_fit_fails(path, "", 1, 4, "NaN/Inf is not accepted");
     }
 }
@@ -646,7 +628,7 @@ START_TEST(test_badinput_angles_out_of_range)
         } else {
             data_path(path, sizeof path, cases[i].data);
         }
-        read_fails(path, NULL, PMRUN_ERR_FORMAT, cases[i].line, cases[i].needle);
+        tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, cases[i].line, cases[i].needle);
         pmfit_fit_fails(path, "", 1, cases[i].line, cases[i].needle);
     }
 }
@@ -866,10 +848,10 @@ START_TEST(test_badinput_mixed_conventions_unflipped_ha)
     ck_assert_int_ge(k, 0);
     tmp_path(path, sizeof path, "unflipped.dat");
     write_four(path, o, 60, -1, -1, NULL);
-    read_fails(path, NULL, PMRUN_ERR_FORMAT, k + 2, "mixed encoder conventions?");
+    tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, k + 2, "mixed encoder conventions?");
     pmrun_options_default(&opt);
     opt.skip_bad = 1;
-    read_fails(path, &opt, PMRUN_ERR_FORMAT, k + 2, "encoder hour angle is ");
+    tu_read_fails(path, &opt, PMRUN_ERR_FORMAT, k + 2, "encoder hour angle is ");
     pmfit_fit_fails(path, "", 1, k + 2, "mixed encoder conventions?");
     pmfit_fit_fails(path, "--skip-bad", 1, k + 2, "mixed encoder conventions?");
 }
@@ -901,8 +883,8 @@ START_TEST(test_badinput_mixed_conventions_pier_column)
     ck_assert_int_ge(k, 0);
     write_named(path, o, 60, 1, -1, -1, NULL);
     snprintf(needle, sizeof needle, "but line %d has pier W", first_w + 3);
-    read_fails(path, NULL, PMRUN_ERR_FORMAT, k + 3, needle);
-    read_fails(path, NULL, PMRUN_ERR_FORMAT, k + 3, "mixed encoder conventions?");
+    tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, k + 3, needle);
+    tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, k + 3, "mixed encoder conventions?");
     pmfit_fit_fails(path, "", 1, k + 3, "mixed encoder conventions?");
     /* the whole run in the folded convention with a pier column is one
     ** convention: read (each side can be fitted, --pier split) */
@@ -930,7 +912,7 @@ START_TEST(test_badinput_mixed_conventions_azimuth)
                      "300 20 300.1 20.1\n"
                      "120 35 -59.9 35.1\n" /* the star's azimuth from the south */
                      "250 45 250.1 45.0\n");
-    read_fails(path, NULL, PMRUN_ERR_FORMAT, 7, "mixed azimuth conventions?");
+    tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 7, "mixed azimuth conventions?");
     pmfit_fit_fails(path, "--order 0", 1, 7, "mixed azimuth conventions?");
 }
 END_TEST
@@ -975,10 +957,10 @@ START_TEST(test_badinput_empty_file)
     char path[256];
     data_path(path, sizeof path, "bad_empty.dat");
     make_tmpdir();
-    read_fails(path, NULL, PMRUN_ERR_FORMAT, 0, "empty file");
+    tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 0, "empty file");
     pmfit_fit_fails(path, "", 1, 0, "empty file");
     data_path(path, sizeof path, "bad_blank.dat");
-    read_fails(path, NULL, PMRUN_ERR_FORMAT, 3, "only blank lines");
+    tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 3, "only blank lines");
     pmfit_fit_fails(path, "", 1, 3, "only blank lines");
 }
 END_TEST
@@ -988,10 +970,10 @@ START_TEST(test_badinput_comments_only)
     char path[256];
     data_path(path, sizeof path, "bad_comments_only.dat");
     make_tmpdir();
-    read_fails(path, NULL, PMRUN_ERR_FORMAT, 3, "no records");
+    tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 3, "no records");
     pmfit_fit_fails(path, "", 1, 3, "no records");
     data_path(path, sizeof path, "bad_tpoint_no_records.dat");
-    read_fails(path, NULL, PMRUN_ERR_FORMAT, 4, "no records after the run line");
+    tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 4, "no records after the run line");
 }
 END_TEST
 
@@ -1052,7 +1034,7 @@ START_TEST(test_badinput_1gb_line)
     ck_assert_int_eq((int)write(fd, head, sizeof head - 1), (int)(sizeof head - 1));
     ck_assert_int_eq(ftruncate(fd, (off_t)1 << 30), 0);
     ck_assert_int_eq(close(fd), 0);
-    read_fails(path, NULL, PMRUN_ERR_FORMAT, 3, "line too long (more than 65536 bytes)");
+    tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 3, "line too long (more than 65536 bytes)");
     pmfit_fit_fails(path, "", 1, 3, "line too long");
     ck_assert_int_eq(unlink(path), 0);
     /* a model file: the header, then the 1 GiB line */
@@ -1124,7 +1106,7 @@ static long endless_pipe(const char *fifo, const char *head, int (*reader)(const
 
 static int read_run_too_long(const char *path)
 {
-    read_fails(path, NULL, PMRUN_ERR_FORMAT, 3, "line too long");
+    tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 3, "line too long");
     return 1;
 }
 
@@ -1442,7 +1424,7 @@ START_TEST(test_badinput_cli_unwritable_output)
     /* the run file itself */
     snprintf(args, sizeof args, "%s/missing.dat", tmpdir);
     pmfit_fit_fails(args, "", 1, 0, "cannot open: No such file or directory");
-    read_fails(args, NULL, PMRUN_ERR_IO, 0, "cannot open");
+    tu_read_fails(args, NULL, PMRUN_ERR_IO, 0, "cannot open");
     pmfit_fit_fails(tmpdir, "", 1, 1, "read error: Is a directory");
     pmfit_eval_fails(tmpdir, path, 1, tmpdir, "cannot read: Is a directory");
 }

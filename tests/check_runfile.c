@@ -18,6 +18,7 @@
 #include <unistd.h>
 
 #include "runfile.h"
+#include "tu_runfile.h"
 #include "ref/runfile_reduction_ref.h"
 
 #define PI 3.14159265358979323846
@@ -53,30 +54,11 @@ static pmrun *read_ok(const char *name, const pmrun_options *opt)
     return run;
 }
 
-/* Expects pmrun_read(path) to fail with `status`, an error beginning
-** "path:LINE: " (line 0: "path: ") and containing `needle`, and *out NULL. */
-static void expect_error_at(const char *path, const pmrun_options *opt, int status, int line,
-                            const char *needle)
-{
-    char err[1024], where[4200];
-    pmrun *run = (pmrun *)err; /* anything but NULL: must come back NULL */
-    int st = pmrun_read(path, opt, &run, err, sizeof err);
-    ck_assert_msg(st == status, "%s: status %d, expected %d (%s)", path, st, status, err);
-    ck_assert_ptr_null(run);
-    if (line > 0)
-        snprintf(where, sizeof where, "%s:%d: ", path, line);
-    else
-        snprintf(where, sizeof where, "%s: ", path);
-    ck_assert_msg(strncmp(err, where, strlen(where)) == 0, "error '%s' does not start with '%s'",
-                  err, where);
-    ck_assert_msg(strstr(err, needle) != NULL, "error '%s' lacks '%s'", err, needle);
-}
-
 static void expect_error(const char *name, int line, const char *needle)
 {
     char path[4096];
     data_path(path, sizeof path, name);
-    expect_error_at(path, NULL, PMRUN_ERR_FORMAT, line, needle);
+    tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, line, needle);
 }
 
 /* Index of the first warning containing both strings, -1 if none. */
@@ -507,7 +489,7 @@ START_TEST(test_pmrun_read_pressure_absurd)
     pmrun *run;
     data_path(path, sizeof path, "tpoint_pressure_absurd.dat");
     /* refraction requested: an error */
-    expect_error_at(path, NULL, PMRUN_ERR_FORMAT, 3, "pressure 5000 mbar is absurd");
+    tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 3, "pressure 5000 mbar is absurd");
     /* no refraction: only a warning */
     pmrun_options_default(&o);
     o.refraction = 0;
@@ -575,7 +557,7 @@ END_TEST
 
 START_TEST(test_pmrun_read_missing_file)
 {
-    expect_error_at("/nonexistent/run.dat", NULL, PMRUN_ERR_IO, 0, "cannot open");
+    tu_read_fails("/nonexistent/run.dat", NULL, PMRUN_ERR_IO, 0, "cannot open");
 }
 END_TEST
 
@@ -583,7 +565,7 @@ START_TEST(test_pmrun_read_directory)
 {
     char path[4096];
     data_path(path, sizeof path, "");
-    expect_error_at(path, NULL, PMRUN_ERR_IO, 1, "read error");
+    tu_read_fails(path, NULL, PMRUN_ERR_IO, 1, "read error");
 }
 END_TEST
 
@@ -596,7 +578,7 @@ START_TEST(test_pmrun_read_too_many_records)
     for (i = 0; i < n; ++i) memcpy(text + i * k, rec, k);
     temp_file(tmp, sizeof tmp, text, n * k);
     free(text);
-    expect_error_at(tmp, NULL, PMRUN_ERR_FORMAT, PMRUN_MAX_RECORDS + 1, "more than");
+    tu_read_fails(tmp, NULL, PMRUN_ERR_FORMAT, PMRUN_MAX_RECORDS + 1, "more than");
     unlink(tmp);
 }
 END_TEST
@@ -638,7 +620,7 @@ START_TEST(test_pmrun_read_out_of_memory)
     ck_assert_int_eq(getrlimit(RLIMIT_AS, &rl), 0);
     rl.rlim_cur = (rlim_t)pages * (rlim_t)sysconf(_SC_PAGESIZE) + ((rlim_t)8 << 20);
     ck_assert_int_eq(setrlimit(RLIMIT_AS, &rl), 0);
-    expect_error_at(tmp, NULL, PMRUN_ERR_NOMEM, 0, "out of memory");
+    tu_read_fails(tmp, NULL, PMRUN_ERR_NOMEM, 0, "out of memory");
     unlink(tmp);
 }
 END_TEST
@@ -802,7 +784,7 @@ static void expect_weather_error(const char *name, const char *needle)
     pmrun_options o;
     pmrun *run;
     data_path(path, sizeof path, name);
-    expect_error_at(path, NULL, PMRUN_ERR_FORMAT, 3, needle);
+    tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 3, needle);
     pmrun_options_default(&o);
     o.refraction = 0;
     run = read_ok(name, &o);
@@ -902,7 +884,7 @@ START_TEST(test_pmrun_read_nul_bytes)
     static const char text[] = "1.0 2.0 3.0 4.0\n1.0 2\0.0 3.0 4.0\n";
     char tmp[64];
     temp_file(tmp, sizeof tmp, text, sizeof text - 1);
-    expect_error_at(tmp, NULL, PMRUN_ERR_FORMAT, 2, "NUL byte");
+    tu_read_fails(tmp, NULL, PMRUN_ERR_FORMAT, 2, "NUL byte");
     unlink(tmp);
 }
 END_TEST
@@ -912,7 +894,7 @@ START_TEST(test_pmrun_read_binary_garbage)
     static const char text[] = "\x7f" "ELF\x02\x01\x01\0\0\0\0\0\0\0\0\0\x03\0>\0\x01\0\0\0";
     char tmp[64];
     temp_file(tmp, sizeof tmp, text, sizeof text - 1);
-    expect_error_at(tmp, NULL, PMRUN_ERR_FORMAT, 1, "NUL byte");
+    tu_read_fails(tmp, NULL, PMRUN_ERR_FORMAT, 1, "NUL byte");
     unlink(tmp);
 }
 END_TEST
@@ -922,11 +904,11 @@ START_TEST(test_pmrun_read_line_too_long)
     char tmp[64];
     /* a 1 MiB record line after a good one */
     temp_file_long(tmp, sizeof tmp, "1.0 2.0 3.0 4.0\n", '1', (size_t)1 << 20, "1.0 2.0 3.0 4.0\n");
-    expect_error_at(tmp, NULL, PMRUN_ERR_FORMAT, 2, "line too long");
+    tu_read_fails(tmp, NULL, PMRUN_ERR_FORMAT, 2, "line too long");
     unlink(tmp);
     /* as the first line */
     temp_file_long(tmp, sizeof tmp, "", '#', (size_t)PMRUN_MAX_LINE + 1, "1.0 2.0 3.0 4.0\n");
-    expect_error_at(tmp, NULL, PMRUN_ERR_FORMAT, 1, "line too long");
+    tu_read_fails(tmp, NULL, PMRUN_ERR_FORMAT, 1, "line too long");
     unlink(tmp);
 }
 END_TEST
@@ -994,7 +976,7 @@ START_TEST(test_pmrun_read_skip_bad_all_records)
     pmrun_options_default(&o);
     o.skip_bad = 1;
     data_path(path, sizeof path, "bad_all_skipped.dat");
-    expect_error_at(path, &o, PMRUN_ERR_FORMAT, 5, "no records left: all 2 records were bad");
+    tu_read_fails(path, &o, PMRUN_ERR_FORMAT, 5, "no records left: all 2 records were bad");
 }
 END_TEST
 
