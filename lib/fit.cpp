@@ -26,6 +26,13 @@ inline int pidx(int i, int j) { return i * (i + 1) / 2 + j; } /* i >= j */
 ** scaled by it could never be met. */
 const double CHI2_FLOOR = 1e-30;
 
+/* Bound on the sums of squares (chi^2 and the diagonal of J^T J) and on
+** what the solve derives from them.  Since |(J^T J)_ij| <=
+** sqrt((J^T J)_ii (J^T J)_jj) and |(J^T r)_i| <= sqrt((J^T J)_ii chi^2),
+** no accumulated sum can overflow below it; residuals and derivatives up
+** to ~1e150 (rad) are accepted, far beyond any real mount. */
+const double SUM_MAX = 1e300;
+
 /* Derivative of the log map at unit vector q (2 x 3). */
 void dlog(const V3<double> &q, double D[2][3], double *ly, double *lz)
 {
@@ -311,11 +318,14 @@ pm_status pm_fit_add(pm_fit *fit, const pm_context *ctx, double enc_ha,
     double r0[PM_MAX_TERMS], r1[PM_MAX_TERMS], r[2];
     rows(&fit->lin, ctx, enc_ha, enc_dec, app_ha, app_dec, r0, r1, r);
     int P = fit->n_par;
-    for (int i = 0; i < P; i++)
-        if (!finite(r0[i]) || !finite(r1[i]))
-            return PM_ERR_NONFINITE;
-    if (!finite(r[0]) || !finite(r[1]))
+    /* Refused before anything is added: non-finite rows (the terms
+    ** overflow here) and rows that would take a sum beyond SUM_MAX (then
+    ** chi^2, sigma and the covariance could not be finite). */
+    if (!(fit->chi2 + (r[0] * r[0] + r[1] * r[1]) <= SUM_MAX))
         return PM_ERR_NONFINITE;
+    for (int i = 0; i < P; i++)
+        if (!(fit->ata[pidx(i, i)] + (r0[i] * r0[i] + r1[i] * r1[i]) <= SUM_MAX))
+            return PM_ERR_NONFINITE;
     for (int i = 0; i < P; i++) {
         double *ai = fit->ata + pidx(i, 0);
         double x0 = r0[i], x1 = r1[i];
@@ -408,11 +418,9 @@ pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res)
             fit->cov[pidx(i, j)] *= fit->scale[i] * fit->scale[j];
 
     pm_model next = fit->lin;
-    for (int i = 0; i < P; i++) {
-        fit->base_coef[i] = fit->lin.coef[i];
-        fit->step[i] = step[i];
+    for (int i = 0; i < P; i++)
         next.coef[i] += step[i];
-    }
+    /* a step that overflows: PM_ERR_NONFINITE from the prepare */
     pm_status st = pm_model_prepare(&next);
     if (st != PM_OK)
         return st;
@@ -422,6 +430,15 @@ pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res)
     double max_step = 0, pred = 0;
     for (int i = 0; i < P; i++)
         pred += step[i] * fit->atb[i]; /* predicted chi^2 decrease */
+    /* The statistics must be finite: every variance sigma^2 (J^T J)^-1_ii
+    ** (so every covariance, |cov_ij| <= sqrt(cov_ii cov_jj)) and the
+    ** predicted decrease.  They overflow only for steps or residuals near
+    ** 1e150 rad. */
+    if (!(m_fabs(pred) <= SUM_MAX))
+        return PM_ERR_NONFINITE;
+    for (int i = 0; i < P; i++)
+        if (!(fit->cov[pidx(i, i)] * (sigma * sigma) <= SUM_MAX))
+            return PM_ERR_NONFINITE;
     /* Converged: every step negligible against its error, or a predicted
     ** decrease of chi^2 below 1e-4 sigma^2 (the step then moves every
     ** coefficient by less than 1% of its 1-sigma error). */
@@ -438,6 +455,10 @@ pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res)
             small = 0;
     }
     converged = converged || small;
+    for (int i = 0; i < P; i++) {
+        fit->base_coef[i] = fit->lin.coef[i];
+        fit->step[i] = step[i];
+    }
     fit->iterations++;
     fit->cov_valid = 1;
     fit->base_chi2 = fit->chi2;
