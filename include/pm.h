@@ -201,6 +201,10 @@ typedef struct pm_model {
     double h[9];                   /* polar-axis rotation H, row-major */
     double sc, cc, se, ce;         /* sin/cos of c' and e' */
     double sd, cd, si, ci;         /* sin/cos of d and i */
+    double lip;                    /* bound on the change of the
+                                      anisotropic displacement per radian
+                                      of either axis angle, AUX inputs
+                                      aside (pm_model_invert, Note 4) */
     double dense[6][PM_N_HARM(PM_MAX_L)]; /* per base vector k, per harmonic */
 } pm_model;
 
@@ -232,7 +236,9 @@ pm_status pm_model_init(pm_model *m, int mount, int order);
 **  Given/Returned:
 **     m        pm_model*   model whose coef[] were set or changed
 **  Returned (function value):
-**              pm_status   PM_OK; PM_ERR_ARG; PM_ERR_NONFINITE; PM_ERR_CAPACITY
+**              pm_status   PM_OK; PM_ERR_ARG; PM_ERR_NONFINITE (a coefficient
+**                          not finite, or |a|, |b| beyond ~1e154 rad, where
+**                          the polar-axis rotation overflows); PM_ERR_CAPACITY
 **  Notes:
 **  1) pm_model_init and pm_fit_solve leave the model prepared.  After
 **     changing coef[] or term[] directly, call this again: apply, invert
@@ -374,7 +380,14 @@ pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
 **     that collimation, non-perpendicularity and the anisotropic terms
 **     make unreachable from that side; the nearest position found on that
 **     side is returned.
-**  4) The paper (Sec. 5.2) inverts by flipping the sign of the
+**  4) The round trip holds at the angles returned, as rounded to doubles.
+**     The fixed point is judged before that rounding, with PM_INVERT_TOL/2
+**     to spare; where the rounding times how fast the anisotropic
+**     displacement can change (m->lip, plus |coef (input - param)| of the
+**     AUX terms) could use that margin (coefficients of ~10 rad and more,
+**     or angles beyond ~100 rad), one more evaluation checks the round
+**     trip at the returned angles (Newton, within the bound of Note 2).
+**  5) The paper (Sec. 5.2) inverts by flipping the sign of the
 **     coefficients, with an error O(a^2); docs/model.md gives the measured
 **     size of that error.
 **  Reference: Pal et al., Sec. 5.2.
@@ -579,11 +592,16 @@ pm_status pm_fit_init(pm_fit *fit, const pm_model *start);
 **     enc_ha, enc_dec  double    encoder position (radians)
 **     app_ha, app_dec  double    observed apparent position (radians)
 **  Returned (function value):
-**              pm_status   PM_OK; PM_ERR_ARG; PM_ERR_NONFINITE (the fit is
-**                          unchanged); PM_ERR_STATE
+**              pm_status   PM_OK; PM_ERR_ARG; PM_ERR_NONFINITE (a
+**                          non-finite input or row, or one that would take
+**                          chi^2 or a diagonal element of J^T J beyond
+**                          1e300; the fit is unchanged); PM_ERR_STATE
 **  Notes:
 **  1) Each observation gives two rows (the tangent-plane residual along both
 **     axes), linearised at fit->lin.  O(P^2) work, no memory growth.
+**  2) The 1e300 bound keeps every accumulated sum finite (residuals and
+**     derivatives up to ~1e150 rad pass), so a solve never reports an
+**     infinite chi^2.
 */
 pm_status pm_fit_add(pm_fit *fit, const pm_context *ctx,
                      double enc_ha, double enc_dec,
@@ -600,7 +618,9 @@ pm_status pm_fit_add(pm_fit *fit, const pm_context *ctx,
 **  Returned (function value):
 **              pm_status   PM_OK; PM_ERR_ARG; PM_ERR_TOO_FEW;
 **                          PM_ERR_SINGULAR (fit->bad_term names the term);
-**                          PM_ERR_STATE
+**                          PM_ERR_NONFINITE (the step, a variance or the
+**                          predicted decrease would overflow: coefficients
+**                          or residuals near 1e150 rad); PM_ERR_STATE
 **  Notes:
 **  1) Column equilibration, then a Cholesky factorisation that stops on a
 **     pivot below 1e-11 of the equilibrated diagonal (the term is a linear
@@ -622,7 +642,9 @@ pm_status pm_fit_add(pm_fit *fit, const pm_context *ctx,
 **     accepted point is returned as converged.  So chi^2 never increases, which matters when terms are
 **     nearly degenerate (one pier side only, narrow sky) and residuals
 **     large, where undamped Gauss-Newton can oscillate.
-**  5) On error *out and *res are unchanged and the accumulated pass is kept
+**  5) After PM_OK, chi^2, sigma, every error and every covariance
+**     (pm_fit_covariance) are finite.
+**  6) On error *out and *res are unchanged and the accumulated pass is kept
 **     (more observations can be added and the solve retried); the
 **     covariance of the previous solve is no longer available.
 */

@@ -26,6 +26,35 @@ bool dropped(int k, int l, int m)
     return false;
 }
 
+/* Bound on how fast the anisotropic displacement of m changes with either
+** axis angle (rad per rad), the AUX terms' inputs aside: the sum of
+** |coef| times a bound for each term's displacement per unit coefficient
+** (value and tangent-frame turning included):
+**   harmonic Y_lm p_k: 8 + l (maxima measured on a 400 x 400 grid for
+**     l <= 10: 4, 4, 8, 8.1, 8.8, 9.7, 10.6, 11.6, 12.7, 13.8, 14.8);
+**   Fourier trig(G x) p_k: |G| + 2;  sectoral cos^G(d) trig(G t) p_k: 2G + 2;
+**   zenith cot(el) (el clamped at 0.01 rad): 1/0.01^2 + 1/0.01 + 2;
+**   zenith cos(el): 2;  AUX: 0 here (pm_model_invert adds them).
+** pm_model_invert uses it to know when the rounding of its returned angles
+** could matter (pm.h, pm_model_invert Note 4). */
+double lipschitz(const pm_model *m)
+{
+    double s = 0;
+    for (int i = 6; i < m->n_terms; i++) {
+        const pm_term &t = m->term[i];
+        double b = 0;
+        switch (t.kind) {
+        case PM_TERM_SH: b = 8.0 + t.l; break;
+        case PM_TERM_FOURIER: b = m_fabs(t.param) + 2; break;
+        case PM_TERM_SECTORAL: b = 2 * m_fabs(t.param) + 2; break;
+        case PM_TERM_ZENITH: b = t.l == 0 ? 1e4 + 100 + 2 : 2; break;
+        default: b = 0; break;
+        }
+        s += m_fabs(m->coef[i]) * b;
+    }
+    return s;
+}
+
 /* Round-trip residual of encoder trig g against target q, measured as the
 ** tangent offset (radians) of q seen from the model's position. */
 double miss(const pm_model *m, const Iso<double> &k, const pm_context *ctx,
@@ -46,11 +75,11 @@ int side_of(const pm_model *m, double d) { return m_cos(d - m->coef[4]) >= 0 ? 1
 ** mount's pole).  x = (t, d) encoder angles, updated in place.  With
 ** lock = +1/-1 a trial point beyond the pole from that side is moved back
 ** onto the pole's edge (projected steps: the nearest point on one side).
-** Trial points are kept on the turn the result is returned on
-** (finish_angles with the caller's start), since periodic terms of
-** non-integer G read the raw angle and jump between turns. */
+** Trial points are kept on the turn the result is returned on (turn,
+** from turn_of), since periodic terms of non-integer G read the raw
+** angles and jump between turns. */
 pm_status newton(const pm_model *m, const Iso<double> &k, const pm_context *ctx,
-                 const V3<double> &q, double tq, double dq, const double *start,
+                 const V3<double> &q, double tq, double dq, const double *turn,
                  double *t, double *d, double *err, int lock = 0)
 {
     /* frame at the target: e1 along increasing axis 1, e2 along axis 2 */
@@ -87,7 +116,7 @@ pm_status newton(const pm_model *m, const Iso<double> &k, const pm_context *ctx,
                 double pole = m_sin(nd - m->coef[4]) >= 0 ? PI / 2 : -PI / 2;
                 nd = pole + m->coef[4] - (pole > 0 ? 1 : -1) * lock * 1e-12;
             }
-            finish_angles(start, &nt, &nd);
+            finish_angles(turn, &nt, &nd);
             double e = miss(m, k, ctx, trig_of(nt, nd), q);
             if (e < best) {
                 best = e;
@@ -126,20 +155,17 @@ void on_turn(Trig<double> *g, double ref_t, double ref_d)
 }
 
 /* Solve on one branch of the closed form (side = +1/-1), or from the start
-** position's branch.  Returns the status, (t, d) and the round-trip miss
-** when known (0 if the fixed point converged). */
+** position's branch, with the angles on the turn the result is returned
+** on (turn_of).  Returns the status and (t, d). */
 pm_status solve_branch(const pm_model *m, const Iso<double> &k,
                        const pm_context *ctx, const V3<double> &q, double app_ha, double app_dec,
-                       int side, const double *start, double *t_out,
+                       int side, const double *start, const double *turn, double *t_out,
                        double *d_out)
 {
     double dt_prev = 0, dd_prev = 0;
     /* Periodic terms of non-integer G read the raw angle itself, not only
-    ** its sine and cosine: iterate with the angles on the turn the result
-    ** is returned on (near the start, or ha in (-pi, pi] and dec near 0 or,
-    ** beyond the pole, near pi). */
-    double ref_t = start ? start[0] : 0.0;
-    double ref_d = start ? start[1] : (side > 0 ? 0.0 : PI);
+    ** its sine and cosine: iterate with the angles on the returned turn. */
+    const double ref_t = turn[0], ref_d = turn[1];
     Trig<double> g;
     if (start) {
         /* The branch of the start: the sign of the x-component of
@@ -196,10 +222,27 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
 
     double t = g.t; /* on the turn of ref_t, ref_d (on_turn) */
     double d = g.d;
+    /* The fixed point judged the position before its angles were rounded
+    ** to doubles (atan2, the turn), with PM_INVERT_TOL / 2 to spare.  The
+    ** rounding (a few ulp of the larger angle) moves the model's position
+    ** by up to 1 + lip times as much; where that could use the margin,
+    ** Newton checks the round trip at the returned angles themselves
+    ** (pm.h, pm_model_invert Note 4). */
+    if (converged) {
+        double big = m_fabs(t) > m_fabs(d) ? m_fabs(t) : m_fabs(d);
+        double lip = m->lip;
+        if (m->needs_ctx) /* (ctx checked by eval_ready) */
+            for (int i = m->n_base; i < m->n_terms; i++)
+                if (m->term[i].kind == PM_TERM_AUX)
+                    lip += m_fabs(m->coef[i] * (aux_input(ctx, m->term[i].aux) -
+                                                m->term[i].param)) * 2;
+        if (!((1 + lip) * 8 * DBL_EPS * (big > 1 ? big : 1) <= 0.5 * PM_INVERT_TOL))
+            converged = false;
+    }
     pm_status result = PM_OK;
     if (!converged || !reachable) {
         double err;
-        result = newton(m, k, ctx, q, app_ha, app_dec, start, &t, &d, &err);
+        result = newton(m, k, ctx, q, app_ha, app_dec, turn, &t, &d, &err);
         if (result != PM_OK && !reachable)
             result = PM_WARN_UNREACHABLE;
     }
@@ -229,15 +272,16 @@ pm_status invert(const pm_model *m, const pm_context *ctx, double app_ha,
     Iso<double> k;
     iso_from_model<double>(m, &k);
     V3<double> q = unit_of(app_ha, app_dec);
-    double t, d;
-    pm_status result = solve_branch(m, k, ctx, q, app_ha, app_dec, side, start, &t, &d);
+    double turn[2], t, d;
+    turn_of(start, side, m->coef[4], turn);
+    pm_status result = solve_branch(m, k, ctx, q, app_ha, app_dec, side, start, turn, &t, &d);
     if (!start && (result != PM_OK || side_of(m, d) != side)) {
         /* Within the anisotropic amplitude of the mount's pole the closed
         ** form's branches (sign of cos(dec - e' + displacement angle)) and
         ** the sides of the pole (sign of cos(dec - e')) differ: the other
         ** branch may hold the solution on the requested side. */
         double t2, d2;
-        pm_status r2 = solve_branch(m, k, ctx, q, app_ha, app_dec, -side, 0, &t2, &d2);
+        pm_status r2 = solve_branch(m, k, ctx, q, app_ha, app_dec, -side, 0, turn, &t2, &d2);
         if (r2 == PM_OK && side_of(m, d2) == side) {
             result = r2;
             t = t2;
@@ -260,14 +304,16 @@ pm_status invert(const pm_model *m, const pm_context *ctx, double app_ha,
                     best_d = d2;
                 }
             }
-            double pole = side > 0 ? PI / 2 : -PI / 2; /* dec' of the edge */
             for (int j = 0; j < PM_INVERT_POLE_STARTS && !found; j++) {
                 double tj = -PI + 2 * PI * (j + 0.5) / PM_INVERT_POLE_STARTS;
                 for (int hemi = -1; hemi <= 1 && !found; hemi += 2) {
-                    double dj = hemi * pole + m->coef[4] - hemi * side * 1e-9;
+                    /* dec - e' = +-(pi/2 - 1e-9) on the normal side,
+                    ** +-(pi/2 + 1e-9) beyond the pole */
+                    double dj = hemi * (PI / 2 - side * 1e-9) + m->coef[4];
                     double err;
+                    finish_angles(turn, &tj, &dj);
                     pm_status sj =
-                        newton(m, k, ctx, q, app_ha, app_dec, 0, &tj, &dj, &err, side);
+                        newton(m, k, ctx, q, app_ha, app_dec, turn, &tj, &dj, &err, side);
                     if (side_of(m, dj) != side)
                         continue;
                     if (sj == PM_OK) {
@@ -299,7 +345,7 @@ pm_status invert(const pm_model *m, const pm_context *ctx, double app_ha,
     if (!finite(t) || !finite(d) ||
         (result != PM_OK && !finite(miss(m, k, ctx, trig_of(t, d), q))))
         return PM_ERR_NONFINITE; /* outputs untouched */
-    finish_angles(start, &t, &d);
+    finish_angles(turn, &t, &d);
     *enc_ha = t;
     *enc_dec = d;
     return result;
@@ -442,6 +488,11 @@ pm_status pm_model_prepare(pm_model *m)
         for (int c = 0; c < 3; c++) {
             double k2 = W[r] * W[c] - (r == c ? th2 : 0.0);
             m->h[3 * r + c] = (r == c ? 1.0 : 0.0) + A * K[3 * r + c] + B * k2;
+            /* a or b beyond ~1e154 rad: a^2 + b^2 overflows and the
+            ** rotation is NaN (the inverse's closed form would then give
+            ** finite garbage) */
+            if (!finite(m->h[3 * r + c]))
+                return PM_ERR_NONFINITE;
         }
     m->sc = m_sin(m->coef[2]);
     m->cc = m_cos(m->coef[2]);
@@ -458,6 +509,7 @@ pm_status pm_model_prepare(pm_model *m)
         int j = t->l * t->l + t->l + t->m;
         m->dense[t->k - 1][j] += m->coef[i] * norm_lm(t->l, t->m);
     }
+    m->lip = lipschitz(m);
     for (int i = 0; i < PM_MAX_TERMS; i++)
         m->prep_coef[i] = i < m->n_terms ? m->coef[i] : 0.0;
     m->prepared = 1;

@@ -225,7 +225,9 @@ pm_status invert_f(const pm_model_f *m, const pm_context *ctx, double T, double 
     ** cut back (at most 3 times). */
     /* iterate on the turn the result is returned on: periodic terms of
     ** non-integer G read the raw angle and jump between turns */
-    finish_angles(start, &t, &d);
+    double turn[2];
+    turn_of(start, side, m->e, turn);
+    finish_angles(turn, &t, &d);
     const double h = 1e-5;
     double T0, D0, T1, D1;
     float fx, fy, ax, ay, j00 = 0, j01 = 0, j10 = 0, j11 = 0, det = 0;
@@ -260,7 +262,7 @@ pm_status invert_f(const pm_model_f *m, const pm_context *ctx, double T, double 
         for (int cut = 0; cut < 4; cut++, lam *= 0.25f) {
             nt = t - lam * ds_t;
             nd = d - lam * ds_d;
-            finish_angles(start, &nt, &nd);
+            finish_angles(turn, &nt, &nd);
             forward_f(m, ctx, nt, nd, &T0, &D0);
             nfn = sky_offset(T0, D0, T, D, &nfx, &nfy);
             if (nfn < fn)
@@ -280,8 +282,13 @@ pm_status invert_f(const pm_model_f *m, const pm_context *ctx, double T, double 
         fn = nfn;
     }
     /* the solution must be on the requested side of the mount's pole */
-    if (result == PM_OK && !start && (m_cos((float)wrap_pi(d - m->e)) >= 0 ? 1 : -1) != side)
-        result = PM_WARN_NOT_CONVERGED;
+    /* (in double, without trig: a float cosine misjudges the side within
+    ** ~1e-8 rad of the pole's edge) */
+    if (result == PM_OK && !start) {
+        double de = wrap_pi(d - m->e);
+        if ((de >= -PI / 2 && de <= PI / 2 ? 1 : -1) != side)
+            result = PM_WARN_NOT_CONVERGED;
+    }
     if (result != PM_OK && finite(t) && finite(d)) {
         /* the best position of a warning: is the model finite there? */
         forward_f(m, ctx, t, d, &T0, &D0);
@@ -290,7 +297,7 @@ pm_status invert_f(const pm_model_f *m, const pm_context *ctx, double T, double 
     }
     if (!finite(t) || !finite(d))
         return PM_ERR_NONFINITE; /* float overflow in the terms: outputs untouched */
-    finish_angles(start, &t, &d);
+    finish_angles(turn, &t, &d);
     *enc_ha = t;
     *enc_dec = d;
     return result;

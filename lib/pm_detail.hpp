@@ -35,6 +35,7 @@ inline float m_fabs(float x) { return __builtin_fabsf(x); }
 inline bool finite(double x) { return x - x == 0.0; }
 
 const double PI = 3.14159265358979323846;
+const double DBL_EPS = 2.220446049250313e-16; /* 2^-52 */
 
 template <typename T> struct V3 {
     T x, y, z;
@@ -231,16 +232,34 @@ inline double wrap_pi(double a)
     return a;
 }
 
-/* The inverse's result: continuous with the start position when there is
-** one (both angles within pi of it), else the hour angle in (-pi, pi]. */
-inline void finish_angles(const double *start, double *t, double *d)
+/* The turn an inverse returns its angles on: within pi of the start
+** position when there is one; else the hour angle in (-pi, pi] and the
+** declination within pi of e' (side +1) or e' + pi (side -1), so that
+** enc_dec - e' is in [-pi/2, pi/2] on the normal side and in
+** (pi/2, 3pi/2) beyond the pole (pm.h).  Iterations keep their trial
+** points on this turn too: periodic terms of non-integer G read the raw
+** angles, so a point and its copy a turn away are different positions. */
+inline void turn_of(const double *start, int side, double e, double ref[2])
 {
     if (start) {
-        *t = start[0] + wrap_pi(*t - start[0]);
-        *d = start[1] + wrap_pi(*d - start[1]);
+        ref[0] = start[0];
+        ref[1] = start[1];
     } else {
-        *t = wrap_pi(*t);
+        ref[0] = 0;
+        ref[1] = side > 0 ? e : e + PI;
     }
+}
+
+/* Angles (t, d) on the turn of ref (turn_of): each within pi of it.
+** Angles already there are left as they are (bit for bit: the inverse
+** checks its round trip at the angles it returns). */
+inline void finish_angles(const double ref[2], double *t, double *d)
+{
+    double a = *t - ref[0], b = *d - ref[1];
+    if (a > PI || a <= -PI)
+        *t = ref[0] + wrap_pi(a);
+    if (b > PI || b <= -PI)
+        *d = ref[1] + wrap_pi(b);
 }
 
 /* The bit pattern of a double. */

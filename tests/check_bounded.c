@@ -170,8 +170,9 @@ static void check_point(const pm_model *m, const pm_model_f *mf, const pm_contex
         ck_assert(isfinite(ah) && isfinite(ad));
         if (st == PM_OK)
             ck_assert_msg(tu_angle(ah, ad, ha, dec) <= PM_INVERT_TOL + ROUND_TRIP_SLACK,
-                          "pm_model_invert PM_OK but misses by %g rad",
-                          tu_angle(ah, ad, ha, dec));
+                          "pm_model_invert PM_OK but misses by %g rad (target %.17g %.17g, "
+                          "side %d, result %.17g %.17g, e' %.17g)",
+                          tu_angle(ah, ad, ha, dec), ha, dec, side, eh, ed, m->coef[4]);
     }
 
     /* near: from the solution just found, or from absurd starts */

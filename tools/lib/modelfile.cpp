@@ -328,6 +328,11 @@ extern "C" int pmmodel_load(const char *path, pm_model *out, char *err, size_t e
         }
     }
     pm_status st = pm_model_prepare(&m);
+    if (st == PM_ERR_NONFINITE) {
+        set_err(err, errlen, std::string(path) + ": the polar-axis coefficients a, b are too "
+                             "large to evaluate (beyond ~1e154 rad)");
+        return -1;
+    }
     if (st != PM_OK) {
         set_err(err, errlen, std::string(path) + ": the terms do not form a valid model "
                              "(the six isotropic terms a b c' d e' i must come first, in order; "
