@@ -285,12 +285,9 @@ std::vector<Located> locate(const Run &run, const FitOut &f, double sigma)
     if (n < 3)
         return out;
     double s2 = sigma * sigma;
-    double all = 0, a1 = 0, a2 = 0;
-    for (size_t j = 0; j < n; j++) {
+    double all = 0;
+    for (size_t j = 0; j < n; j++)
         all += f.r0[j] * f.r0[j] + f.r1[j] * f.r1[j];
-        a1 += f.r0[j] * f.r0[j];
-        a2 += f.r1[j] * f.r1[j];
-    }
     double rms = std::sqrt(all / (double)n);
     auto add_group = [&](const std::string &what, const std::vector<size_t> &members, int comps) {
         if (members.size() < 3)

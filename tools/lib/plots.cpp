@@ -176,8 +176,8 @@ std::vector<Tick> ticks(const Axis &a, double spacing)
     double raw = (a.hi - a.lo) / std::max(2.0, a.px() / spacing), step = 0;
     if (a.angular && raw > 7.5 && raw < 180)
         for (double c : ANGLE_STEP)
-            if (!step && c >= raw * 0.75) step = c;
-    if (!step) {
+            if (step == 0 && c >= raw * 0.75) step = c;
+    if (step == 0) {
         double mag = std::pow(10.0, std::floor(std::log10(raw))), f = raw / mag;
         step = (f < 1.5 ? 1 : f < 3.5 ? 2 : f < 7.5 ? 5 : 10) * mag;
     }
