@@ -36,9 +36,16 @@ bool dropped(int k, int l, int m)
 **   zenith cot(el) (el clamped at 0.01 rad): 1/0.01^2 + 1/0.01 + 2;
 **   zenith cos(el): 2;  AUX: 0 here (pm_model_invert adds them).
 ** pm_model_invert uses it to know when the rounding of its returned angles
-** could matter (pm.h, pm_model_invert Note 4). */
+** could matter (pm.h, pm_model_invert Note 4).  Infinite for isotropic
+** geometries far from any mount (|d|, |i| or the polar axis's offset
+** beyond 0.5 rad; at d or i = 90 deg the closed form degenerates and loses
+** digits): every inverse there is checked. */
 double lipschitz(const pm_model *m)
 {
+    const double far = 0.5;
+    if (!(m_fabs(m->coef[3]) <= far && m_fabs(m->coef[5]) <= far &&
+          m->coef[0] * m->coef[0] + m->coef[1] * m->coef[1] <= far * far))
+        return __builtin_inf();
     double s = 0;
     for (int i = 6; i < m->n_terms; i++) {
         const pm_term &t = m->term[i];
