@@ -204,7 +204,9 @@ typedef struct pm_model {
     double lip;                    /* bound on the change of the
                                       anisotropic displacement per radian
                                       of either axis angle, AUX inputs
-                                      aside (pm_model_invert, Note 4) */
+                                      aside; infinite if |d|, |i| or the
+                                      polar offset exceed 0.5 rad
+                                      (pm_model_invert, Note 4) */
     double dense[6][PM_N_HARM(PM_MAX_L)]; /* per base vector k, per harmonic */
 } pm_model;
 
@@ -385,7 +387,9 @@ pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
 **     to spare; where the rounding times how fast the anisotropic
 **     displacement can change (m->lip, plus |coef (input - param)| of the
 **     AUX terms) could use that margin (coefficients of ~10 rad and more,
-**     or angles beyond ~100 rad), one more evaluation checks the round
+**     or angles beyond ~100 rad), and for geometries no mount has (|d|,
+**     |i| or the polar axis's offset beyond 0.5 rad, where the closed form
+**     degenerates towards 90 deg), one more evaluation checks the round
 **     trip at the returned angles (Newton, within the bound of Note 2).
 **  5) The paper (Sec. 5.2) inverts by flipping the sign of the
 **     coefficients, with an error O(a^2); docs/model.md gives the measured
@@ -476,6 +480,7 @@ typedef struct pm_model_f {
     double c, e;                   /* index terms c', e' (radians), exact */
     float a, b, ra, rb;            /* polar axis (a, b) and Rodrigues factors */
     float sd, vd, si, vi;          /* sin d, 1 - cos d, sin i, 1 - cos i */
+    float sc, cc, se, ce;          /* sin, cos of c' and e' */
     float lat_s, lat_c;            /* site latitude */
     float dense[6][PM_N_HARM(PM_MAX_L)];
     pm_term term[PM_MAX_TERMS];    /* the added terms (index >= n_base) */
@@ -502,20 +507,29 @@ pm_status pm_model_f_prepare(pm_model_f *mf, const pm_model *m);
 **  Notes:
 **  1) The correction (apparent - encoder, after the exact index shifts)
 **     agrees with the double build to 0.01" over the sky (tested at L=2).
-**  2) The inverse is a Newton iteration on sky offsets at the target
-**     (Jacobian by differences, kept while steps gain a factor 10, steps
-**     cut back when they do not help): at most PM_INVERT_F_MAX_EVALS =
-**     2 + 6 * PM_INVERT_F_MAX model evaluations whatever the inputs,
-**     usually 4; it iterates to PM_INVERT_F_TOL (0.002", above the float
-**     forward's own noise of ~0.0002"), not 1e-13.
+**  2) The inverse is a fixed point on the float correction (the frame
+**     position is the target minus the correction there; at most
+**     PM_INVERT_F_FIXED steps of one evaluation each, usually 2, no libm
+**     call per step while the correction is below 0.01 rad), stopped when
+**     the change it predicts for the next step is below PM_INVERT_F_TOL/4,
+**     and the point checked with the forward model.  Where it does not
+**     contract or the check fails (near the mount's pole; corrections
+**     beyond 0.01 rad) a Newton iteration on sky offsets at the target
+**     takes over (Jacobian by differences, kept while steps gain a factor
+**     10, steps cut back when they do not help).  At most
+**     PM_INVERT_F_MAX_EVALS = PM_INVERT_F_FIXED + 3 + 6 * PM_INVERT_F_MAX
+**     model evaluations whatever the inputs.  It iterates to
+**     PM_INVERT_F_TOL (0.002", above the float forward's own noise of
+**     ~0.0002"), not 1e-13.
 **     PM_WARN_NOT_CONVERGED if the bound is reached or the solution found
 **     is on the other side of the mount's pole; this happens only within
 **     about a degree of the mount's pole (use the double build there).
 */
+#define PM_INVERT_F_FIXED 6
 #define PM_INVERT_F_MAX 12
 #define PM_INVERT_F_TOL 1e-8
-/* Worst-case model evaluations of the float inverse (74). */
-#define PM_INVERT_F_MAX_EVALS (2 + 6 * PM_INVERT_F_MAX)
+/* Worst-case model evaluations of the float inverse (81). */
+#define PM_INVERT_F_MAX_EVALS (PM_INVERT_F_FIXED + 3 + 6 * PM_INVERT_F_MAX)
 pm_status pm_model_apply_f(const pm_model_f *m, const pm_context *ctx,
                            double enc_ha, double enc_dec,
                            double *app_ha, double *app_dec);

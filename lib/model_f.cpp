@@ -67,43 +67,45 @@ V3<float> rotate_offset(const V3<float> &n, float s1, float s2, const V3<float> 
                      o.z + s1 * nv.z + s2 * nnv.z);
 }
 
-/* Forward model: encoder (t, d) -> apparent (T, D), in float except for the
-** frame angles. */
-void forward_f(const pm_model_f *m, const pm_context *ctx, double t, double d, double *T,
-               double *D)
+/* An encoder position as the float correction sees it: the trig of its
+** frame position (t_r, d_r) (|d_r| <= pi/2: beyond the pole the equivalent
+** position (t_c + pi, pi - d_e)), of the shifted position (t_c, d_e) and of
+** the encoder position itself, with its float angles for the terms that
+** read them (periodic terms). */
+struct FrameF {
+    bool flip;        /* beyond the pole */
+    float sd, cd;     /* sin, cos of d_r (cd >= 0) */
+    Trig<float> ge;   /* shifted position */
+    Trig<float> g;    /* encoder position */
+};
+
+/* Fill f.ge and f.g from the frame trig (st, ct of t_r; f.sd, f.cd) and the
+** encoder angles (t, d). */
+void frame_finish(const pm_model_f *m, float st, float ct, float t, float d, FrameF *f)
+{
+    f->ge.st = f->flip ? -st : st;
+    f->ge.ct = f->flip ? -ct : ct;
+    f->ge.sd = f->sd;
+    f->ge.cd = f->flip ? -f->cd : f->cd;
+    f->ge.have_angles = false;
+    f->g.st = f->ge.st * m->cc - f->ge.ct * m->sc;
+    f->g.ct = f->ge.ct * m->cc + f->ge.st * m->sc;
+    f->g.sd = f->ge.sd * m->ce + f->ge.cd * m->se;
+    f->g.cd = f->ge.cd * m->ce - f->ge.sd * m->se;
+    f->g.t = t;
+    f->g.d = d;
+    f->g.have_angles = true;
+}
+
+/* The correction at a frame: the apparent position is (t_r + dT, d_r + dD).
+** One model evaluation (everything of the forward model but the frame
+** angles). */
+void correction_f(const pm_model_f *m, const pm_context *ctx, const FrameF &f, float *dTo,
+                  float *dDo)
 {
     PM_EVAL_PROBE();
-    /* frame angles: exact index shifts; beyond the pole, the equivalent
-    ** position (t_r, d_r) = (t_c + pi, pi - d_e) with |d_r| <= pi/2 */
-    double tc = t + m->c, de = wrap_pi(d - m->e);
-    bool flip = de > PI / 2 || de < -PI / 2;
-    double tr = flip ? tc + PI : tc;
-    double dr = flip ? (de > 0 ? PI - de : -PI - de) : de;
-    float st = m_sin((float)wrap_pi(tr)), ct = m_cos((float)wrap_pi(tr));
-    /* cos d_r from the complement pi/2 - |d_r|, formed in double: near the
-    ** pole cos((float)d_r) would carry the angle's own rounding (1e-7 rad),
-    ** which the HA correction (~ offset / cos d) magnifies */
-    float cu = (float)(PI / 2 - m_fabs(dr));
-    float cd = m_sin(cu), sd = dr >= 0 ? m_cos(cu) : -m_cos(cu);
-    /* trig of the shifted position (t_c, d_e) */
-    Trig<float> ge;
-    ge.st = flip ? -st : st;
-    ge.ct = flip ? -ct : ct;
-    ge.sd = sd;
-    ge.cd = flip ? -cd : cd;
-    ge.have_angles = false;
-    /* trig of the encoder position itself (harmonics, base vectors) */
-    float sc = m_sin((float)m->c), cc = m_cos((float)m->c);
-    float se = m_sin((float)m->e), ce = m_cos((float)m->e);
-    Trig<float> g;
-    g.st = ge.st * cc - ge.ct * sc;
-    g.ct = ge.ct * cc + ge.st * sc;
-    g.sd = ge.sd * ce + ge.cd * se;
-    g.cd = ge.cd * ce - ge.sd * se;
-    g.t = (float)t;
-    g.d = (float)d;
-    g.have_angles = true;
-
+    const Trig<float> &ge = f.ge, &g = f.g;
+    const float cd = f.cd, sd = f.sd;
     /* the polar-axis rotation in the local frame: omega' = Q^T (a, b, 0) */
     V3<float> om = rot_dt<float>(ge.sd, ge.cd, rot_zt<float>(ge.st, ge.ct, v3<float>(m->a, m->b, 0)));
 
@@ -123,7 +125,7 @@ void forward_f(const pm_model_f *m, const pm_context *ctx, double t, double d, d
     float dt = -g.sd * (S[0] * g.ct + S[1] * g.st + S[3]) + g.cd * S[2] + S[5];
     float dd = S[0] * g.st - S[1] * g.ct - S[4];
     if (m->n_terms > m->n_base) {
-        int side = ctx && ctx->pier ? (ctx->pier > 0 ? 1 : -1) : (flip ? -1 : 1);
+        int side = ctx && ctx->pier ? (ctx->pier > 0 ? 1 : -1) : (f.flip ? -1 : 1);
         Site<float> s = site_f(m, ge, side, om.x, om.y, om.z);
         for (int i = m->n_base; i < m->n_terms; i++) {
             float u, v;
@@ -150,7 +152,7 @@ void forward_f(const pm_model_f *m, const pm_context *ctx, double t, double d, d
     ** the factors: ra = sin(th)/th, rb = (1 - cos th)/th^2) */
     o = rotate_offset(om, m->ra, m->rb, o);
     /* beyond the pole the frame of (t_r, d_r) is (x, -y, -z) */
-    if (flip) {
+    if (f.flip) {
         o.y = -o.y;
         o.z = -o.z;
     }
@@ -161,8 +163,32 @@ void forward_f(const pm_model_f *m, const pm_context *ctx, double t, double d, d
     float q = cd + eta;
     float rho = m_sqrt(o.y * o.y + q * q);
     float rmc = rho + cd > 0 ? (2 * cd * eta + eta * eta + o.y * o.y) / (rho + cd) : rho - cd;
-    float dT = m_atan2(o.y, q);
-    float dD = m_atan2(zeta * cd - rmc * sd, rho * cd + (sd + zeta) * sd);
+    *dTo = m_atan2(o.y, q);
+    *dDo = m_atan2(zeta * cd - rmc * sd, rho * cd + (sd + zeta) * sd);
+}
+
+/* Forward model: encoder (t, d) -> apparent (T, D), in float except for the
+** frame angles. */
+void forward_f(const pm_model_f *m, const pm_context *ctx, double t, double d, double *T,
+               double *D)
+{
+    /* frame angles: exact index shifts; beyond the pole, the equivalent
+    ** position (t_r, d_r) = (t_c + pi, pi - d_e) with |d_r| <= pi/2 */
+    double tc = t + m->c, de = wrap_pi(d - m->e);
+    FrameF f;
+    f.flip = de > PI / 2 || de < -PI / 2;
+    double tr = f.flip ? tc + PI : tc;
+    double dr = f.flip ? (de > 0 ? PI - de : -PI - de) : de;
+    float st = m_sin((float)wrap_pi(tr)), ct = m_cos((float)wrap_pi(tr));
+    /* cos d_r from the complement pi/2 - |d_r|, formed in double: near the
+    ** pole cos((float)d_r) would carry the angle's own rounding (1e-7 rad),
+    ** which the HA correction (~ offset / cos d) magnifies */
+    float cu = (float)(PI / 2 - m_fabs(dr));
+    f.cd = m_sin(cu);
+    f.sd = dr >= 0 ? m_cos(cu) : -m_cos(cu);
+    frame_finish(m, st, ct, (float)t, (float)d, &f);
+    float dT, dD;
+    correction_f(m, ctx, f, &dT, &dD);
     *T = wrap_pi(tr + (double)dT);
     *D = dr + (double)dD;
 }
@@ -194,6 +220,117 @@ pm_status check_f(const pm_model_f *m, const pm_context *ctx)
     return context_ok(m, ctx);
 }
 
+/* Does an evaluation read the float angles g.t, g.d, not only their trig
+** (periodic and sectoral terms)? */
+bool reads_angles_f(const pm_model_f *m)
+{
+    for (int i = m->n_base; i < m->n_terms; i++)
+        if (m->term[i].kind == PM_TERM_FOURIER || m->term[i].kind == PM_TERM_SECTORAL)
+            return true;
+    return false;
+}
+
+/* sin and cos of a float angle, by series where it is small (the fixed
+** point's corrections: arcminutes), else by libm. */
+inline void sincos_small(float x, float *s, float *c)
+{
+    float x2 = x * x;
+    if (x2 < 1e-4f) { /* |x| < 0.01: the next terms are below 1e-12 */
+        *s = x * (1 - x2 / 6 * (1 - x2 / 20));
+        *c = 1 - x2 / 2 * (1 - x2 / 12);
+    } else {
+        *s = m_sin(x);
+        *c = m_cos(x);
+    }
+}
+
+/* Encoder angles of the frame position (T0 - dT, D - dD) on the side given
+** by flip (the forward model's frame, undone), on the turn of ref. */
+void encoder_of(const pm_model_f *m, double T0, double D, float dT, float dD, bool flip,
+                const double ref[2], double *t, double *d)
+{
+    double tr = T0 - (double)dT, dr = D - (double)dD;
+    double tt = (flip ? tr - PI : tr) - m->c;
+    double dd = (flip ? (dr > 0 ? PI - dr : -PI - dr) : dr) + m->e;
+    finish_angles(ref, &tt, &dd);
+    *t = tt;
+    *d = dd;
+}
+
+/* The fixed point of the float inverse: the frame position is the target
+** minus the correction there, x_{n+1} = target - C(x_n), iterated from
+** the target itself.  The frame trig comes from the target's, turned by
+** the correction (no libm call per step while it is below 0.01 rad), so a
+** step costs one correction.  x_{n+1} misses by about the contraction
+** times the last change |C(x_n) - C(x_{n-1})|; it stops when that
+** prediction (or the change itself) is well below PM_INVERT_F_TOL.
+** PM_WARN_NOT_CONVERGED where it does not contract (close to the mount's
+** pole, or beyond its edge): the Newton iteration then takes over. */
+pm_status fixed_f(const pm_model_f *m, const pm_context *ctx, double T, double D, bool flip,
+                  const double ref[2], double *t_out, double *d_out)
+{
+    const double T0 = wrap_pi(T);
+    const float sT = m_sin((float)T0), cT = m_cos((float)T0);
+    const float cu = (float)(PI / 2 - m_fabs(D)); /* as forward_f: near the pole */
+    const float cD = m_sin(cu), sD = D >= 0 ? m_cos(cu) : -m_cos(cu);
+    const bool raw = reads_angles_f(m);
+    const float tol = (float)PM_INVERT_F_TOL;
+    float dT = 0, dD = 0, last = 0;
+    for (int it = 0; it < PM_INVERT_F_FIXED; it++) {
+        float s1, c1, s2, c2;
+        sincos_small(dT, &s1, &c1);
+        sincos_small(dD, &s2, &c2);
+        FrameF f;
+        f.flip = flip;
+        f.sd = sD * c2 - cD * s2; /* sin(D - dD) */
+        f.cd = cD * c2 + sD * s2;
+        if (!(f.cd > 0))
+            return PM_WARN_NOT_CONVERGED; /* past the pole's edge */
+        float ft = 0, fd = 0;
+        if (raw) { /* the angles as forward_f would see them */
+            double t, d;
+            encoder_of(m, T0, D, dT, dD, flip, ref, &t, &d);
+            ft = (float)t;
+            fd = (float)d;
+        }
+        frame_finish(m, sT * c1 - cT * s1, cT * c1 + sT * s1, ft, fd, &f);
+        float nT, nD;
+        correction_f(m, ctx, f, &nT, &nD);
+        float ex = (nT - dT) * f.cd, ey = nD - dD; /* on the sky */
+        float change = m_sqrt(ex * ex + ey * ey);
+        dT = nT;
+        dD = nD;
+        if (!finite(change) || (it > 0 && change > 0.5f * last))
+            return PM_WARN_NOT_CONVERGED;
+        /* corrections beyond 0.01 rad (no real mount's, after the exact
+        ** index shifts) carry float noise of 1e-9 and more: Newton, on
+        ** forward_f itself, is consistent with the forward model there */
+        if (!(m_fabs(dT) <= 0.01f && m_fabs(dD) <= 0.01f))
+            return PM_WARN_NOT_CONVERGED;
+        /* From the second step on, the contraction rho = change / last
+        ** predicts the next change, which is about how far the new point
+        ** misses.  One direction's rate need not be another's, and this
+        ** iteration turns the target's trig where the forward model rounds
+        ** its own frame angle to float: so the point is checked with the
+        ** forward model itself, as the Newton iteration judges its points
+        ** (one more evaluation); Newton takes over if it misses. */
+        float rho = last > 0 ? change / last : change == 0 ? 0.0f : 1.0f;
+        if (it > 0 && change * rho <= 0.25f * tol) {
+            double t, d, T1, D1;
+            float x, y;
+            encoder_of(m, T0, D, dT, dD, flip, ref, &t, &d);
+            forward_f(m, ctx, t, d, &T1, &D1);
+            if (!(sky_offset(T1, D1, T, D, &x, &y) <= tol))
+                return PM_WARN_NOT_CONVERGED;
+            *t_out = t;
+            *d_out = d;
+            return PM_OK;
+        }
+        last = change;
+    }
+    return PM_WARN_NOT_CONVERGED;
+}
+
 pm_status invert_f(const pm_model_f *m, const pm_context *ctx, double T, double D, int side,
                    const double *start, double *enc_ha, double *enc_dec)
 {
@@ -208,7 +345,20 @@ pm_status invert_f(const pm_model_f *m, const pm_context *ctx, double T, double 
         return PM_ERR_ARG;
     if (start && (m_fabs(start[0]) > PM_START_MAX || m_fabs(start[1]) > PM_START_MAX))
         return PM_ERR_ARG;
+    double turn[2];
+    turn_of(start, side, m->e, turn);
     double t, d;
+    {
+        /* the fixed point first; Newton where it does not contract */
+        bool flip = side < 0;
+        if (start)
+            flip = m_fabs(wrap_pi(start[1] - m->e)) > PI / 2;
+        if (fixed_f(m, ctx, T, D, flip, turn, &t, &d) == PM_OK) {
+            *enc_ha = t;
+            *enc_dec = d;
+            return PM_OK;
+        }
+    }
     if (start) {
         t = start[0];
         d = start[1];
@@ -225,8 +375,6 @@ pm_status invert_f(const pm_model_f *m, const pm_context *ctx, double T, double 
     ** cut back (at most 3 times). */
     /* iterate on the turn the result is returned on: periodic terms of
     ** non-integer G read the raw angle and jump between turns */
-    double turn[2];
-    turn_of(start, side, m->e, turn);
     finish_angles(turn, &t, &d);
     const double h = 1e-5;
     double T0, D0, T1, D1;
@@ -322,6 +470,10 @@ pm_status pm_model_f_prepare(pm_model_f *mf, const pm_model *m)
     mf->needs_ctx = m->needs_ctx;
     mf->c = m->coef[2];
     mf->e = m->coef[4];
+    mf->sc = (float)m->sc;
+    mf->cc = (float)m->cc;
+    mf->se = (float)m->se;
+    mf->ce = (float)m->ce;
     double a = m->coef[0], b = m->coef[1], th2 = a * a + b * b;
     mf->a = (float)a;
     mf->b = (float)b;

@@ -221,6 +221,13 @@ template <typename T> inline void logmap(const V3<T> &q, T *a, T *b)
 /* Wrap an angle into (-pi, pi]. */
 inline double wrap_pi(double a)
 {
+    if (a > 1e6 || a < -1e6) {
+        /* far out, the remainder by the double 2 pi (off by 2.4e-16 per
+        ** turn) would not be the angle libm's sin and cos see (the double
+        ** build's targets go through them): reduce as they do */
+        a = m_atan2(m_sin(a), m_cos(a));
+        return a == -PI ? PI : a;
+    }
     if (a > PI || a <= -PI) {
         /* one remainder, not a loop: bounded time for any finite a */
         a = __builtin_fmod(a, 2 * PI); /* |a| < 2 pi, the sign of a */
