@@ -57,7 +57,7 @@ def callgrind(dirname):
         if "_empty_" in name:
             out[name] = v
             continue
-        loop = raw.get(re.sub(r"_(fwd|inv|inv_near|naive_fwd|naive_inv)_", "_empty_", name), 0)
+        loop = raw.get(re.sub(r"_(fwd|inv_near|inv|naive_fwd|naive_inv)_", "_empty_", name), 0)
         out[name] = v - loop
     return out
 
