@@ -353,7 +353,11 @@ pm_status invert_f(const pm_model_f *m, const pm_context *ctx, double T, double 
         bool flip = side < 0;
         if (start)
             flip = m_fabs(wrap_pi(start[1] - m->e)) > PI / 2;
-        if (fixed_f(m, ctx, T, D, flip, turn, &t, &d) == PM_OK) {
+        /* (within float noise of the pole's edge the frame can put the
+        ** point a hair beyond it: the side is checked in double) */
+        double de;
+        if (fixed_f(m, ctx, T, D, flip, turn, &t, &d) == PM_OK &&
+            (start || ((de = wrap_pi(d - m->e)) >= -PI / 2 && de <= PI / 2) == !flip)) {
             *enc_ha = t;
             *enc_dec = d;
             return PM_OK;
