@@ -21,8 +21,7 @@ FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit
 FUZZ_OPT     := -O1 -g
 FUZZ_CORE_FLAGS := $(filter-out $(OPT),$(CORE_FLAGS)) $(FUZZ_OPT) $(FUZZ_SAN) -fsanitize=fuzzer-no-link
 FUZZ_HOST_FLAGS := $(filter-out $(OPT),$(HOST_CXXFLAGS)) $(FUZZ_OPT) $(FUZZ_SAN) -fsanitize=fuzzer-no-link
-# FUZZ_DEFS=-DPMFZ_CORE_OPEN_ISSUES=0 (with another B): the strict
-# harnesses, which fail on the open core issues (fuzz/README.md).
+# FUZZ_DEFS: extra -D flags for the harnesses (none needed).
 FUZZ_DEFS    ?=
 FUZZ_C_FLAGS    := -std=c99 $(FUZZ_OPT) -Wall -Wextra -Iinclude -Itools/lib -Ifuzz $(FUZZ_SAN) \
                    -fsanitize=fuzzer-no-link $(FUZZ_DEFS)

@@ -172,29 +172,12 @@ static inline int pmfz_status_in(pm_status st, const int *allowed)
 #define pmfz_sep tu_angle
 
 
-/* Open issues of the core that the fuzzer found (fuzz/README.md,
-** "Open core issues"; reproducers in fuzz/pending/).  While this is 1 the
-** harnesses still require documented statuses and no crash, hang, leak or
-** undefined behaviour everywhere, but check these only for sane
-** evaluations (coefficients, displacements, angles and context inputs
-** within the bounds below):
-**   - pm_model_invert(_near) returns PM_OK with a round trip above
-**     PM_INVERT_TOL for large anisotropic terms (none seen since 9c984bb;
-**     kept while issue 2 is open);
-**   - at the pole, pm_model_invert's enc_dec can be 2pi off the documented
-**     interval (the side, the sign of cos(enc_dec - e'), is right);
-**   - pm_fit_add accepts a residual whose square overflows (models with
-**     coefficients near 1e300); pm_fit_solve then gives PM_OK with
-**     chi2 = sigma = inf (and pm_fit_covariance then +-inf), or
-**     PM_ERR_NONFINITE (not among its documented statuses) when the step
-**     overflows.
-** Plain evaluations (within the same bounds, whatever the switch) must
-** also give PM_OK where PM_ERR_NONFINITE (overflow) is allowed.  Build
-** with -DPMFZ_CORE_OPEN_ISSUES=0 (make fuzz B=build-strict
-** FUZZ_DEFS=-DPMFZ_CORE_OPEN_ISSUES=0) to check everything everywhere. */
-#ifndef PMFZ_CORE_OPEN_ISSUES
-#define PMFZ_CORE_OPEN_ISSUES 1
-#endif
+/* Plain evaluations: coefficients, displacements, angles and context
+** inputs within the bounds below.  Everywhere the harnesses require
+** documented statuses, no crash, hang, leak or undefined behaviour and
+** every result property (round trips, sides, finite statistics); for
+** plain evaluations they also refuse PM_ERR_NONFINITE, which the core may
+** answer only where the terms overflow. */
 #define PMFZ_SANE_COEF 0.5   /* radians, isotropic terms (real: < 0.1) */
 #define PMFZ_SANE_ANISO 2e-3 /* radians, displacement of the others
                                 (real: < 1e-3); cot(el) counts 100 times */
@@ -228,9 +211,12 @@ static inline int pmfz_plain_model(const pm_model *m)
     if (!(pmfz_max_coef(m, 0) <= PMFZ_SANE_COEF) || !(pmfz_max_coef(m, 1) <= PMFZ_SANE_ANISO))
         return 0;
     for (i = 0; i < m->n_terms && i < PM_MAX_TERMS; i++)
-        /* an AUX term displaces by coef * (input - param) */
+        /* an AUX term displaces by coef * (input - param); the float build
+        ** forms input - param in float, so a huge param overflows there
+        ** even with a zero coefficient */
         if (i >= m->n_base && m->term[i].kind == PM_TERM_AUX &&
-            !(fabs(m->coef[i]) * (fabs(m->term[i].param) + PMFZ_SANE_ANGLE) <= PMFZ_SANE_ANISO))
+            (!(fabs(m->coef[i]) * (fabs(m->term[i].param) + PMFZ_SANE_ANGLE) <= PMFZ_SANE_ANISO) ||
+             !(fabs(m->term[i].param) <= PMFZ_SANE_ANGLE)))
             return 0;
     return 1;
 }
@@ -247,17 +233,6 @@ static inline int pmfz_plain_ctx(const pm_context *c)
         if (!pmfz_plain_x(c->aux[j]))
             return 0;
     return 1;
-}
-
-/* Sane: where the open core issues are checked (everywhere once fixed). */
-static inline int pmfz_sane_x(double x) { return !PMFZ_CORE_OPEN_ISSUES || pmfz_plain_x(x); }
-static inline int pmfz_sane_model(const pm_model *m)
-{
-    return !PMFZ_CORE_OPEN_ISSUES || pmfz_plain_model(m);
-}
-static inline int pmfz_sane_ctx(const pm_context *c)
-{
-    return !PMFZ_CORE_OPEN_ISSUES || pmfz_plain_ctx(c);
 }
 
 #endif

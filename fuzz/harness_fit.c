@@ -30,7 +30,7 @@
 
 static const int ft_add_st[] = {PM_OK, PM_ERR_ARG, PM_ERR_NONFINITE, PM_ERR_STATE, 99};
 static const int ft_solve_st[] = {PM_OK, PM_ERR_ARG, PM_ERR_TOO_FEW, PM_ERR_SINGULAR,
-                                  PM_ERR_STATE, 99};
+                                  PM_ERR_NONFINITE, PM_ERR_STATE, 99};
 static const int ft_run_st[] = {PM_OK, PM_ERR_DIVERGED, PM_ERR_ARG, PM_ERR_NONFINITE,
                                 PM_ERR_TOO_FEW, PM_ERR_SINGULAR, PM_ERR_STATE, 99};
 static const int ft_cov_st[] = {PM_OK, PM_ERR_ARG, PM_ERR_STATE, 99};
@@ -47,7 +47,6 @@ static struct {
     pm_model truth, model, out, snap_model;
     pm_fit fit, snap_fit;
     pm_fit_result res, snap_res;
-    int res_sane; /* ft.res comes from a sane linearisation point */
     ft_obs obs[FT_MAX_OBS];
     double eh[FT_MAX_OBS], ed[FT_MAX_OBS], ah[FT_MAX_OBS], ad[FT_MAX_OBS];
     pm_context ctxs[FT_MAX_OBS];
@@ -164,19 +163,27 @@ static int ft_solve(int *solved)
     pm_status st;
     int i;
     pm_fit_result res = ft.res; /* a rejected step leaves most fields */
-    int sane = pmfz_sane_model(&ft.fit.lin); /* fz_input.h: chi2 can overflow */
     memset(&ft.out, 0x5A, sizeof ft.out);
     memcpy(&ft.snap_model, &ft.out, sizeof ft.out);
     memcpy(&ft.snap_res, &res, sizeof res);
+    memcpy(&ft.snap_fit, &ft.fit, sizeof ft.fit);
     st = pm_fit_solve(&ft.fit, &ft.out, &res);
-    /* fz_input.h, PMFZ_CORE_OPEN_ISSUES: a step that overflows gives the
-    ** undocumented PM_ERR_NONFINITE (pm_model_prepare's) */
-    if (!pmfz_status_in(st, ft_solve_st) && !(st == PM_ERR_NONFINITE && !sane))
+    if (!pmfz_status_in(st, ft_solve_st))
         return pmfz_fail("fit_solve: status %d", st);
     if (st != PM_OK) {
+        const pm_fit *a = &ft.snap_fit, *b = &ft.fit;
         if (memcmp(&ft.snap_model, &ft.out, sizeof ft.out) != 0 ||
             memcmp(&ft.snap_res, &res, sizeof res) != 0)
             return pmfz_fail("fit_solve: error %d changed *out or *res", st);
+        /* the accumulated pass and the damping state are kept */
+        if (a->n_obs != b->n_obs || memcmp(&a->chi2, &b->chi2, sizeof a->chi2) != 0 ||
+            memcmp(a->ata, b->ata, sizeof a->ata) != 0 ||
+            memcmp(a->atb, b->atb, sizeof a->atb) != 0 ||
+            memcmp(&a->lin, &b->lin, sizeof a->lin) != 0 ||
+            memcmp(a->base_coef, b->base_coef, sizeof a->base_coef) != 0 ||
+            memcmp(a->step, b->step, sizeof a->step) != 0 || a->halvings != b->halvings ||
+            a->iterations != b->iterations)
+            return pmfz_fail("fit_solve: error %d changed the pass or the damping state", st);
         if (st == PM_ERR_SINGULAR && (ft.fit.bad_term < 0 || ft.fit.bad_term >= ft.fit.n_par))
             return pmfz_fail("fit_solve: PM_ERR_SINGULAR with bad_term %d", ft.fit.bad_term);
         if (st == PM_ERR_SINGULAR)
@@ -186,11 +193,9 @@ static int ft_solve(int *solved)
     if (ft_model_ok(&ft.out, "fit_solve"))
         return 1;
     ft.res = res;
-    if (ft.res.accepted) {
+    if (ft.res.accepted)
         *solved = 1;
-        ft.res_sane = sane;
-    }
-    if (ft.res.accepted && sane) {
+    if (ft.res.accepted) {
         if (!pmfz_finite(ft.res.chi2) || ft.res.chi2 < 0 || !pmfz_finite(ft.res.sigma) ||
             ft.res.sigma < 0 || ft.res.n_par != ft.fit.n_par)
             return pmfz_fail("fit_solve: result chi2 %g sigma %g", ft.res.chi2, ft.res.sigma);
@@ -217,8 +222,7 @@ static int ft_cov(pmfz_in *in, int solved)
     }
     if (i < 0 || j < 0 || i >= n || j >= n)
         return pmfz_fail("covariance: PM_OK for (%d, %d) of %d", i, j, n);
-    /* fz_input.h, PMFZ_CORE_OPEN_ISSUES: sigma = inf after chi2 overflowed */
-    if ((ft.res_sane && !pmfz_finite(cov)) || !pmfz_finite(corr) ||
+    if (!pmfz_finite(cov) || !pmfz_finite(corr) ||
         !(fabs(corr) <= 1 + FT_CORR_SLACK) || (i == j && cov < 0))
         return pmfz_fail("covariance: (%d, %d) cov %g corr %g", i, j, cov, corr);
     return 0;
@@ -293,7 +297,6 @@ int pmfz_fit(const unsigned char *data, size_t size)
     if (st != PM_OK)
         return pmfz_fail("fit_init of a prepared model gave %d", st);
     memset(&ft.res, 0, sizeof ft.res);
-    ft.res_sane = 1;
     for (ops = 0; ops < FT_MAX_OPS && !r; ops++) {
         unsigned op = pmfz_u8(&in) % 8u;
         if (!pmfz_left(&in))

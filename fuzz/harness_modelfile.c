@@ -53,7 +53,7 @@ static int mf_evaluate(const pm_model *m)
     static const int inv_ok[] = {PM_OK, PM_WARN_NOT_CONVERGED, PM_WARN_UNREACHABLE, 99};
     pm_context ctx;
     size_t i;
-    if (!pmfz_sane_model(m) || !pmfz_plain_model(m)) { /* fz_input.h: statuses only */
+    if (!pmfz_plain_model(m)) { /* fz_input.h: statuses only (overflow) */
         static const int apply_st[] = {PM_OK, PM_ERR_NONFINITE, 99}; /* overflow */
         double t, d;
         memset(&ctx, 0, sizeof ctx);
