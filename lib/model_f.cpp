@@ -167,6 +167,17 @@ void correction_f(const pm_model_f *m, const pm_context *ctx, const FrameF &f, f
     *dDo = m_atan2(zeta * cd - rmc * sd, rho * cd + (sd + zeta) * sd);
 }
 
+/* sin and cos of a declination-like angle |x| <= pi/2, the cosine from the
+** complement pi/2 - |x| formed in double: near the pole cos((float)x) would
+** carry the angle's own rounding (1e-7 rad), which the HA correction
+** (~ offset / cos d) magnifies. */
+inline void dec_trig_f(double x, float *s, float *c)
+{
+    float cu = (float)(PI / 2 - m_fabs(x));
+    *c = m_sin(cu);
+    *s = x >= 0 ? m_cos(cu) : -m_cos(cu);
+}
+
 /* Forward model: encoder (t, d) -> apparent (T, D), in float except for the
 ** frame angles. */
 void forward_f(const pm_model_f *m, const pm_context *ctx, double t, double d, double *T,
@@ -180,12 +191,7 @@ void forward_f(const pm_model_f *m, const pm_context *ctx, double t, double d, d
     double tr = f.flip ? tc + PI : tc;
     double dr = f.flip ? (de > 0 ? PI - de : -PI - de) : de;
     float st = m_sin((float)wrap_pi(tr)), ct = m_cos((float)wrap_pi(tr));
-    /* cos d_r from the complement pi/2 - |d_r|, formed in double: near the
-    ** pole cos((float)d_r) would carry the angle's own rounding (1e-7 rad),
-    ** which the HA correction (~ offset / cos d) magnifies */
-    float cu = (float)(PI / 2 - m_fabs(dr));
-    f.cd = m_sin(cu);
-    f.sd = dr >= 0 ? m_cos(cu) : -m_cos(cu);
+    dec_trig_f(dr, &f.sd, &f.cd);
     frame_finish(m, st, ct, (float)t, (float)d, &f);
     float dT, dD;
     correction_f(m, ctx, f, &dT, &dD);
@@ -271,8 +277,8 @@ pm_status fixed_f(const pm_model_f *m, const pm_context *ctx, double T, double D
 {
     const double T0 = wrap_pi(T);
     const float sT = m_sin((float)T0), cT = m_cos((float)T0);
-    const float cu = (float)(PI / 2 - m_fabs(D)); /* as forward_f: near the pole */
-    const float cD = m_sin(cu), sD = D >= 0 ? m_cos(cu) : -m_cos(cu);
+    float sD, cD;
+    dec_trig_f(D, &sD, &cD);
     const bool raw = reads_angles_f(m);
     const float tol = (float)PM_INVERT_F_TOL;
     float dT = 0, dD = 0, last = 0;
