@@ -217,8 +217,8 @@ static void check_point(const pm_model *m, const pm_model_f *mf, const pm_contex
         if (tu_angle(ah, ad, ha, dec) > s->worst_rt_f)
             s->worst_rt_f = tu_angle(ah, ad, ha, dec);
         ck_assert_msg(tu_angle(ah, ad, ha, dec) <= 2 * PM_INVERT_F_TOL,
-                      "pm_model_invert_f PM_OK but misses (%.17g, %.17g) by %g rad", ha, dec,
-                      tu_angle(ah, ad, ha, dec));
+                      "pm_model_invert_f PM_OK but misses (%.17g, %.17g) by %g rad (side %d, "
+                      "result %.17g %.17g)", ha, dec, tu_angle(ah, ad, ha, dec), side, eh, ed);
     }
     probe_count = 0;
     st = pm_model_invert_near_f(mf, ctx, ha, dec, sh, sd, &eh, &ed);
