@@ -391,6 +391,11 @@ pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
 **     |i| or the polar axis's offset beyond 0.5 rad, where the closed form
 **     degenerates towards 90 deg), one more evaluation checks the round
 **     trip at the returned angles (Newton, within the bound of Note 2).
+**     So it does where a term restricted to one pier side (no pier side
+**     in ctx) sees the rounded angles on the other side of the pole's
+**     edge than the fixed point's last position: such a term jumps there,
+**     and a target whose only solutions sit on the edge itself gets
+**     PM_WARN_UNREACHABLE (or _NOT_CONVERGED) with the nearest position.
 **  5) The paper (Sec. 5.2) inverts by flipping the sign of the
 **     coefficients, with an error O(a^2); docs/model.md gives the measured
 **     size of that error.

@@ -153,6 +153,15 @@ bool reads_raw_angles(const pm_model *m)
     return false;
 }
 
+/* The side of the pole the added terms see at g without a pier side in
+** the context (site_of). */
+int side_at(const Iso<double> &k, const Trig<double> &g)
+{
+    double stp, ctp, sdp, cdp;
+    shifted<double>(k, g, &stp, &ctp, &sdp, &cdp);
+    return cdp >= 0 ? 1 : -1;
+}
+
 /* Give trig g the angles nearest the reference angles. */
 void on_turn(Trig<double> *g, double ref_t, double ref_d)
 {
@@ -238,12 +247,19 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
     if (converged) {
         double big = m_fabs(t) > m_fabs(d) ? m_fabs(t) : m_fabs(d);
         double lip = m->lip;
-        if (m->needs_ctx) /* (ctx checked by eval_ready) */
-            for (int i = m->n_base; i < m->n_terms; i++)
-                if (m->term[i].kind == PM_TERM_AUX)
-                    lip += m_fabs(m->coef[i] * (aux_input(ctx, m->term[i].aux) -
-                                                m->term[i].param)) * 2;
+        bool sided = false;
+        for (int i = m->n_base; i < m->n_terms; i++) {
+            if (m->term[i].kind == PM_TERM_AUX) /* (ctx checked by eval_ready) */
+                lip += m_fabs(m->coef[i] * (aux_input(ctx, m->term[i].aux) -
+                                            m->term[i].param)) * 2;
+            sided = sided || m->term[i].side != 0;
+        }
         if (!((1 + lip) * 8 * DBL_EPS * (big > 1 ? big : 1) <= 0.5 * PM_INVERT_TOL))
+            converged = false;
+        /* A term restricted to one side of the pole jumps at the pole's
+        ** edge; where rounding the angles moved the point across it, the
+        ** returned angles evaluate a different model: Newton checks them. */
+        else if (sided && !(ctx && ctx->pier) && side_at(k, g) != side_at(k, trig_of(t, d)))
             converged = false;
     }
     pm_status result = PM_OK;
