@@ -110,18 +110,8 @@ void correction_f(const pm_model_f *m, const pm_context *ctx, const FrameF &f, f
     V3<float> om = rot_dt<float>(ge.sd, ge.cd, rot_zt<float>(ge.st, ge.ct, v3<float>(m->a, m->b, 0)));
 
     /* anisotropic displacement (same templates as the double build) */
-    float Y[PM_N_HARM(PM_MAX_L)];
-    float S[6] = {0, 0, 0, 0, 0, 0};
-    if (m->order > 0) {
-        harmonics<float>(m->order, g, Y);
-        int nh = PM_N_HARM(m->order);
-        for (int k = 0; k < 6; k++) {
-            float acc = 0;
-            for (int j = 1; j < nh; j++)
-                acc += m->dense[k][j] * Y[j];
-            S[k] = acc;
-        }
-    }
+    float S[6];
+    sh_sums<float, float>(m->order, g, m->dense, S);
     float dt = -g.sd * (S[0] * g.ct + S[1] * g.st + S[3]) + g.cd * S[2] + S[5];
     float dd = S[0] * g.st - S[1] * g.ct - S[4];
     if (m->n_terms > m->n_base) {

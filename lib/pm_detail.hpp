@@ -119,11 +119,17 @@ template <typename T> struct Trig {
 ** Y(t+pi, pi-d) = Y(t, d) (Pal et al. Sec. 5.4).  The paper's normalisation
 ** multiplies by norm_lm() (folded into the coefficients).  Recurrences
 ** only: no trigonometric call.
+**
+** harmonics_n is the recurrence for order LC > 0 known at compile time
+** (unrolled: no loop counters, the divisions by constants folded), or for
+** the order Lrt (LC = 0).
 */
-template <typename T> inline void harmonics(int L, const Trig<T> &g, T *Y)
+template <typename T, int LC> inline void harmonics_n(int Lrt, const Trig<T> &g, T *Y)
 {
+    const int L = LC > 0 ? LC : Lrt;
     T cm = 1, sm = 0;  /* cos(m t), sin(m t) */
     T pmm = 1;         /* P_m^m */
+#pragma GCC unroll 16
     for (int m = 0; m <= L; m++) {
         if (m > 0) {
             T c2 = cm * g.ct - sm * g.st;
@@ -132,6 +138,7 @@ template <typename T> inline void harmonics(int L, const Trig<T> &g, T *Y)
             pmm = pmm * (T)(2 * m - 1) * g.cd;
         }
         T p2 = 0, p1 = pmm; /* P_{l-2}^m, P_{l-1}^m */
+#pragma GCC unroll 16
         for (int l = m; l <= L; l++) {
             T p;
             if (l == m)
@@ -150,6 +157,31 @@ template <typename T> inline void harmonics(int L, const Trig<T> &g, T *Y)
             if (m > 0)
                 Y[j - m] = p * sm;
         }
+    }
+}
+
+
+/* The raw harmonics up to order L (0..PM_MAX_L): orders 1..4 unrolled (the
+** orders a mount model uses), beyond that the loops. */
+template <typename T> inline void harmonics(int L, const Trig<T> &g, T *Y)
+{
+    switch (L) {
+    case 0: Y[0] = 1; return;
+    case 1: harmonics_n<T, 1>(1, g, Y); return;
+#if PM_MAX_L >= 2
+    case 2: harmonics_n<T, 2>(2, g, Y); return;
+#endif
+#if PM_MAX_L >= 3
+    case 3: harmonics_n<T, 3>(3, g, Y); return;
+#endif
+#if PM_MAX_L >= 4
+    case 4: harmonics_n<T, 4>(4, g, Y); return;
+#endif
+    default:
+#if PM_MAX_L > 4
+        harmonics_n<T, 0>(L, g, Y);
+#endif
+        return;
     }
 }
 
@@ -468,6 +500,51 @@ inline void term_uv(const pm_term &t, const Trig<T> &g, const Site<T> &s,
     *v = f * bv;
 }
 
+/* The harmonic sums of the base vectors at g: S[k] = sum over the harmonics
+** j >= 1 of dense[k][j] Y_j (base vector k + 1), for order LC (compile
+** time, unrolled) or Lrt (LC = 0).  W is the table's type (pm_model's
+** double, pm_model_f's float). */
+template <typename T, typename W, int LC>
+inline void sh_sums_n(int Lrt, const Trig<T> &g, const W (*dense)[PM_N_HARM(PM_MAX_L)], T *S)
+{
+    const int L = LC > 0 ? LC : Lrt;
+    T Y[PM_N_HARM(LC > 0 ? LC : PM_MAX_L)];
+    harmonics_n<T, LC>(L, g, Y);
+#pragma GCC unroll 32
+    for (int j = 1; j < (L + 1) * (L + 1); j++) {
+        const T y = Y[j];
+#pragma GCC unroll 6
+        for (int kk = 0; kk < 6; kk++)
+            S[kk] += (T)dense[kk][j] * y;
+    }
+}
+
+/* The harmonic sums for order L (0..PM_MAX_L), dispatched as harmonics(). */
+template <typename T, typename W>
+inline void sh_sums(int L, const Trig<T> &g, const W (*dense)[PM_N_HARM(PM_MAX_L)], T S[6])
+{
+    for (int kk = 0; kk < 6; kk++)
+        S[kk] = 0;
+    switch (L) {
+    case 0: return;
+    case 1: sh_sums_n<T, W, 1>(1, g, dense, S); return;
+#if PM_MAX_L >= 2
+    case 2: sh_sums_n<T, W, 2>(2, g, dense, S); return;
+#endif
+#if PM_MAX_L >= 3
+    case 3: sh_sums_n<T, W, 3>(3, g, dense, S); return;
+#endif
+#if PM_MAX_L >= 4
+    case 4: sh_sums_n<T, W, 4>(4, g, dense, S); return;
+#endif
+    default:
+#if PM_MAX_L > 4
+        sh_sums_n<T, W, 0>(L, g, dense, S);
+#endif
+        return;
+    }
+}
+
 /* Anisotropic displacement (tangent components in the transported frame)
 ** at encoder trig g: the base harmonic terms with l >= 1 through the dense
 ** table, then the added terms. */
@@ -476,19 +553,8 @@ inline void aniso(const pm_model *m, const Iso<T> &k, const Trig<T> &g0,
                   const pm_context *ctx, T *dt, T *dd)
 {
     PM_EVAL_PROBE();
-    T Y[PM_N_HARM(PM_MAX_L)];
-    T S[6] = {0, 0, 0, 0, 0, 0};
-    int nh = PM_N_HARM(m->order);
-    if (m->order > 0) {
-        harmonics<T>(m->order, g0, Y);
-        for (int kk = 0; kk < 6; kk++) {
-            const double *row = m->dense[kk];
-            T acc = 0;
-            for (int j = 1; j < nh; j++)
-                acc += (T)row[j] * Y[j];
-            S[kk] = acc;
-        }
-    }
+    T S[6];
+    sh_sums<T, double>(m->order, g0, m->dense, S);
     /* sum_k S_k (u_k, v_k), written out */
     *dt = -g0.sd * (S[0] * g0.ct + S[1] * g0.st + S[3]) + g0.cd * S[2] + S[5];
     *dd = S[0] * g0.st - S[1] * g0.ct - S[4];
