@@ -317,18 +317,24 @@ inline pm_status model_ready(const pm_model *m)
         return PM_ERR_ARG;
     if (m->prepared != 1 || m->n_terms < 6 || m->n_terms > PM_MAX_TERMS)
         return PM_ERR_STATE;
-    /* Bit patterns OR-ed together, four at a time, no early exit: a
-    ** quarter of the instructions of a compare-and-branch loop.  (Bitwise,
-    ** so writing -0.0 over 0.0 also asks for pm_model_prepare.) */
-    const int n = m->n_terms;
-    unsigned long long acc[4] = {0, 0, 0, 0};
+    /* Bit patterns XOR-ed and OR-ed together in the machine's words (two
+    ** per double on a 32-bit core), four at a time, no early exit.
+    ** (Bitwise, so writing -0.0 over 0.0 also asks for pm_model_prepare.) */
+    typedef unsigned long __attribute__((may_alias)) word; /* 32 bits on ARM EABI, 64 on LP64 */
+    const word *a = (const word *)m->coef;
+    const word *b = (const word *)m->prep_coef;
+    const int n = m->n_terms * (int)(sizeof(double) / sizeof(word));
+    word acc0 = 0, acc1 = 0, acc2 = 0, acc3 = 0;
     int i = 0;
-    for (; i + 4 <= n; i += 4)
-        for (int j = 0; j < 4; j++)
-            acc[j] |= bits_of(m->coef[i + j]) ^ bits_of(m->prep_coef[i + j]);
+    for (; i + 4 <= n; i += 4) {
+        acc0 |= a[i] ^ b[i];
+        acc1 |= a[i + 1] ^ b[i + 1];
+        acc2 |= a[i + 2] ^ b[i + 2];
+        acc3 |= a[i + 3] ^ b[i + 3];
+    }
     for (; i < n; i++)
-        acc[0] |= bits_of(m->coef[i]) ^ bits_of(m->prep_coef[i]);
-    return (acc[0] | acc[1] | acc[2] | acc[3]) ? PM_ERR_STATE : PM_OK;
+        acc0 |= a[i] ^ b[i];
+    return (acc0 | acc1 | acc2 | acc3) ? PM_ERR_STATE : PM_OK;
 }
 
 /* Model constants in working precision. */
@@ -501,8 +507,8 @@ inline void term_uv(const pm_term &t, const Trig<T> &g, const Site<T> &s,
 }
 
 /* The harmonic sums of the base vectors at g: S[k] = sum over the harmonics
-** j >= 1 of dense[k][j] Y_j (base vector k + 1), for order LC (compile
-** time, unrolled) or Lrt (LC = 0).  W is the table's type (pm_model's
+** j >= 1 of dense[k][j] Y_j (base vector k + 1), for order LC >= 1 (compile
+** time, unrolled) or Lrt >= 1 (LC = 0).  W is the table's type (pm_model's
 ** double, pm_model_f's float). */
 template <typename T, typename W, int LC>
 inline void sh_sums_n(int Lrt, const Trig<T> &g, const W (*dense)[PM_N_HARM(PM_MAX_L)], T *S)
@@ -510,8 +516,13 @@ inline void sh_sums_n(int Lrt, const Trig<T> &g, const W (*dense)[PM_N_HARM(PM_M
     const int L = LC > 0 ? LC : Lrt;
     T Y[PM_N_HARM(LC > 0 ? LC : PM_MAX_L)];
     harmonics_n<T, LC>(L, g, Y);
+    /* (assigned, not zeroed and added: the same sums, and no memset call
+    ** from the compiler on some cores) */
+#pragma GCC unroll 6
+    for (int kk = 0; kk < 6; kk++)
+        S[kk] = (T)dense[kk][1] * Y[1];
 #pragma GCC unroll 32
-    for (int j = 1; j < (L + 1) * (L + 1); j++) {
+    for (int j = 2; j < (L + 1) * (L + 1); j++) {
         const T y = Y[j];
 #pragma GCC unroll 6
         for (int kk = 0; kk < 6; kk++)
@@ -523,10 +534,10 @@ inline void sh_sums_n(int Lrt, const Trig<T> &g, const W (*dense)[PM_N_HARM(PM_M
 template <typename T, typename W>
 inline void sh_sums(int L, const Trig<T> &g, const W (*dense)[PM_N_HARM(PM_MAX_L)], T S[6])
 {
-    for (int kk = 0; kk < 6; kk++)
-        S[kk] = 0;
     switch (L) {
-    case 0: return;
+    case 0:
+        S[0] = S[1] = S[2] = S[3] = S[4] = S[5] = 0;
+        return;
     case 1: sh_sums_n<T, W, 1>(1, g, dense, S); return;
 #if PM_MAX_L >= 2
     case 2: sh_sums_n<T, W, 2>(2, g, dense, S); return;
@@ -540,6 +551,8 @@ inline void sh_sums(int L, const Trig<T> &g, const W (*dense)[PM_N_HARM(PM_MAX_L
     default:
 #if PM_MAX_L > 4
         sh_sums_n<T, W, 0>(L, g, dense, S);
+#else
+        S[0] = S[1] = S[2] = S[3] = S[4] = S[5] = 0; /* (L is checked) */
 #endif
         return;
     }
