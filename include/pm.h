@@ -388,7 +388,8 @@ pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
 **     displacement can change (m->lip, plus |coef (input - param)| of the
 **     AUX terms) could use that margin (coefficients of ~10 rad and more,
 **     or angles beyond ~100 rad), and for geometries no mount has (|d|,
-**     |i| or the polar axis's offset beyond 0.5 rad, where the closed form
+**     |i| or the polar axis's offset beyond 0.5 rad, or an anisotropic
+**     displacement that can reach 0.5 rad, where the closed form
 **     degenerates towards 90 deg), one more evaluation checks the round
 **     trip at the returned angles (Newton, within the bound of Note 2).
 **     So it does where a term restricted to one pier side (no pier side

@@ -36,30 +36,38 @@ bool dropped(int k, int l, int m)
 **   zenith cot(el) (el clamped at 0.01 rad): 1/0.01^2 + 1/0.01 + 2;
 **   zenith cos(el): 2;  AUX: 0 here (pm_model_invert adds them).
 ** pm_model_invert uses it to know when the rounding of its returned angles
-** could matter (pm.h, pm_model_invert Note 4).  Infinite for isotropic
-** geometries far from any mount (|d|, |i| or the polar axis's offset
-** beyond 0.5 rad; at d or i = 90 deg the closed form degenerates and loses
-** digits): every inverse there is checked. */
+** could matter (pm.h, pm_model_invert Note 4).  Infinite for geometries far
+** from any mount, where every inverse is checked: |d|, |i| or the polar
+** axis's offset beyond 0.5 rad (at d or i = 90 deg the closed form
+** degenerates and loses digits), or an anisotropic displacement that can
+** reach 0.5 rad (the sum of |coef| times each term's largest value per unit
+** coefficient: harmonic 2 (N_lm Y_lm, l <= 10, measured), Fourier and
+** sectoral 1, zenith cot(el) 100, cos(el) 1; towards 90 deg the closed
+** form's branch is ill-conditioned: a 1.57 rad term missed by 5.6e-13). */
 double lipschitz(const pm_model *m)
 {
     const double far = 0.5;
     if (!(m_fabs(m->coef[3]) <= far && m_fabs(m->coef[5]) <= far &&
           m->coef[0] * m->coef[0] + m->coef[1] * m->coef[1] <= far * far))
         return __builtin_inf();
-    double s = 0;
+    double s = 0, amp = 0;
     for (int i = 6; i < m->n_terms; i++) {
         const pm_term &t = m->term[i];
-        double b = 0;
+        double b = 0, v = 0; /* rate and value bounds per unit coefficient */
         switch (t.kind) {
-        case PM_TERM_SH: b = 8.0 + t.l; break;
-        case PM_TERM_FOURIER: b = m_fabs(t.param) + 2; break;
-        case PM_TERM_SECTORAL: b = 2 * m_fabs(t.param) + 2; break;
-        case PM_TERM_ZENITH: b = t.l == 0 ? 1e4 + 100 + 2 : 2; break;
-        default: b = 0; break;
+        case PM_TERM_SH: b = 8.0 + t.l; v = 2; break;
+        case PM_TERM_FOURIER: b = m_fabs(t.param) + 2; v = 1; break;
+        case PM_TERM_SECTORAL: b = 2 * m_fabs(t.param) + 2; v = 1; break;
+        case PM_TERM_ZENITH:
+            b = t.l == 0 ? 1e4 + 100 + 2 : 2;
+            v = t.l == 0 ? 100 : 1;
+            break;
+        default: break;
         }
         s += m_fabs(m->coef[i]) * b;
+        amp += m_fabs(m->coef[i]) * v;
     }
-    return s;
+    return amp <= far ? s : __builtin_inf();
 }
 
 /* Round-trip residual of encoder trig g against target q, measured as the
@@ -254,7 +262,10 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
                                             m->term[i].param)) * 2;
             sided = sided || m->term[i].side != 0;
         }
-        if (!((1 + lip) * 8 * DBL_EPS * (big > 1 ? big : 1) <= 0.5 * PM_INVERT_TOL))
+        /* (the AUX terms' part of lip is twice their largest displacement:
+        ** beyond 0.5 rad, as for lipschitz(), every inverse is checked) */
+        if (!((1 + lip) * 8 * DBL_EPS * (big > 1 ? big : 1) <= 0.5 * PM_INVERT_TOL) ||
+            !(lip - m->lip <= 1))
             converged = false;
         /* A term restricted to one side of the pole jumps at the pole's
         ** edge; where rounding the angles moved the point across it, the
