@@ -97,6 +97,17 @@ void frame_finish(const pm_model_f *m, float st, float ct, float t, float d, Fra
     f->g.have_angles = true;
 }
 
+/* atan2(y, x), by its series where the angle is small (|y| <= 0.01 x: the
+** terms left out are below 2e-15 rad), else by libm. */
+inline float atan2_small(float y, float x)
+{
+    if (x > 0 && m_fabs(y) <= 0.01f * x) {
+        float r = y / x, r2 = r * r;
+        return r * (1 - r2 * (1.0f / 3 - r2 * 0.2f));
+    }
+    return m_atan2(y, x);
+}
+
 /* The correction at a frame: the apparent position is (t_r + dT, d_r + dD).
 ** One model evaluation (everything of the forward model but the frame
 ** angles). */
@@ -153,38 +164,83 @@ void correction_f(const pm_model_f *m, const pm_context *ctx, const FrameF &f, f
     float q = cd + eta;
     float rho = m_sqrt(o.y * o.y + q * q);
     float rmc = rho + cd > 0 ? (2 * cd * eta + eta * eta + o.y * o.y) / (rho + cd) : rho - cd;
-    *dTo = m_atan2(o.y, q);
-    *dDo = m_atan2(zeta * cd - rmc * sd, rho * cd + (sd + zeta) * sd);
+    *dTo = atan2_small(o.y, q);
+    *dDo = atan2_small(zeta * cd - rmc * sd, rho * cd + (sd + zeta) * sd);
 }
 
-/* sin and cos of a declination-like angle |x| <= pi/2, the cosine from the
-** complement pi/2 - |x| formed in double: near the pole cos((float)x) would
-** carry the angle's own rounding (1e-7 rad), which the HA correction
-** (~ offset / cos d) magnifies. */
+/* sin and cos of a float angle |x| <= 3.2 (frame angles: within pi), without
+** libm: the nearest multiple k pi/2 taken off in two parts (k pi/2 as a float
+** is exact for |k| <= 2, and x - k pi/2 then too, by Sterbenz's lemma), the
+** Taylor series to r^9 and r^10 on |r| <= pi/4 (truncation below 3e-9
+** relative), the quadrant's swap: within 1.5 ulp of 1 of the exact values
+** (libm: 0.5 ulp).  Beyond 3.2 (k = 3 and more), libm. */
+inline void sincos_f(float x, float *s, float *c)
+{
+    if (!(m_fabs(x) <= 3.2f)) {
+        *s = m_sin(x);
+        *c = m_cos(x);
+        return;
+    }
+    const float P1 = 1.57079625129699707031f, P2 = 7.54978995489188216e-08f;
+    int k = (int)(x * 0.636619772f + (x >= 0 ? 0.5f : -0.5f));
+    float r = (x - (float)k * P1) - (float)k * P2, r2 = r * r;
+    float sr = r + r * r2 * (-1.0f / 6 + r2 * (1.0f / 120 + r2 * (-1.0f / 5040 + r2 * (1.0f / 362880))));
+    float cr = 1 - 0.5f * r2 +
+               r2 * r2 * (1.0f / 24 + r2 * (-1.0f / 720 + r2 * (1.0f / 40320 - r2 * (1.0f / 3628800))));
+    switch (k & 3) {
+    case 0: *s = sr; *c = cr; break;
+    case 1: *s = cr; *c = -sr; break;
+    case 2: *s = -sr; *c = -cr; break;
+    default: *s = -cr; *c = sr; break;
+    }
+}
+
+/* sin and cos of a declination-like angle |x| <= pi/2.  Beyond 1 rad the
+** cosine comes from the complement pi/2 - |x| formed in double: near the
+** pole cos((float)x) would carry the angle's own rounding (up to 6e-8 rad,
+** a relative error of 6e-8 tan x in the cosine), which the HA correction
+** (~ offset / cos d) magnifies; within 1 rad that is below 1e-7. */
 inline void dec_trig_f(double x, float *s, float *c)
 {
+    if (!abs_beyond(x, 1.0)) {
+        sincos_f((float)x, s, c);
+        return;
+    }
     float cu = (float)(PI / 2 - m_fabs(x));
-    *c = m_sin(cu);
-    *s = x >= 0 ? m_cos(cu) : -m_cos(cu);
+    float sc;
+    sincos_f(cu, c, &sc);
+    *s = below0(x) ? -sc : sc;
 }
 
-/* Forward model: encoder (t, d) -> apparent (T, D), in float except for the
-** frame angles. */
-void forward_f(const pm_model_f *m, const pm_context *ctx, double t, double d, double *T,
-               double *D)
+/* Forward model: encoder (t, d) -> apparent (T, D) = (wrap_pi(t_r + dT),
+** d_r + dD), in float except for the frame angles (t_r, d_r), returned
+** apart with the correction (dT, dD). */
+void forward_parts_f(const pm_model_f *m, const pm_context *ctx, double t, double d,
+                     double *tr_out, double *dr_out, float *dT, float *dD)
 {
     /* frame angles: exact index shifts; beyond the pole, the equivalent
     ** position (t_r, d_r) = (t_c + pi, pi - d_e) with |d_r| <= pi/2 */
     double tc = t + m->c, de = wrap_pi(d - m->e);
     FrameF f;
-    f.flip = de > PI / 2 || de < -PI / 2;
+    f.flip = abs_beyond(de, PI / 2);
     double tr = f.flip ? tc + PI : tc;
-    double dr = f.flip ? (de > 0 ? PI - de : -PI - de) : de;
-    float st = m_sin((float)wrap_pi(tr)), ct = m_cos((float)wrap_pi(tr));
+    double dr = f.flip ? (above0(de) ? PI - de : -PI - de) : de;
+    float st, ct;
+    sincos_f((float)wrap_pi(tr), &st, &ct);
     dec_trig_f(dr, &f.sd, &f.cd);
     frame_finish(m, st, ct, (float)t, (float)d, &f);
+    correction_f(m, ctx, f, dT, dD);
+    *tr_out = tr;
+    *dr_out = dr;
+}
+
+/* Forward model: encoder (t, d) -> apparent (T, D). */
+void forward_f(const pm_model_f *m, const pm_context *ctx, double t, double d, double *T,
+               double *D)
+{
+    double tr, dr;
     float dT, dD;
-    correction_f(m, ctx, f, &dT, &dD);
+    forward_parts_f(m, ctx, t, d, &tr, &dr, &dT, &dD);
     *T = wrap_pi(tr + (double)dT);
     *D = dr + (double)dD;
 }
@@ -247,7 +303,7 @@ void encoder_of(const pm_model_f *m, double T0, double D, float dT, float dD, bo
 {
     double tr = T0 - (double)dT, dr = D - (double)dD;
     double tt = (flip ? tr - PI : tr) - m->c;
-    double dd = (flip ? (dr > 0 ? PI - dr : -PI - dr) : dr) + m->e;
+    double dd = (flip ? (above0(dr) ? PI - dr : -PI - dr) : dr) + m->e;
     finish_angles(ref, &tt, &dd);
     *t = tt;
     *d = dd;
@@ -266,7 +322,8 @@ pm_status fixed_f(const pm_model_f *m, const pm_context *ctx, double T, double D
                   const double ref[2], double *t_out, double *d_out)
 {
     const double T0 = wrap_pi(T);
-    const float sT = m_sin((float)T0), cT = m_cos((float)T0);
+    float sT, cT;
+    sincos_f((float)T0, &sT, &cT);
     float sD, cD;
     dec_trig_f(D, &sD, &cD);
     const bool raw = reads_angles_f(m);
@@ -312,11 +369,22 @@ pm_status fixed_f(const pm_model_f *m, const pm_context *ctx, double T, double D
         ** (one more evaluation); Newton takes over if it misses. */
         float rho = last > 0 ? change / last : change == 0 ? 0.0f : 1.0f;
         if (it > 0 && change * rho <= 0.25f * tol) {
-            double t, d, T1, D1;
-            float x, y;
+            double t, d, tr, dr;
+            float kT, kD; /* the correction there */
             encoder_of(m, T0, D, dT, dD, flip, ref, &t, &d);
-            forward_f(m, ctx, t, d, &T1, &D1);
-            if (!(sky_offset(T1, D1, T, D, &x, &y) <= tol))
+            forward_parts_f(m, ctx, t, d, &tr, &dr, &kT, &kD);
+            /* The forward model gives (T1, D1) = (t_r + kT, d_r + kD), to
+            ** the rounding of those sums (1e-16), so its offset from the
+            ** target is (eT, eD) below.  The separation (haversine):
+            ** chord^2 = (2 sin(eD/2))^2 + cos D1 cos D (2 sin(eT/2))^2
+            **         <= eD^2 + cos D1 cos D eT^2,
+            ** with cos D1 <= cos D - sin D eD + eD^2 (|eD| < 1); the angle
+            ** exceeds the chord by a part in chord^2 / 24, and the float
+            ** sums by a few parts in 1e7: 1% of tol^2 covers both. */
+            float eT = (float)wrap_pi(tr - T0) + kT, eD = (float)(dr - D) + kD;
+            float cD1 = cD - sD * eD + eD * eD;
+            float cc = cD1 > 0 ? cD1 * cD : 0.0f;
+            if (!(m_fabs(eD) < 1 && eD * eD + cc * eT * eT <= 0.99f * tol * tol))
                 return PM_WARN_NOT_CONVERGED;
             *t_out = t;
             *d_out = d;
@@ -337,9 +405,9 @@ pm_status invert_f(const pm_model_f *m, const pm_context *ctx, double T, double 
         return PM_ERR_ARG;
     if (!finite(T) || !finite(D) || (start && (!finite(start[0]) || !finite(start[1]))))
         return PM_ERR_NONFINITE;
-    if (m_fabs(D) > PI / 2 + 1e-12)
+    if (abs_beyond(D, PI / 2 + 1e-12))
         return PM_ERR_ARG;
-    if (start && (m_fabs(start[0]) > PM_START_MAX || m_fabs(start[1]) > PM_START_MAX))
+    if (start && (abs_beyond(start[0], PM_START_MAX) || abs_beyond(start[1], PM_START_MAX)))
         return PM_ERR_ARG;
     double turn[2];
     turn_of(start, side, m->e, turn);
@@ -348,12 +416,11 @@ pm_status invert_f(const pm_model_f *m, const pm_context *ctx, double T, double 
         /* the fixed point first; Newton where it does not contract */
         bool flip = side < 0;
         if (start)
-            flip = m_fabs(wrap_pi(start[1] - m->e)) > PI / 2;
+            flip = abs_beyond(wrap_pi(start[1] - m->e), PI / 2);
         /* (within float noise of the pole's edge the frame can put the
         ** point a hair beyond it: the side is checked in double) */
-        double de;
         if (fixed_f(m, ctx, T, D, flip, turn, &t, &d) == PM_OK &&
-            (start || ((de = wrap_pi(d - m->e)) >= -PI / 2 && de <= PI / 2) == !flip)) {
+            (start || !abs_beyond(wrap_pi(d - m->e), PI / 2) == !flip)) {
             *enc_ha = t;
             *enc_dec = d;
             return PM_OK;

@@ -32,7 +32,73 @@ inline float m_atan2(float y, float x) { return __builtin_atan2f(y, x); }
 inline float m_sqrt(float x) { return __builtin_sqrtf(x); }
 inline float m_fabs(float x) { return __builtin_fabsf(x); }
 
-inline bool finite(double x) { return x - x == 0.0; }
+/* The bit pattern of a double. */
+inline unsigned long long bits_of(double x)
+{
+    unsigned long long u;
+    __builtin_memcpy(&u, &x, sizeof u);
+    return u;
+}
+
+/* Double-precision tests written on the bit pattern where double arithmetic
+** is emulated (a Cortex-M4F: a libgcc compare costs ~100 instructions, the
+** integer test a few); plain comparisons elsewhere.  Same answers. */
+#if defined(__arm__) && !(defined(__ARM_FP) && (__ARM_FP & 8))
+#define PM_SOFT_DOUBLE 1
+#else
+#define PM_SOFT_DOUBLE 0
+#endif
+
+/* x finite (not NaN, not +-inf). */
+inline bool finite(double x)
+{
+#if PM_SOFT_DOUBLE
+    return (bits_of(x) & 0x7ff0000000000000ULL) != 0x7ff0000000000000ULL;
+#else
+    return x - x == 0.0;
+#endif
+}
+
+/* !(|a| <= b): |a| beyond b, or a NaN; for b >= 0, not NaN.  (Non-negative
+** doubles are ordered as their bit patterns.) */
+inline bool abs_beyond(double a, double b)
+{
+#if PM_SOFT_DOUBLE
+    return (bits_of(a) & 0x7fffffffffffffffULL) > bits_of(b);
+#else
+    return !(m_fabs(a) <= b);
+#endif
+}
+
+/* a == b for b not NaN and not zero (one bit pattern each). */
+inline bool same_as(double a, double b)
+{
+#if PM_SOFT_DOUBLE
+    return bits_of(a) == bits_of(b);
+#else
+    return a == b;
+#endif
+}
+
+/* x < 0, for x not NaN. */
+inline bool below0(double x)
+{
+#if PM_SOFT_DOUBLE
+    return bits_of(x) > 0x8000000000000000ULL;
+#else
+    return x < 0;
+#endif
+}
+
+/* x > 0, for x not NaN. */
+inline bool above0(double x)
+{
+#if PM_SOFT_DOUBLE
+    return (long long)bits_of(x) > 0;
+#else
+    return x > 0;
+#endif
+}
 
 const double PI = 3.14159265358979323846;
 const double DBL_EPS = 2.220446049250313e-16; /* 2^-52 */
@@ -253,6 +319,8 @@ template <typename T> inline void logmap(const V3<T> &q, T *a, T *b)
 /* Wrap an angle into (-pi, pi]. */
 inline double wrap_pi(double a)
 {
+    if (!abs_beyond(a, PI)) /* |a| <= pi: the common case */
+        return same_as(a, -PI) ? PI : a;
     if (a > 1e6 || a < -1e6) {
         /* far out, the remainder by the double 2 pi (off by 2.4e-16 per
         ** turn) would not be the angle libm's sin and cos see (the double
@@ -295,19 +363,12 @@ inline void turn_of(const double *start, int side, double e, double ref[2])
 inline void finish_angles(const double ref[2], double *t, double *d)
 {
     double a = *t - ref[0], b = *d - ref[1];
-    if (a > PI || a <= -PI)
+    if (abs_beyond(a, PI) || same_as(a, -PI)) /* not in (-pi, pi] */
         *t = ref[0] + wrap_pi(a);
-    if (b > PI || b <= -PI)
+    if (abs_beyond(b, PI) || same_as(b, -PI))
         *d = ref[1] + wrap_pi(b);
 }
 
-/* The bit pattern of a double. */
-inline unsigned long long bits_of(double x)
-{
-    unsigned long long u;
-    __builtin_memcpy(&u, &x, sizeof u);
-    return u;
-}
 
 /* Is the model ready for evaluation: prepared, and no coefficient changed
 ** since (a stale model would be silently wrong). */
