@@ -122,9 +122,14 @@ def main():
     ticks = {r["name"]: r["ticks_median"] for r in read_jsonl(os.path.join(D, "host.jsonl"))}
     insns = callgrind(os.path.join(D, "callgrind"))
     for t in targets:
-        for r in read_jsonl(os.path.join(D, t + ".out")):
-            if "_counter_" not in r["name"]:
-                insns[r["name"]] = r["instructions"]
+        raw = {r["name"]: r["instructions"] for r in read_jsonl(os.path.join(D, t + ".out"))
+               if "_counter_" not in r["name"]}
+        for name, v in raw.items():
+            # the loop's own cost subtracted, as for the host (libm rows: loop included)
+            loop = None
+            if re.search(r"_(fwd|inv_near|inv|naive_fwd|naive_inv)_L", name):
+                loop = raw.get(re.sub(r"_(fwd|inv_near|inv|naive_fwd|naive_inv)_", "_empty_", name))
+            insns[name] = v - loop if loop is not None else v
     fit = read_jsonl(os.path.join(D, "fit.jsonl"))
 
     # per-call entries
