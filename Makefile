@@ -71,6 +71,16 @@ $(B)/tests/check_bounded: tests/check_bounded.c $(PROBE_OBJ) $(wildcard tests/*.
 	@mkdir -p $(@D)
 	$(CC) $(TEST_CFLAGS) $< -o $@ $(PROBE_OBJ) $(TEST_LIBS)
 
+# check_internal tests the core's own helpers (lib/pm_detail.hpp) through a
+# test-only shim compiled with the core's flags.
+$(B)/tests/internal_shim.o: tests/internal_shim.cpp $(wildcard include/*.h lib/*.hpp)
+	@mkdir -p $(@D)
+	$(CXX) $(CORE_FLAGS) -c $< -o $@
+
+$(B)/tests/check_internal: tests/check_internal.c $(B)/tests/internal_shim.o $(wildcard tests/*.h)
+	@mkdir -p $(@D)
+	$(CC) $(TEST_CFLAGS) $< -o $@ $(B)/tests/internal_shim.o $(TEST_LIBS)
+
 # The public header must be strict ANSI C.
 check-c89: include/pm.h
 	@mkdir -p $(B)

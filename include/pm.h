@@ -207,7 +207,7 @@ typedef struct pm_model {
                                       aside; infinite if |d|, |i| or the
                                       polar offset exceed 0.5 rad
                                       (pm_model_invert, Note 4) */
-    double dense[6][PM_N_HARM(PM_MAX_L)]; /* per base vector k, per harmonic */
+    double dense[PM_N_HARM(PM_MAX_L)][6]; /* per harmonic, per base vector k */
 } pm_model;
 
 /*
@@ -488,7 +488,7 @@ typedef struct pm_model_f {
     float sd, vd, si, vi;          /* sin d, 1 - cos d, sin i, 1 - cos i */
     float sc, cc, se, ce;          /* sin, cos of c' and e' */
     float lat_s, lat_c;            /* site latitude */
-    float dense[6][PM_N_HARM(PM_MAX_L)];
+    float dense[PM_N_HARM(PM_MAX_L)][6];
     pm_term term[PM_MAX_TERMS];    /* the added terms (index >= n_base) */
     float coef[PM_MAX_TERMS];
 } pm_model_f;

@@ -83,7 +83,78 @@ double miss(const pm_model *m, const Iso<double> &k, const pm_context *ctx,
 
 /* Which side of the mount's pole an encoder declination is on: the sign of
 ** cos(dec - e'). */
-int side_of(const pm_model *m, double d) { return m_cos(d - m->coef[4]) >= 0 ? 1 : -1; }
+int side_of(const pm_model *m, double d)
+{
+    double x = d - m->coef[4];
+    /* within pi: cos x >= 0 exactly where |x| <= pi/2 as a double (cos of
+    ** that double is 6e-17, of the next one -1.6e-16) */
+    if (!abs_beyond(x, PI))
+        return abs_beyond(x, PI / 2) ? -1 : 1;
+    return m_cos(x) >= 0 ? 1 : -1;
+}
+
+/* atan(r) for |r| <= 0.01 by its series (the terms left out are below
+** 1e-23). */
+inline double atan_small(double r)
+{
+    double r2 = r * r;
+    return r * (1 - r2 * (1.0 / 3 - r2 * (1.0 / 5 - r2 * (1.0 / 7 - r2 * (1.0 / 9)))));
+}
+
+/* The angle x + s (+ pi if half) in (-pi, pi], for |x| <= 64 and |s| <= 1:
+** the multiple of 2 pi taken off in the parts of pi/2 (x - q PIO2_1 is
+** exact or rounded once), s added apart: within about an ulp (a result
+** that rounds onto or beyond +-pi is pi). */
+inline double turn_sum(double x, double s, bool half)
+{
+    double n = ((x + s) * 0.15915494309189535 + (half ? 0.5 : 0.0) + RND_INT) - RND_INT;
+    double q = 4 * n - (half ? 2 : 0); /* x + s + (pi) - 2 pi n = x + s - q pi/2 */
+    double a = (x - q * PIO2_1) + ((s - q * PIO2_2) - q * PIO2_3);
+    return abs_beyond(a, PI) || same_as(a, -PI) ? PI : a;
+}
+
+/*
+** Apparent angles (T, D) of the forward model's unit vector p at encoder
+** (t, d), without atan2: measured from the shifted position (t + c',
+** d - e') -- beyond the mount's pole from its equivalent (t + c' + pi,
+** pi - (d - e')) -- whose trig sh (forward_vec) is known, p's offsets
+** (dT, dD) are small (the anisotropic displacement, a, b, d, i): two short
+** series.  The sums are formed so that about one rounding falls on the
+** result: multiples of pi/2 in three parts (turn_sum; +-2 PIO2_1 - d is
+** exact or rounded once), the small parts added apart.  Returns false where this does not apply -- |t| > 64,
+** |d| > 4, |c'| or |e'| > 0.5, an offset beyond 0.01 rad (within ~0.6 deg
+** of the pole) -- and the caller takes atan2.
+*/
+bool frame_angles(const pm_model *m, double t, double d, const double sh[4],
+                  const V3<double> &p, double *T, double *D)
+{
+    const double c = m->coef[2], e = m->coef[4];
+    if (abs_beyond(t, 64) || abs_beyond(d, 4) || abs_beyond(c, 0.5) || abs_beyond(e, 0.5))
+        return false;
+    /* |d - e'| <= 4.5 < 3 pi/2: the normal side is d - e' in [-pi/2, pi/2] */
+    const bool flip = sh[3] < 0;
+    const double sT = flip ? -sh[0] : sh[0], cT = flip ? -sh[1] : sh[1];
+    const double sD = sh[2], cD = flip ? -sh[3] : sh[3];
+    double x1 = cT * p.x + sT * p.y, y1 = cT * p.y - sT * p.x;
+    double rho = m_sqrt(x1 * x1 + y1 * y1);
+    double zn = p.z * cD - rho * sD, zd = rho * cD + p.z * sD;
+    if (!(m_fabs(y1) <= 0.01 * x1) || !(m_fabs(zn) <= 0.01 * zd))
+        return false;
+    double dT = atan_small(y1 / x1), dD = atan_small(zn / zd);
+    /* T = t + c' + dT (+ pi), in (-pi, pi] */
+    *T = turn_sum(t, c + dT, flip);
+    /* D = d - e' + dD, or beyond the pole +-pi - (d - e') + dD */
+    double da;
+    if (!flip)
+        da = d + (dD - e);
+    else if (d - e > 0)
+        da = (2 * PIO2_1 - d) + (((e + dD) + 2 * PIO2_2) + 2 * PIO2_3);
+    else
+        da = (-2 * PIO2_1 - d) + (((e + dD) - 2 * PIO2_2) - 2 * PIO2_3);
+    /* the exact angle is in [-pi/2, pi/2]: rounding only can leave it */
+    *D = abs_beyond(da, PI / 2) ? (below0(da) ? -PI / 2 : PI / 2) : da;
+    return true;
+}
 
 /* Damped Newton iteration on the forward model, in a frame fixed at the
 ** target.  Used where the fixed point does not contract (close to the
@@ -170,11 +241,64 @@ int side_at(const Iso<double> &k, const Trig<double> &g)
     return cdp >= 0 ? 1 : -1;
 }
 
-/* Give trig g the angles nearest the reference angles. */
-void on_turn(Trig<double> *g, double ref_t, double ref_d)
+/* The inverse's target: apparent (ha, dec), their sines and cosines, the
+** unit vector. */
+struct Aim {
+    double ha, dec;
+    double sh, ch, sd, cd;
+    V3<double> q;
+};
+
+/* Angle of the pair (s, c) near the angle a0 whose sine and cosine are
+** (s0, c0): a0 + atan2(sin(a - a0), cos(a - a0)), the small angle by its
+** series, returned as the parts (a0, the small angle) in *small; false if
+** it is not small (beyond 0.01 rad). */
+inline bool near_angle(double s, double c, double s0, double c0, double *small)
 {
-    g->t = ref_t + wrap_pi(m_atan2(g->st, g->ct) - ref_t);
-    g->d = ref_d + wrap_pi(m_atan2(g->sd, g->cd) - ref_d);
+    double y = s * c0 - c * s0, x = c * c0 + s * s0;
+    if (!(m_fabs(y) <= 0.01 * x))
+        return false;
+    *small = atan_small(y / x);
+    return true;
+}
+
+/* Give trig g (an inverse's trial point for target a) its angles, the ones
+** nearest the reference angles.  The encoder position is near the target
+** after the index shifts, (ha - c', dec + e') -- beyond the pole (ha - c'
+** + pi, pi - dec + e') --, off by the displacement: its angles from there
+** by series where that is below 0.01 rad (the sums formed as in
+** frame_angles), else by atan2. */
+void on_turn(const pm_model *m, const Iso<double> &k, const Aim &a, Trig<double> *g,
+             double ref_t, double ref_d)
+{
+    const double c = m->coef[2], e = m->coef[4];
+    /* beyond the pole: cos(d - e') < 0 */
+    const bool flip = g->cd * k.ce + g->sd * k.se < 0;
+    double small, t, d;
+    /* t0 = ha - c' (+ pi) */
+    double s0 = a.sh * k.cc - a.ch * k.sc, c0 = a.ch * k.cc + a.sh * k.sc;
+    if (flip) {
+        s0 = -s0;
+        c0 = -c0;
+    }
+    if (!abs_beyond(a.ha, 64) && !abs_beyond(c, 0.5) &&
+        near_angle(g->st, g->ct, s0, c0, &small))
+        t = turn_sum(a.ha, small - c, flip);
+    else
+        t = m_atan2(g->st, g->ct);
+    /* d0 = dec + e', or pi - dec + e' */
+    double sd0 = a.sd * k.ce + a.cd * k.se, cd0 = a.cd * k.ce - a.sd * k.se;
+    if (flip) {
+        sd0 = a.sd * k.ce - a.cd * k.se;
+        cd0 = -(a.cd * k.ce + a.sd * k.se);
+    }
+    if (!abs_beyond(e, 0.5) && near_angle(g->sd, g->cd, sd0, cd0, &small))
+        d = flip ? (2 * PIO2_1 - a.dec) + (((e + small) + 2 * PIO2_2) + 2 * PIO2_3)
+                 : a.dec + (small + e);
+    else
+        d = m_atan2(g->sd, g->cd);
+    g->t = ref_t + wrap_pi(t - ref_t);
+    g->d = ref_d + wrap_pi(d - ref_d);
     g->have_angles = true;
 }
 
@@ -182,14 +306,14 @@ void on_turn(Trig<double> *g, double ref_t, double ref_d)
 ** position's branch, with the angles on the turn the result is returned
 ** on (turn_of).  Returns the status and (t, d). */
 pm_status solve_branch(const pm_model *m, const Iso<double> &k,
-                       const pm_context *ctx, const V3<double> &q, double app_ha, double app_dec,
-                       int side, const double *start, const double *turn, double *t_out,
+                       const pm_context *ctx, const Aim &a, int side, const double *start, const double *turn, double *t_out,
                        double *d_out)
 {
     double dt_prev = 0, dd_prev = 0;
     /* Periodic terms of non-integer G read the raw angle itself, not only
     ** its sine and cosine: iterate with the angles on the returned turn. */
     const double ref_t = turn[0], ref_d = turn[1];
+    const Target<double> tg = target_of(k, a.q);
     Trig<double> g;
     if (start) {
         /* The branch of the start: the sign of the x-component of
@@ -205,9 +329,9 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
     /* the angles themselves (two atan2) only where a term reads them;
     ** else once, at the end */
     const bool raw = reads_raw_angles(m);
-    bool reachable = iso_inverse<double>(k, q, dt_prev, dd_prev, side, &g);
+    bool reachable = iso_inverse<double>(k, tg, dt_prev, dd_prev, side, &g);
     if (raw)
-        on_turn(&g, ref_t, ref_d);
+        on_turn(m, k, a, &g, ref_t, ref_d);
 
     /* Fixed point: x_{n+1} = iso_inverse(D(x_n)).  x_n misses the target
     ** by |D(x_n) - D(x_{n-1})| (to first order), which is the test. */
@@ -235,14 +359,14 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
         last_change = change;
         dt_prev = dt;
         dd_prev = dd;
-        reachable = iso_inverse<double>(k, q, dt, dd, side, &g);
+        reachable = iso_inverse<double>(k, tg, dt, dd, side, &g);
         if (raw)
-            on_turn(&g, ref_t, ref_d);
+            on_turn(m, k, a, &g, ref_t, ref_d);
     }
     g = best;
     reachable = best_reachable;
     if (!raw)
-        on_turn(&g, ref_t, ref_d);
+        on_turn(m, k, a, &g, ref_t, ref_d);
 
     double t = g.t; /* on the turn of ref_t, ref_d (on_turn) */
     double d = g.d;
@@ -276,7 +400,7 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
     pm_status result = PM_OK;
     if (!converged || !reachable) {
         double err;
-        result = newton(m, k, ctx, q, app_ha, app_dec, turn, &t, &d, &err);
+        result = newton(m, k, ctx, a.q, a.ha, a.dec, turn, &t, &d, &err);
         if (result != PM_OK && !reachable)
             result = PM_WARN_UNREACHABLE;
     }
@@ -303,19 +427,23 @@ pm_status invert(const pm_model *m, const pm_context *ctx, double app_ha,
     if (start && (m_fabs(start[0]) > PM_START_MAX || m_fabs(start[1]) > PM_START_MAX))
         return PM_ERR_ARG;
 
-    Iso<double> k;
-    iso_from_model<double>(m, &k);
-    V3<double> q = unit_of(app_ha, app_dec);
+    const Iso<double> &k = iso_of(m);
+    Aim a;
+    a.ha = app_ha;
+    a.dec = app_dec;
+    sincos_d2(app_ha, app_dec, &a.sh, &a.ch, &a.sd, &a.cd);
+    a.q = v3(a.cd * a.ch, a.cd * a.sh, a.sd);
+    const V3<double> &q = a.q;
     double turn[2], t, d;
     turn_of(start, side, m->coef[4], turn);
-    pm_status result = solve_branch(m, k, ctx, q, app_ha, app_dec, side, start, turn, &t, &d);
+    pm_status result = solve_branch(m, k, ctx, a, side, start, turn, &t, &d);
     if (!start && (result != PM_OK || side_of(m, d) != side)) {
         /* Within the anisotropic amplitude of the mount's pole the closed
         ** form's branches (sign of cos(dec - e' + displacement angle)) and
         ** the sides of the pole (sign of cos(dec - e')) differ: the other
         ** branch may hold the solution on the requested side. */
         double t2, d2;
-        pm_status r2 = solve_branch(m, k, ctx, q, app_ha, app_dec, -side, 0, turn, &t2, &d2);
+        pm_status r2 = solve_branch(m, k, ctx, a, -side, 0, turn, &t2, &d2);
         if (r2 == PM_OK && side_of(m, d2) == side) {
             result = r2;
             t = t2;
@@ -541,7 +669,7 @@ pm_status pm_model_prepare(pm_model *m)
     for (int i = 6; i < m->n_base; i++) {
         const pm_term *t = &m->term[i];
         int j = t->l * t->l + t->l + t->m;
-        m->dense[t->k - 1][j] += m->coef[i] * norm_lm(t->l, t->m);
+        m->dense[j][t->k - 1] += m->coef[i] * norm_lm(t->l, t->m);
     }
     m->lip = lipschitz(m);
     for (int i = 0; i < PM_MAX_TERMS; i++)
@@ -667,11 +795,13 @@ pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
         return PM_ERR_ARG;
     if (!finite(enc_ha) || !finite(enc_dec))
         return PM_ERR_NONFINITE;
-    Iso<double> k;
-    iso_from_model<double>(m, &k);
-    V3<double> p = forward_vec<double>(m, k, trig_of(enc_ha, enc_dec), ctx);
-    double t = m_atan2(p.y, p.x);
-    double d = m_atan2(p.z, m_sqrt(p.x * p.x + p.y * p.y));
+    const Iso<double> &k = iso_of(m);
+    double sh[4], t, d;
+    V3<double> p = forward_vec<double>(m, k, trig_of(enc_ha, enc_dec), ctx, sh);
+    if (!frame_angles(m, enc_ha, enc_dec, sh, p, &t, &d)) {
+        t = m_atan2(p.y, p.x);
+        d = m_atan2(p.z, m_sqrt(p.x * p.x + p.y * p.y));
+    }
     if (!finite(t) || !finite(d))
         return PM_ERR_NONFINITE; /* overflow in the terms: outputs untouched */
     *app_ha = t <= -PI ? PI : t; /* atan2(-0, -1) = -pi */
@@ -710,8 +840,7 @@ pm_status pm_model_residual(const pm_model *m, const pm_context *ctx,
     if (!finite(enc_ha) || !finite(enc_dec) || !finite(app_ha) ||
         !finite(app_dec))
         return PM_ERR_NONFINITE;
-    Iso<double> k;
-    iso_from_model<double>(m, &k);
+    const Iso<double> &k = iso_of(m);
     V3<double> p = forward_vec<double>(m, k, trig_of(enc_ha, enc_dec), ctx);
     V3<double> q = unit_of(app_ha, app_dec);
     /* sky frame at the model position */

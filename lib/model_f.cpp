@@ -138,8 +138,8 @@ void correction_f(const pm_model_f *m, const pm_context *ctx, const FrameF &f, f
 
     /* w = expmap(dt, dd) as an offset from (1,0,0) */
     float r2 = dt * dt + dd * dd;
-    float sinc = 1 - r2 / 6 + r2 * r2 / 120;
-    V3<float> o = v3<float>(-r2 / 2 + r2 * r2 / 24, dt * sinc, dd * sinc);
+    float sinc = 1 - r2 * (1.0f / 6 - r2 * (1.0f / 120));
+    V3<float> o = v3<float>(-r2 * (0.5f - r2 * (1.0f / 24)), dt * sinc, dd * sinc);
     if (r2 >= 1e-4f) {
         float r = m_sqrt(r2);
         o = v3<float>(-2 * m_sin(r / 2) * m_sin(r / 2), dt * m_sin(r) / r, dd * m_sin(r) / r);
@@ -559,9 +559,9 @@ pm_status pm_model_f_prepare(pm_model_f *mf, const pm_model *m)
     mf->vi = (float)(2 * m_sin(ih / 2) * m_sin(ih / 2));
     mf->lat_s = (float)m_sin(m->latitude);
     mf->lat_c = (float)m_cos(m->latitude);
-    for (int k = 0; k < 6; k++)
-        for (int j = 0; j < PM_N_HARM(PM_MAX_L); j++)
-            mf->dense[k][j] = (float)m->dense[k][j];
+    for (int j = 0; j < PM_N_HARM(PM_MAX_L); j++)
+        for (int k = 0; k < 6; k++)
+            mf->dense[j][k] = (float)m->dense[j][k];
     for (int i = 0; i < m->n_terms; i++) {
         mf->term[i] = m->term[i];
         mf->coef[i] = (float)m->coef[i];

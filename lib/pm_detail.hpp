@@ -102,6 +102,114 @@ inline bool above0(double x)
 
 const double PI = 3.14159265358979323846;
 const double DBL_EPS = 2.220446049250313e-16; /* 2^-52 */
+/* pi/2 in three parts (Cody & Waite): PIO2_1 and PIO2_2 have 33
+** significant bits (k times them is exact for |k| < 2^20), PIO2_1 + PIO2_2 +
+** PIO2_3 is pi/2 to 1e-37 (tests/ref/sincos_split.py) */
+const double PIO2_1 = 1.5707963267341256, PIO2_2 = 6.077100506303966e-11,
+             PIO2_3 = 2.0222662487959506e-21;
+/* (x + RND_INT) - RND_INT is x rounded to an integer, |x| < 2^51 (1.5 2^52) */
+const double RND_INT = 6755399441055744.0;
+
+/* A double from its bit pattern. */
+inline double of_bits(unsigned long long u)
+{
+    double x;
+    __builtin_memcpy(&x, &u, sizeof x);
+    return x;
+}
+
+/*
+** sin and cos of a double |x| <= 64 (axis angles and targets; beyond, and
+** where double arithmetic is emulated, libm), without libm.  The nearest
+** multiple k pi/2 is taken off in three parts (PIO2_1..3; x - k PIO2_1 is
+** exact by Sterbenz's lemma), keeping the rounding of the reduced angle
+** r = rh + rl; the Taylor series to r^17 and r^18 on |r| <= pi/4
+** (truncation below 1.2e-19 relative), the leading terms added last and
+** the cosine's 1 - r^2/2 compensated; the quadrant chosen on the bit
+** patterns (no branch to mispredict).  Within 1 ulp of the exact values
+** (0.92 measured against long double on 4e6 angles; libm's 0.52;
+** tests/check_internal.c checks).
+*/
+inline void sincos_d(double x, double *s, double *c)
+{
+#if !PM_SOFT_DOUBLE
+    if (m_fabs(x) <= 64.0) {
+        double kd = (x * 0.6366197723675814 + RND_INT) - RND_INT;
+        double a = x - kd * PIO2_1, b = kd * PIO2_2; /* exact */
+        double rh = a - b;
+        double rl = ((a - rh) - b) - kd * PIO2_3; /* a - b - rh exactly, as |a| >= |b| or a ~ b */
+        double r2 = rh * rh;
+        double ps = r2 * (-1.0 / 6 + r2 * (1.0 / 120 + r2 * (-1.0 / 5040 +
+                    r2 * (1.0 / 362880 + r2 * (-1.0 / 39916800 + r2 * (1.0 / 6227020800.0 +
+                    r2 * (-1.0 / 1307674368000.0 + r2 * (1.0 / 355687428096000.0))))))));
+        double pc = r2 * r2 * (1.0 / 24 + r2 * (-1.0 / 720 + r2 * (1.0 / 40320 +
+                    r2 * (-1.0 / 3628800 + r2 * (1.0 / 479001600 + r2 * (-1.0 / 87178291200.0 +
+                    r2 * (1.0 / 20922789888000.0 + r2 * (-1.0 / 6402373705728000.0))))))));
+        double sr = rh + (rh * ps + rl); /* sin(rh + rl) = sin rh + rl cos rh */
+        double hz = 0.5 * r2, w = 1 - hz;
+        double cr = w + (((1 - w) - hz) + (pc - rh * rl));
+        /* quadrant q = k mod 4: (sin, cos) = (sr, cr), (cr, -sr), (-sr, -cr), (-cr, sr) */
+        unsigned q = (unsigned)(int)kd;
+        unsigned long long sw = 0ULL - (unsigned long long)(q & 1u);
+        unsigned long long bs = bits_of(sr), bc = bits_of(cr);
+        unsigned long long us = (bs & ~sw) | (bc & sw), uc = (bc & ~sw) | (bs & sw);
+        us ^= (unsigned long long)(q & 2u) << 62;
+        uc ^= (unsigned long long)((q + 1u) & 2u) << 62;
+        *s = of_bits(us);
+        *c = of_bits(uc);
+        return;
+    }
+#endif
+    *s = m_sin(x);
+    *c = m_cos(x);
+}
+
+/* sincos_d of two angles at once: the same operations in the two lanes of
+** a vector where the machine has them (x86-64's SSE2: half the
+** instructions), else one after the other.  Same results. */
+inline void sincos_d2(double x0, double x1, double *s0, double *c0, double *s1, double *c1)
+{
+#if defined(__SSE2__) && !PM_SOFT_DOUBLE
+    if (m_fabs(x0) <= 64.0 && m_fabs(x1) <= 64.0) {
+        typedef double v2d __attribute__((vector_size(16)));
+        typedef unsigned long long v2u __attribute__((vector_size(16)));
+#define PM_V2(c) ((v2d){(c), (c)}) /* constants as vectors: one load each */
+        const v2d x = {x0, x1};
+        /* the nearest integer k, also in the low bits of kr (its ulp is 1) */
+        const v2d kr = x * PM_V2(0.6366197723675814) + PM_V2(RND_INT);
+        const v2d kd = kr - PM_V2(RND_INT);
+        const v2d a = x - kd * PM_V2(PIO2_1), b = kd * PM_V2(PIO2_2);
+        const v2d rh = a - b;
+        const v2d rl = ((a - rh) - b) - kd * PM_V2(PIO2_3);
+        const v2d r2 = rh * rh;
+        const v2d ps = r2 * (PM_V2(-1.0 / 6) + r2 * (PM_V2(1.0 / 120) + r2 * (PM_V2(-1.0 / 5040) +
+                       r2 * (PM_V2(1.0 / 362880) + r2 * (PM_V2(-1.0 / 39916800) +
+                       r2 * (PM_V2(1.0 / 6227020800.0) + r2 * (PM_V2(-1.0 / 1307674368000.0) +
+                       r2 * PM_V2(1.0 / 355687428096000.0))))))));
+        const v2d pc = r2 * r2 * (PM_V2(1.0 / 24) + r2 * (PM_V2(-1.0 / 720) + r2 * (PM_V2(1.0 / 40320) +
+                       r2 * (PM_V2(-1.0 / 3628800) + r2 * (PM_V2(1.0 / 479001600) +
+                       r2 * (PM_V2(-1.0 / 87178291200.0) + r2 * (PM_V2(1.0 / 20922789888000.0) +
+                       r2 * PM_V2(-1.0 / 6402373705728000.0))))))));
+        const v2d sr = rh + (rh * ps + rl);
+        const v2d hz = PM_V2(0.5) * r2, w = PM_V2(1.0) - hz;
+        const v2d cr = w + (((PM_V2(1.0) - w) - hz) + (pc - rh * rl));
+#undef PM_V2
+        const v2u q = (v2u)kr;
+        const v2u sw = (v2u){0, 0} - (q & 1);
+        const v2u bs = (v2u)sr, bc = (v2u)cr;
+        const v2u us = ((bs & ~sw) | (bc & sw)) ^ ((q & 2) << 62);
+        const v2u uc = ((bc & ~sw) | (bs & sw)) ^ (((q + 1) & 2) << 62);
+        const v2d vs = (v2d)us, vc = (v2d)uc;
+        *s0 = vs[0];
+        *s1 = vs[1];
+        *c0 = vc[0];
+        *c1 = vc[1];
+        return;
+    }
+#endif
+    sincos_d(x0, s0, c0);
+    sincos_d(x1, s1, c1);
+}
 
 template <typename T> struct V3 {
     T x, y, z;
@@ -290,8 +398,9 @@ template <typename T> inline V3<T> expmap(T a, T b)
     T r2 = a * a + b * b;
     T c, s;
     if (r2 < (T)1e-4) {
-        c = 1 - r2 / 2 + r2 * r2 / 24 - r2 * r2 * r2 / 720;
-        s = 1 - r2 / 6 + r2 * r2 / 120 - r2 * r2 * r2 / 5040;
+        /* (Horner, by the reciprocals: no division) */
+        c = 1 - r2 * ((T)0.5 - r2 * ((T)(1.0 / 24) - r2 * (T)(1.0 / 720)));
+        s = 1 - r2 * ((T)(1.0 / 6) - r2 * ((T)(1.0 / 120) - r2 * (T)(1.0 / 5040)));
     } else {
         T r = m_sqrt(r2);
         c = m_cos(r);
@@ -307,7 +416,7 @@ template <typename T> inline void logmap(const V3<T> &q, T *a, T *b)
     T f;
     if (s2 < (T)1e-4 && q.x > 0) {
         /* theta/sin(theta) as a series in sin^2 */
-        f = 1 + s2 / 6 + (T)3 * s2 * s2 / 40 + (T)5 * s2 * s2 * s2 / 112;
+        f = 1 + s2 * ((T)(1.0 / 6) + s2 * ((T)(3.0 / 40) + s2 * (T)(5.0 / 112)));
     } else {
         T s = m_sqrt(s2);
         f = s > 0 ? m_atan2(s, q.x) / s : (T)1;
@@ -379,14 +488,19 @@ inline pm_status model_ready(const pm_model *m)
     if (m->prepared != 1 || m->n_terms < 6 || m->n_terms > PM_MAX_TERMS)
         return PM_ERR_STATE;
     /* Bit patterns XOR-ed and OR-ed together in the machine's words (two
-    ** per double on a 32-bit core), four at a time, no early exit.
-    ** (Bitwise, so writing -0.0 over 0.0 also asks for pm_model_prepare.) */
+    ** per double on a 32-bit core; two doubles per SSE2 register), four at
+    ** a time, no early exit.  (Bitwise, so writing -0.0 over 0.0 also asks
+    ** for pm_model_prepare.) */
+#if defined(__SSE2__)
+    typedef unsigned long long __attribute__((vector_size(16), aligned(8), may_alias)) word;
+#else
     typedef unsigned long __attribute__((may_alias)) word; /* 32 bits on ARM EABI, 64 on LP64 */
+#endif
     const word *a = (const word *)m->coef;
     const word *b = (const word *)m->prep_coef;
-    const int n = m->n_terms * (int)(sizeof(double) / sizeof(word));
-    word acc0 = 0, acc1 = 0, acc2 = 0, acc3 = 0;
-    int i = 0;
+    const int n = m->n_terms * (int)sizeof(double) / (int)sizeof(word); /* whole words */
+    word acc0 = a[0] ^ b[0], acc1 = acc0, acc2 = acc0, acc3 = acc0; /* n_terms >= 6 */
+    int i = 1;
     for (; i + 4 <= n; i += 4) {
         acc0 |= a[i] ^ b[i];
         acc1 |= a[i + 1] ^ b[i + 1];
@@ -395,14 +509,32 @@ inline pm_status model_ready(const pm_model *m)
     }
     for (; i < n; i++)
         acc0 |= a[i] ^ b[i];
-    return (acc0 | acc1 | acc2 | acc3) ? PM_ERR_STATE : PM_OK;
+    acc0 |= acc1 | acc2 | acc3;
+#if defined(__SSE2__)
+    unsigned long long any = acc0[0] | acc0[1];
+    if (m->n_terms & 1) /* the last double, outside the whole words */
+        any |= bits_of(m->coef[m->n_terms - 1]) ^ bits_of(m->prep_coef[m->n_terms - 1]);
+#else
+    word any = acc0;
+#endif
+    return any ? PM_ERR_STATE : PM_OK;
 }
 
 /* Model constants in working precision. */
-template <typename T> struct Iso {
+template <typename T> struct __attribute__((may_alias)) Iso {
     T h[9];
     T sc, cc, se, ce, sd, cd, si, ci;
 };
+
+/* The double constants in place: pm_model holds them in Iso<double>'s
+** layout (checked here), so the double build reads them without a copy. */
+inline const Iso<double> &iso_of(const pm_model *m)
+{
+    static_assert(__builtin_offsetof(pm_model, ci) - __builtin_offsetof(pm_model, h) ==
+                      __builtin_offsetof(Iso<double>, ci),
+                  "pm_model's h..ci must match Iso<double>");
+    return *reinterpret_cast<const Iso<double> *>(m->h);
+}
 
 template <typename T> inline void iso_from_model(const pm_model *m, Iso<T> *o)
 {
@@ -567,33 +699,72 @@ inline void term_uv(const pm_term &t, const Trig<T> &g, const Site<T> &s,
     *v = f * bv;
 }
 
+/* S[k] = sum over the harmonics j = 1..N-1 of dense[j][k] Y[j], in the
+** order of j (N = (L+1)^2; LC > 0: unrolled). */
+template <typename T, typename W, int LC> struct HarmSums {
+    static void sum(int N, const W (*dense)[6], const T *Y, T *S)
+    {
+        /* (assigned, not zeroed and added: the same sums, and no memset
+        ** call from the compiler on some cores) */
+#pragma GCC unroll 6
+        for (int kk = 0; kk < 6; kk++)
+            S[kk] = (T)dense[1][kk] * Y[1];
+#pragma GCC unroll 32
+        for (int j = 2; j < N; j++) {
+            const T y = Y[j];
+#pragma GCC unroll 6
+            for (int kk = 0; kk < 6; kk++)
+                S[kk] += (T)dense[j][kk] * y;
+        }
+    }
+};
+
+#if defined(__SSE2__) && !PM_SOFT_DOUBLE
+/* Doubles on x86-64: the six sums as three pairs in SSE2 registers, each
+** lane doing the scalar version's operations in its order (same results,
+** half the instructions). */
+template <int LC> struct HarmSums<double, double, LC> {
+    static void sum(int N, const double (*dense)[6], const double *Y, double *S)
+    {
+        typedef double v2d __attribute__((vector_size(16)));
+        typedef double __attribute__((vector_size(16), aligned(8), may_alias)) v2u;
+        const v2u *r = (const v2u *)dense[1];
+        v2d y = {Y[1], Y[1]};
+        v2d s0 = r[0] * y, s1 = r[1] * y, s2 = r[2] * y;
+#pragma GCC unroll 32
+        for (int j = 2; j < N; j++) {
+            r = (const v2u *)dense[j];
+            y = (v2d){Y[j], Y[j]};
+            s0 += r[0] * y;
+            s1 += r[1] * y;
+            s2 += r[2] * y;
+        }
+        S[0] = s0[0];
+        S[1] = s0[1];
+        S[2] = s1[0];
+        S[3] = s1[1];
+        S[4] = s2[0];
+        S[5] = s2[1];
+    }
+};
+#endif
+
 /* The harmonic sums of the base vectors at g: S[k] = sum over the harmonics
-** j >= 1 of dense[k][j] Y_j (base vector k + 1), for order LC >= 1 (compile
+** j >= 1 of dense[j][k] Y_j (base vector k + 1), for order LC >= 1 (compile
 ** time, unrolled) or Lrt >= 1 (LC = 0).  W is the table's type (pm_model's
 ** double, pm_model_f's float). */
 template <typename T, typename W, int LC>
-inline void sh_sums_n(int Lrt, const Trig<T> &g, const W (*dense)[PM_N_HARM(PM_MAX_L)], T *S)
+inline void sh_sums_n(int Lrt, const Trig<T> &g, const W (*dense)[6], T *S)
 {
     const int L = LC > 0 ? LC : Lrt;
     T Y[PM_N_HARM(LC > 0 ? LC : PM_MAX_L)];
     harmonics_n<T, LC>(L, g, Y);
-    /* (assigned, not zeroed and added: the same sums, and no memset call
-    ** from the compiler on some cores) */
-#pragma GCC unroll 6
-    for (int kk = 0; kk < 6; kk++)
-        S[kk] = (T)dense[kk][1] * Y[1];
-#pragma GCC unroll 32
-    for (int j = 2; j < (L + 1) * (L + 1); j++) {
-        const T y = Y[j];
-#pragma GCC unroll 6
-        for (int kk = 0; kk < 6; kk++)
-            S[kk] += (T)dense[kk][j] * y;
-    }
+    HarmSums<T, W, LC>::sum((L + 1) * (L + 1), dense, Y, S);
 }
 
 /* The harmonic sums for order L (0..PM_MAX_L), dispatched as harmonics(). */
 template <typename T, typename W>
-inline void sh_sums(int L, const Trig<T> &g, const W (*dense)[PM_N_HARM(PM_MAX_L)], T S[6])
+inline void sh_sums(int L, const Trig<T> &g, const W (*dense)[6], T S[6])
 {
     switch (L) {
     case 0:
@@ -649,14 +820,22 @@ inline void aniso(const pm_model *m, const Iso<T> &k, const Trig<T> &g0,
     }
 }
 
-/* Forward model as a unit vector: p' = H Pt(t') X(d) Pd(d') T(i) w. */
+/* Forward model as a unit vector: p' = H Pt(t') X(d) Pd(d') T(i) w; sh, if
+** not null, receives the trig of the shifted position (t', d'): sin t',
+** cos t', sin d', cos d'. */
 template <typename T>
 inline V3<T> forward_vec(const pm_model *m, const Iso<T> &k, const Trig<T> &g,
-                         const pm_context *ctx)
+                         const pm_context *ctx, T *sh = 0)
 {
     T dt, dd, stp, ctp, sdp, cdp;
     aniso<T>(m, k, g, ctx, &dt, &dd);
     shifted<T>(k, g, &stp, &ctp, &sdp, &cdp);
+    if (sh) {
+        sh[0] = stp;
+        sh[1] = ctp;
+        sh[2] = sdp;
+        sh[3] = cdp;
+    }
     V3<T> w = expmap<T>(dt, dd);
     w = rot_z<T>(k.si, k.ci, w);
     w = rot_d<T>(sdp, cdp, w);
@@ -665,13 +844,29 @@ inline V3<T> forward_vec(const pm_model *m, const Iso<T> &k, const Trig<T> &g,
     return mat_mul<T>(k.h, w);
 }
 
+/* sin and cos of one angle: sincos_d for doubles, libm for floats. */
+inline void sin_cos(double x, double *s, double *c) { sincos_d(x, s, c); }
+inline void sin_cos(float x, float *s, float *c)
+{
+    *s = m_sin(x);
+    *c = m_cos(x);
+}
+
+/* sin and cos of two angles: sincos_d2 for doubles, libm for floats. */
+inline void sin_cos2(double t, double d, double *st, double *ct, double *sd, double *cd)
+{
+    sincos_d2(t, d, st, ct, sd, cd);
+}
+inline void sin_cos2(float t, float d, float *st, float *ct, float *sd, float *cd)
+{
+    sin_cos(t, st, ct);
+    sin_cos(d, sd, cd);
+}
+
 template <typename T> inline Trig<T> trig_of(T t, T d)
 {
     Trig<T> g;
-    g.st = m_sin(t);
-    g.ct = m_cos(t);
-    g.sd = m_sin(d);
-    g.cd = m_cos(d);
+    sin_cos2(t, d, &g.st, &g.ct, &g.sd, &g.cd);
     g.t = t;
     g.d = d;
     g.have_angles = true;
@@ -680,8 +875,9 @@ template <typename T> inline Trig<T> trig_of(T t, T d)
 
 template <typename T> inline V3<T> unit_of(T t, T d)
 {
-    T cd = m_cos(d);
-    return v3(cd * m_cos(t), cd * m_sin(t), m_sin(d));
+    T st, ct, sd, cd;
+    sin_cos2(t, d, &st, &ct, &sd, &cd);
+    return v3(cd * ct, cd * st, sd);
 }
 
 /* Normalise (s, c) in place to a unit pair; returns false for (0,0). */
@@ -695,6 +891,23 @@ template <typename T> inline bool unit_pair(T *s, T *c)
     return true;
 }
 
+/* A target as the closed-form inverse reads it: q0 = H^T q, |q0_xy|^2 and
+** its inverse, 1 / cos d (loop constants of the fixed point). */
+template <typename T> struct Target {
+    V3<T> q0;
+    T rho2, irho2, icd;
+};
+
+template <typename T> inline Target<T> target_of(const Iso<T> &k, const V3<T> &q)
+{
+    Target<T> o;
+    o.q0 = mat_tmul<T>(k.h, q);
+    o.rho2 = o.q0.x * o.q0.x + o.q0.y * o.q0.y;
+    o.irho2 = o.rho2 > (T)1e-12 ? 1 / o.rho2 : 0; /* 0: normalise by unit_pair */
+    o.icd = 1 / k.cd;
+    return o;
+}
+
 /*
 ** Closed-form inverse of the isotropic part for a fixed anisotropic
 ** displacement (dt, dd): the encoder trig g with
@@ -703,18 +916,18 @@ template <typename T> inline bool unit_pair(T *s, T *c)
 ** if not, the nearest reachable point (branch boundary) is returned.
 */
 template <typename T>
-inline bool iso_inverse(const Iso<T> &k, const V3<T> &q, T dt, T dd, int side,
+inline bool iso_inverse(const Iso<T> &k, const Target<T> &tg, T dt, T dd, int side,
                         Trig<T> *g)
 {
-    V3<T> q0 = mat_tmul<T>(k.h, q);
+    const V3<T> &q0 = tg.q0;
     V3<T> v = rot_z<T>(k.si, k.ci, expmap<T>(dt, dd));
     /* With g = Pd(d') v and u = X(d) g: u_z = q0_z fixes g3, then u_y,
     ** and |u_xy| = |q0_xy| fixes g1 up to the side. */
-    T g3 = (q0.z - k.sd * v.y) / k.cd;
+    T g3 = (q0.z - k.sd * v.y) * tg.icd;
     T uy = k.cd * v.y - k.sd * g3;
-    T rho2 = q0.x * q0.x + q0.y * q0.y;
+    T rho2 = tg.rho2;
     T disc = rho2 - uy * uy;
-    bool ok = true;
+    bool ok = true, on_edge = false;
     if (disc < 0) {
         /* The target lies outside this branch's reach by about
         ** -disc / (2 |q0_xy|) radians; within rounding of the edge (the
@@ -723,21 +936,37 @@ inline bool iso_inverse(const Iso<T> &k, const V3<T> &q, T dt, T dd, int side,
         if (-disc / (2 * rho) > (T)(PM_INVERT_TOL * 0.25))
             ok = false;
         disc = 0;
+        on_edge = true;
     }
     T g1 = (T)side * m_sqrt(disc);
     /* (g1 + i g3) = (vx + i vz) exp(i d'): d' = arg(g1 + i g3) - arg(v) */
     T sdp = g3 * v.x - g1 * v.z;
     T cdp = g1 * v.x + g3 * v.z;
-    if (!unit_pair<T>(&sdp, &cdp)) {
-        sdp = 0;
-        cdp = 1;
-    }
     /* t' = arg(q0_xy) - arg(u_xy), u_x = g1 */
     T stp = q0.y * g1 - q0.x * uy;
     T ctp = q0.x * g1 + q0.y * uy;
-    if (!unit_pair<T>(&stp, &ctp)) {
-        stp = 0;
-        ctp = 1;
+    T vxz = v.x * v.x + v.z * v.z;
+    if (!on_edge && tg.irho2 > 0 && vxz > (T)1e-12) {
+        /* Both pairs have known lengths: |g| = |u| = |q| = |v| = 1 gives
+        ** |(g1, g3)| = |(vx, vz)|, so |(sdp, cdp)| = vx^2 + vz^2, and
+        ** g1^2 + uy^2 = rho2, so |(stp, ctp)| = rho2: a division by a
+        ** loop constant and one off the iteration's chain instead of two
+        ** square roots and four divisions on it (the pairs come out unit
+        ** to rounding). */
+        T f = 1 / vxz;
+        sdp *= f;
+        cdp *= f;
+        stp *= tg.irho2;
+        ctp *= tg.irho2;
+    } else {
+        if (!unit_pair<T>(&sdp, &cdp)) {
+            sdp = 0;
+            cdp = 1;
+        }
+        if (!unit_pair<T>(&stp, &ctp)) {
+            stp = 0;
+            ctp = 1;
+        }
     }
     /* undo the index shifts: t = t' - c', d = d' + e' */
     g->st = stp * k.cc - ctp * k.sc;

@@ -472,6 +472,48 @@ START_TEST(test_pm_model_invert_bad_side)
 }
 END_TEST
 
+/* Every coefficient counts in the staleness check, whatever the word size
+** it is read in (two doubles per SSE2 register on x86-64: an odd number of
+** terms leaves one over), and nothing beyond n_terms does. */
+START_TEST(test_pm_model_stale_each_coef)
+{
+    static pm_model m;
+    double T, D, t, d;
+    int order, extra, i;
+    for (order = 0; order <= 2; order++)
+        for (extra = 0; extra <= 1; extra++) {
+            ck_assert_int_eq(pm_model_init(&m, PM_MOUNT_EQUATORIAL, order), PM_OK);
+            if (extra) {
+                pm_term x;
+                memset(&x, 0, sizeof x);
+                x.kind = PM_TERM_FOURIER;
+                x.k = PM_BASE_C;
+                x.l = 1;
+                x.param = 2.0;
+                ck_assert_int_eq(pm_model_add_term(&m, &x, 1e-5, NULL), PM_OK);
+            }
+            for (i = 0; i < m.n_terms; i++)
+                m.coef[i] = 1e-5 * (i % 3 - 1); /* zeros among them */
+            ck_assert_int_eq(pm_model_prepare(&m), PM_OK);
+            ck_assert_int_eq(m.n_terms % 2, extra); /* both parities */
+            for (i = 0; i < m.n_terms; i++) {
+                double keep = m.coef[i];
+                /* the smallest change: one ulp, or -0.0 over 0.0 */
+                m.coef[i] = keep == 0.0 ? -0.0 : nextafter(keep, 1.0);
+                ck_assert_int_eq(pm_model_apply(&m, NULL, 0.1, 0.2, &T, &D), PM_ERR_STATE);
+                ck_assert_int_eq(pm_model_invert(&m, NULL, 0.1, 0.2, PM_SIDE_NORMAL, &t, &d),
+                                 PM_ERR_STATE);
+                m.coef[i] = keep;
+                ck_assert_int_eq(pm_model_apply(&m, NULL, 0.1, 0.2, &T, &D), PM_OK);
+            }
+            if (m.n_terms < PM_MAX_TERMS) {
+                m.coef[m.n_terms] = 1.0; /* not a term */
+                ck_assert_int_eq(pm_model_apply(&m, NULL, 0.1, 0.2, &T, &D), PM_OK);
+            }
+        }
+}
+END_TEST
+
 START_TEST(test_pm_model_invert_stale)
 {
     static pm_model good, stale;
@@ -1762,6 +1804,7 @@ static Suite *model_suite(void)
     tcase_add_test(tc, test_pm_model_invert_dec_out_of_range);
     tcase_add_test(tc, test_pm_model_invert_bad_side);
     tcase_add_test(tc, test_pm_model_invert_stale);
+    tcase_add_test(tc, test_pm_model_stale_each_coef);
     tcase_add_test(tc, test_pm_model_residual_null);
     tcase_add_test(tc, test_pm_model_residual_nonfinite);
     tcase_add_test(tc, test_pm_model_residual_stale);
