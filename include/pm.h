@@ -332,8 +332,11 @@ pm_status pm_term_name(const pm_model *m, int index, char *buf, size_t len);
 **     (1,0,0) by the anisotropic terms' tangent-plane offset (docs/model.md).
 **     To first order in the coefficients this is the paper's Eq.
 **     (pyyexpansion).
-**  2) Cost: one sin/cos pair per axis, recurrences for the harmonics, one
-**     atan2 and one asin.  No iteration.
+**  2) Cost: one sin/cos pair per axis (the library's own, within 1 ulp,
+**     for angles within 64 rad; libm beyond), recurrences for the
+**     harmonics, and the angles of p' measured from (ha+c', dec-e') by
+**     short series (atan2 where they differ by more than 0.01 rad).  No
+**     iteration, no libm call in the common case.
 **  Reference: Pal et al., Sec. 2, Eq. (tdmatrices); Sec. 3, Eq. (pyyexpansion).
 */
 pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,

@@ -249,16 +249,22 @@ void forward_f(const pm_model_f *m, const pm_context *ctx, double t, double d, d
 ** the tangent components (x, y) of the direction (T1, D1) and, returned,
 ** a size that grows with the angle between them: |(x, y)| = sin(angle)
 ** in the near hemisphere, 2 - sin(angle) in the far one (the tangent
-** components alone vanish at the antipode too). */
+** components alone vanish at the antipode too).  The cosines of the
+** declinations by dec_trig_f: near a celestial pole cos((float)D) would
+** carry the angle's own rounding (6e-8 rad, a quarter of the cosine
+** 2.5e-7 rad from the pole) into the HA part of the offset (fuzz finding:
+** a 1.29e-8 rad miss judged within 1e-8). */
 float sky_offset(double T1, double D1, double T2, double D2, float *x, float *y)
 {
     float dT = (float)wrap_pi(T1 - T2), dD = (float)(D1 - D2);
-    float c1 = m_cos((float)D1), s2 = m_sin((float)D2);
+    float s1, c1, s2, c2;
+    dec_trig_f(D1, &s1, &c1);
+    dec_trig_f(D2, &s2, &c2);
     float h = m_sin(dT / 2);
     *x = c1 * m_sin(dT);
     *y = m_sin(dD) + c1 * s2 * 2 * h * h;
     /* cos(angle) = cos(dD) - 2 cos(D1) cos(D2) sin^2(dT/2) */
-    float z = m_cos(dD) - 2 * c1 * m_cos((float)D2) * h * h;
+    float z = m_cos(dD) - 2 * c1 * c2 * h * h;
     float n = m_sqrt(*x * *x + *y * *y);
     return z >= 0 ? n : 2 - n;
 }
