@@ -77,9 +77,9 @@ $(B)/tests/internal_shim.o: tests/internal_shim.cpp $(wildcard include/*.h lib/*
 	@mkdir -p $(@D)
 	$(CXX) $(CORE_FLAGS) -c $< -o $@
 
-$(B)/tests/check_internal: tests/check_internal.c $(B)/tests/internal_shim.o $(wildcard tests/*.h)
+$(B)/tests/check_internal: tests/check_internal.c $(B)/tests/internal_shim.o $(B)/libpm.a $(wildcard tests/*.h)
 	@mkdir -p $(@D)
-	$(CC) $(TEST_CFLAGS) $< -o $@ $(B)/tests/internal_shim.o $(TEST_LIBS)
+	$(CC) $(TEST_CFLAGS) $< -o $@ $(B)/tests/internal_shim.o $(B)/libpm.a $(TEST_LIBS)
 
 # The public header must be strict ANSI C.
 check-c89: include/pm.h

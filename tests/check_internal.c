@@ -1,8 +1,9 @@
 /*
 **  check_internal.c - the core's own sin/cos (lib/pm_detail.hpp sincos_d,
 **  sincos_d2), which replace libm's on the per-tick path of the double
-**  build, against long double libm on x86-64 (64-bit significand: a
-**  reference ~2000 times finer than a double's ulp).
+**  build, and the double model that uses them, against long double on
+**  x86-64 (64-bit significand: a reference ~2000 times finer than a
+**  double's ulp).  Skipped where long double is no wider than double.
 **
 **    sincos_d      within 1 ulp of the exact value (the header states it)
 **                  on 10^6 angles: uniform in |x| <= 64 (every quadrant
@@ -11,9 +12,15 @@
 **                  cases); beyond 64, NaN and infinities: libm's answers
 **    sincos_d2     the same bits as sincos_d for both angles, in and out
 **                  of its fast range
+**    the model     pm_model_apply within 1e-15 rad of the same model in long
+**                  double (the templates instantiated again,
+**                  tests/internal_shim.cpp); pm_model_invert's PM_OK round
+**                  trips within PM_INVERT_TOL through that long double
+**                  forward model
 */
 #include "tu_check.h"
 #include "testutil.h"
+#include "pm.h"
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
@@ -21,6 +28,8 @@
 
 void pm_test_sincos_d(double x, double *s, double *c);
 void pm_test_sincos_d2(double x0, double x1, double *s0, double *c0, double *s1, double *c1);
+void pm_test_apply_ld(const pm_model *m, const pm_context *ctx, double t, double d,
+                      long double *T, long double *D);
 
 /* |a - ref| in units of the last place of the double nearest ref. */
 static double ulp_err(double a, long double ref)
@@ -110,6 +119,117 @@ START_TEST(test_sincos_d2_same_bits)
 }
 END_TEST
 
+/* A model of order L: isotropic terms of 0.01 rad (0.4 rad for every
+** third), harmonic terms of 1e-4 rad. */
+static void ld_model(pm_model *m, tu_rng *r, int mi)
+{
+    int i;
+    double big = mi % 3 == 0 ? 0.4 : 0.01;
+    ck_assert_int_eq(pm_model_init(m, PM_MOUNT_EQUATORIAL, mi % (PM_MAX_L + 1)), PM_OK);
+    for (i = 0; i < m->n_terms; i++)
+        m->coef[i] = (tu_uniform(r) * 2 - 1) * (i < 6 ? big : 1e-4);
+    ck_assert_int_eq(pm_model_prepare(m), PM_OK);
+}
+
+/* Separation of (T1, D1) and (T2, D2), in long double (haversine). */
+static long double ld_sep(long double T1, long double D1, long double T2, long double D2)
+{
+    long double a = sinl((D1 - D2) / 2), b = sinl((T1 - T2) / 2);
+    long double h = a * a + cosl(D1) * cosl(D2) * b * b;
+    return 2 * asinl(sqrtl(h));
+}
+
+/* The forward model (which takes its angles by series from the shifted
+** position, and its sines and cosines from sincos_d2) against the same
+** model evaluated in long double with libm's long double functions: on
+** ordinary positions, hour angles to +-64 rad and declinations to +-4
+** (the series' range), beyond it (the atan2 path), and within 0.05 rad of
+** the mount's pole. */
+START_TEST(test_apply_vs_long_double)
+{
+    static pm_model m;
+    tu_rng r;
+    double worst_t = 0, worst_d = 0, sum2 = 0;
+    long n = 0;
+    int mi, j;
+    if (LDBL_MANT_DIG < 64)
+        return;
+    tu_seed(&r, 31);
+    for (mi = 0; mi < 40; mi++) {
+        ld_model(&m, &r, mi);
+        for (j = 0; j < 4000; j++) {
+            double u = tu_uniform(&r) * 2 - 1, v = tu_uniform(&r) * 2 - 1, t, d, T, D;
+            long double Tr, Dr, eT, eD;
+            switch (j % 4) {
+            case 0: t = u * 3.2; d = v * 1.6; break;
+            case 1: t = u * 64; d = v * 4; break;
+            case 2: t = u * 100; d = v * 8; break;
+            default:
+                t = u * 3.2;
+                d = m.coef[4] + (v < 0 ? -1 : 1) * (M_PI / 2 + v * 0.05);
+                break;
+            }
+            ck_assert_int_eq(pm_model_apply(&m, NULL, t, d, &T, &D), PM_OK);
+            pm_test_apply_ld(&m, NULL, t, d, &Tr, &Dr);
+            eT = T - Tr;
+            eT = fabsl(eT - 2 * (long double)M_PI * floorl(eT / (2 * (long double)M_PI) + 0.5L));
+            eT *= cosl(Dr);
+            eD = fabsl(D - Dr);
+            if ((double)eT > worst_t)
+                worst_t = (double)eT;
+            if ((double)eD > worst_d)
+                worst_d = (double)eD;
+            sum2 += (double)(eT * eT + eD * eD);
+            n++;
+        }
+    }
+    printf("check_internal: pm_model_apply vs long double on %ld positions: ha (x cos dec) within "
+           "%.2e rad, dec within %.2e rad, rms %.2e\n", n, worst_t, worst_d, sqrt(sum2 / n));
+    ck_assert_msg(worst_t <= 1e-15 && worst_d <= 1e-15, "forward off by %g, %g", worst_t, worst_d);
+}
+END_TEST
+
+/* The inverse's round trip through the long double forward model: a PM_OK
+** inverse (either side, and from a start nearby) is within PM_INVERT_TOL of
+** its target there too (plus the double forward's own 1e-15). */
+START_TEST(test_invert_vs_long_double)
+{
+    static pm_model m;
+    tu_rng r;
+    double worst = 0;
+    long ok = 0;
+    int mi, j;
+    if (LDBL_MANT_DIG < 64)
+        return;
+    tu_seed(&r, 37);
+    for (mi = 0; mi < 40; mi++) {
+        ld_model(&m, &r, mi);
+        for (j = 0; j < 1500; j++) {
+            double T = (tu_uniform(&r) * 2 - 1) * M_PI, D = asin(tu_uniform(&r) * 2 - 1) * 0.99;
+            double t, d;
+            long double Tr, Dr, e;
+            pm_status st;
+            if (j % 3 == 2)
+                st = pm_model_invert_near(&m, NULL, T, D, T - m.coef[2] + 1e-3, D + m.coef[4] - 1e-3,
+                                          &t, &d);
+            else
+                st = pm_model_invert(&m, NULL, T, D, j % 3 ? PM_SIDE_FLIPPED : PM_SIDE_NORMAL, &t, &d);
+            if (st != PM_OK)
+                continue;
+            ok++;
+            pm_test_apply_ld(&m, NULL, t, d, &Tr, &Dr);
+            e = ld_sep(Tr, Dr, T, D);
+            if ((double)e > worst)
+                worst = (double)e;
+        }
+    }
+    printf("check_internal: pm_model_invert round trips (%ld PM_OK) through the long double "
+           "forward model: within %.2e rad\n", ok, worst);
+    ck_assert(ok > 50000);
+    ck_assert_msg(worst <= PM_INVERT_TOL + 1e-15, "round trip %g", worst);
+}
+END_TEST
+
 static Suite *internal_suite(void)
 {
     Suite *s = suite_create("internal");
@@ -118,6 +238,8 @@ static Suite *internal_suite(void)
     tcase_add_test(tc, test_sincos_d_ulp);
     tcase_add_test(tc, test_sincos_d_outside);
     tcase_add_test(tc, test_sincos_d2_same_bits);
+    tcase_add_test(tc, test_apply_vs_long_double);
+    tcase_add_test(tc, test_invert_vs_long_double);
     suite_add_tcase(s, tc);
     return s;
 }
