@@ -130,31 +130,46 @@ inline double of_bits(unsigned long long u)
 ** (0.92 measured against long double on 4e6 angles; libm's 0.52;
 ** tests/check_internal.c checks).
 */
+/* The core of sincos_d on doubles or (V) on SSE2 pairs of them, |x| <= 64:
+** the sine sr and cosine cr of the reduced angle, and kr, whose low bits
+** hold k (its ulp is 1). */
+template <typename V> inline void sincos_core(V x, V *sr, V *cr, V *kr)
+{
+    *kr = x * 0.6366197723675814 + RND_INT;
+    const V kd = *kr - RND_INT;
+    const V a = x - kd * PIO2_1, b = kd * PIO2_2; /* exact */
+    const V rh = a - b;
+    const V rl = ((a - rh) - b) - kd * PIO2_3; /* a - b - rh exactly, as |a| >= |b| or a ~ b */
+    const V r2 = rh * rh;
+    const V ps = r2 * (-1.0 / 6 + r2 * (1.0 / 120 + r2 * (-1.0 / 5040 +
+                 r2 * (1.0 / 362880 + r2 * (-1.0 / 39916800 + r2 * (1.0 / 6227020800.0 +
+                 r2 * (-1.0 / 1307674368000.0 + r2 * (1.0 / 355687428096000.0))))))));
+    const V pc = r2 * r2 * (1.0 / 24 + r2 * (-1.0 / 720 + r2 * (1.0 / 40320 +
+                 r2 * (-1.0 / 3628800 + r2 * (1.0 / 479001600 + r2 * (-1.0 / 87178291200.0 +
+                 r2 * (1.0 / 20922789888000.0 + r2 * (-1.0 / 6402373705728000.0))))))));
+    *sr = rh + (rh * ps + rl); /* sin(rh + rl) = sin rh + rl cos rh */
+    const V hz = 0.5 * r2, w = 1.0 - hz;
+    *cr = w + (((1.0 - w) - hz) + (pc - rh * rl));
+}
+
+/* The quadrant, k mod 4 in the low bits of q: (sin, cos) = (sr, cr), (cr,
+** -sr), (-sr, -cr), (-cr, sr), chosen on the bit patterns bs, bc of sr and
+** cr (U: a 64-bit integer or an SSE2 pair of them). */
+template <typename U> inline void quadrant(U q, U bs, U bc, U *us, U *uc)
+{
+    const U sw = (q ^ q) - (q & 1); /* all ones where k is odd */
+    *us = ((bs & ~sw) | (bc & sw)) ^ ((q & 2) << 62);
+    *uc = ((bc & ~sw) | (bs & sw)) ^ (((q + 1) & 2) << 62);
+}
+
 inline void sincos_d(double x, double *s, double *c)
 {
 #if !PM_SOFT_DOUBLE
     if (m_fabs(x) <= 64.0) {
-        double kd = (x * 0.6366197723675814 + RND_INT) - RND_INT;
-        double a = x - kd * PIO2_1, b = kd * PIO2_2; /* exact */
-        double rh = a - b;
-        double rl = ((a - rh) - b) - kd * PIO2_3; /* a - b - rh exactly, as |a| >= |b| or a ~ b */
-        double r2 = rh * rh;
-        double ps = r2 * (-1.0 / 6 + r2 * (1.0 / 120 + r2 * (-1.0 / 5040 +
-                    r2 * (1.0 / 362880 + r2 * (-1.0 / 39916800 + r2 * (1.0 / 6227020800.0 +
-                    r2 * (-1.0 / 1307674368000.0 + r2 * (1.0 / 355687428096000.0))))))));
-        double pc = r2 * r2 * (1.0 / 24 + r2 * (-1.0 / 720 + r2 * (1.0 / 40320 +
-                    r2 * (-1.0 / 3628800 + r2 * (1.0 / 479001600 + r2 * (-1.0 / 87178291200.0 +
-                    r2 * (1.0 / 20922789888000.0 + r2 * (-1.0 / 6402373705728000.0))))))));
-        double sr = rh + (rh * ps + rl); /* sin(rh + rl) = sin rh + rl cos rh */
-        double hz = 0.5 * r2, w = 1 - hz;
-        double cr = w + (((1 - w) - hz) + (pc - rh * rl));
-        /* quadrant q = k mod 4: (sin, cos) = (sr, cr), (cr, -sr), (-sr, -cr), (-cr, sr) */
-        unsigned q = (unsigned)(int)kd;
-        unsigned long long sw = 0ULL - (unsigned long long)(q & 1u);
-        unsigned long long bs = bits_of(sr), bc = bits_of(cr);
-        unsigned long long us = (bs & ~sw) | (bc & sw), uc = (bc & ~sw) | (bs & sw);
-        us ^= (unsigned long long)(q & 2u) << 62;
-        uc ^= (unsigned long long)((q + 1u) & 2u) << 62;
+        double sr, cr, kr;
+        unsigned long long us, uc;
+        sincos_core(x, &sr, &cr, &kr);
+        quadrant(bits_of(kr), bits_of(sr), bits_of(cr), &us, &uc);
         *s = of_bits(us);
         *c = of_bits(uc);
         return;
@@ -162,6 +177,15 @@ inline void sincos_d(double x, double *s, double *c)
 #endif
     *s = m_sin(x);
     *c = m_cos(x);
+}
+
+/* sincos_d of two angles, one after the other (kept out of line: the
+** rare path of sincos_d2 on x86-64). */
+__attribute__((noinline, cold)) inline void sincos_d_each(double x0, double x1, double *s0,
+                                                          double *c0, double *s1, double *c1)
+{
+    sincos_d(x0, s0, c0);
+    sincos_d(x1, s1, c1);
 }
 
 /* sincos_d of two angles at once: the same operations in the two lanes of
@@ -173,32 +197,11 @@ inline void sincos_d2(double x0, double x1, double *s0, double *c0, double *s1, 
     if (m_fabs(x0) <= 64.0 && m_fabs(x1) <= 64.0) {
         typedef double v2d __attribute__((vector_size(16)));
         typedef unsigned long long v2u __attribute__((vector_size(16)));
-#define PM_V2(c) ((v2d){(c), (c)}) /* constants as vectors: one load each */
         const v2d x = {x0, x1};
-        /* the nearest integer k, also in the low bits of kr (its ulp is 1) */
-        const v2d kr = x * PM_V2(0.6366197723675814) + PM_V2(RND_INT);
-        const v2d kd = kr - PM_V2(RND_INT);
-        const v2d a = x - kd * PM_V2(PIO2_1), b = kd * PM_V2(PIO2_2);
-        const v2d rh = a - b;
-        const v2d rl = ((a - rh) - b) - kd * PM_V2(PIO2_3);
-        const v2d r2 = rh * rh;
-        const v2d ps = r2 * (PM_V2(-1.0 / 6) + r2 * (PM_V2(1.0 / 120) + r2 * (PM_V2(-1.0 / 5040) +
-                       r2 * (PM_V2(1.0 / 362880) + r2 * (PM_V2(-1.0 / 39916800) +
-                       r2 * (PM_V2(1.0 / 6227020800.0) + r2 * (PM_V2(-1.0 / 1307674368000.0) +
-                       r2 * PM_V2(1.0 / 355687428096000.0))))))));
-        const v2d pc = r2 * r2 * (PM_V2(1.0 / 24) + r2 * (PM_V2(-1.0 / 720) + r2 * (PM_V2(1.0 / 40320) +
-                       r2 * (PM_V2(-1.0 / 3628800) + r2 * (PM_V2(1.0 / 479001600) +
-                       r2 * (PM_V2(-1.0 / 87178291200.0) + r2 * (PM_V2(1.0 / 20922789888000.0) +
-                       r2 * PM_V2(-1.0 / 6402373705728000.0))))))));
-        const v2d sr = rh + (rh * ps + rl);
-        const v2d hz = PM_V2(0.5) * r2, w = PM_V2(1.0) - hz;
-        const v2d cr = w + (((PM_V2(1.0) - w) - hz) + (pc - rh * rl));
-#undef PM_V2
-        const v2u q = (v2u)kr;
-        const v2u sw = (v2u){0, 0} - (q & 1);
-        const v2u bs = (v2u)sr, bc = (v2u)cr;
-        const v2u us = ((bs & ~sw) | (bc & sw)) ^ ((q & 2) << 62);
-        const v2u uc = ((bc & ~sw) | (bs & sw)) ^ (((q + 1) & 2) << 62);
+        v2d sr, cr, kr;
+        v2u us, uc;
+        sincos_core(x, &sr, &cr, &kr);
+        quadrant((v2u)kr, (v2u)sr, (v2u)cr, &us, &uc);
         const v2d vs = (v2d)us, vc = (v2d)uc;
         *s0 = vs[0];
         *s1 = vs[1];
@@ -206,9 +209,11 @@ inline void sincos_d2(double x0, double x1, double *s0, double *c0, double *s1, 
         *c1 = vc[1];
         return;
     }
-#endif
+    sincos_d_each(x0, x1, s0, c0, s1, c1);
+#else
     sincos_d(x0, s0, c0);
     sincos_d(x1, s1, c1);
+#endif
 }
 
 template <typename T> struct V3 {
