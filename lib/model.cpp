@@ -121,9 +121,9 @@ inline double turn_sum(double x, double s, bool half)
 ** (dT, dD) are small (the anisotropic displacement, a, b, d, i): two short
 ** series.  The sums are formed so that about one rounding falls on the
 ** result: multiples of pi/2 in three parts (turn_sum; +-2 PIO2_1 - d is
-** exact or rounded once), the small parts added apart.  Returns false where this does not apply -- |t| > 64,
-** |d| > 4, |c'| or |e'| > 0.5, an offset beyond 0.01 rad (within ~0.6 deg
-** of the pole) -- and the caller takes atan2.
+** exact or rounded once), the small parts added apart.  Returns false
+** where this does not apply -- |t| > 64, |d| > 4, |c'| or |e'| > 0.5, an
+** offset beyond 0.01 rad (near the pole) -- and the caller takes atan2.
 */
 bool frame_angles(const pm_model *m, double t, double d, const double sh[4],
                   const V3<double> &p, double *T, double *D)
@@ -306,8 +306,8 @@ void on_turn(const pm_model *m, const Iso<double> &k, const Aim &a, Trig<double>
 ** position's branch, with the angles on the turn the result is returned
 ** on (turn_of).  Returns the status and (t, d). */
 pm_status solve_branch(const pm_model *m, const Iso<double> &k,
-                       const pm_context *ctx, const Aim &a, int side, const double *start, const double *turn, double *t_out,
-                       double *d_out)
+                       const pm_context *ctx, const Aim &a, int side, const double *start,
+                       const double *turn, double *t_out, double *d_out)
 {
     double dt_prev = 0, dd_prev = 0;
     /* Periodic terms of non-integer G read the raw angle itself, not only
@@ -326,8 +326,8 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
         V3<double> v = rot_z<double>(k.si, k.ci, expmap<double>(dt_prev, dd_prev));
         side = cdp * v.x - sdp * v.z >= 0 ? 1 : -1;
     }
-    /* the angles themselves (two atan2) only where a term reads them;
-    ** else once, at the end */
+    /* the angles themselves (on_turn) only where a term reads them; else
+    ** once, at the end */
     const bool raw = reads_raw_angles(m);
     bool reachable = iso_inverse<double>(k, tg, dt_prev, dd_prev, side, &g);
     if (raw)

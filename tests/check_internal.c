@@ -210,10 +210,11 @@ START_TEST(test_invert_vs_long_double)
             long double Tr, Dr, e;
             pm_status st;
             if (j % 3 == 2)
-                st = pm_model_invert_near(&m, NULL, T, D, T - m.coef[2] + 1e-3, D + m.coef[4] - 1e-3,
-                                          &t, &d);
+                st = pm_model_invert_near(&m, NULL, T, D, T - m.coef[2] + 1e-3,
+                                          D + m.coef[4] - 1e-3, &t, &d);
             else
-                st = pm_model_invert(&m, NULL, T, D, j % 3 ? PM_SIDE_FLIPPED : PM_SIDE_NORMAL, &t, &d);
+                st = pm_model_invert(&m, NULL, T, D, j % 3 ? PM_SIDE_FLIPPED : PM_SIDE_NORMAL,
+                                     &t, &d);
             if (st != PM_OK)
                 continue;
             ok++;

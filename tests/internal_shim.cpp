@@ -53,7 +53,8 @@ void pm_test_apply_ld(const pm_model *m, const pm_context *ctx, double t, double
     LD K[9] = {0, 0, b, 0, 0, -a, -b, a, 0}, W[3] = {a, b, 0};
     for (int r = 0; r < 3; r++)
         for (int c = 0; c < 3; c++)
-            k.h[3 * r + c] = (r == c ? 1 : 0) + A * K[3 * r + c] + B * (W[r] * W[c] - (r == c ? th2 : 0));
+            k.h[3 * r + c] =
+                (r == c ? 1 : 0) + A * K[3 * r + c] + B * (W[r] * W[c] - (r == c ? th2 : 0));
     sin_cos((LD)m->coef[2], &k.sc, &k.cc);
     sin_cos((LD)m->coef[3], &k.sd, &k.cd);
     sin_cos((LD)m->coef[4], &k.se, &k.ce);
