@@ -403,9 +403,12 @@ template <typename T> inline V3<T> expmap(T a, T b)
     T r2 = a * a + b * b;
     T c, s;
     if (r2 < (T)1e-4) {
-        /* (Horner, by the reciprocals: no division) */
-        c = 1 - r2 * ((T)0.5 - r2 * ((T)(1.0 / 24) - r2 * (T)(1.0 / 720)));
-        s = 1 - r2 * ((T)(1.0 / 6) - r2 * ((T)(1.0 / 120) - r2 * (T)(1.0 / 5040)));
+        /* (by the reciprocals: no division; the r^4 part beside the
+        ** leading terms, so that the chain is short: it is on the
+        ** inverse's iteration path) */
+        T r4 = r2 * r2;
+        c = (1 - (T)0.5 * r2) + r4 * ((T)(1.0 / 24) - r2 * (T)(1.0 / 720));
+        s = (1 - (T)(1.0 / 6) * r2) + r4 * ((T)(1.0 / 120) - r2 * (T)(1.0 / 5040));
     } else {
         T r = m_sqrt(r2);
         c = m_cos(r);
@@ -725,9 +728,9 @@ template <typename T, typename W, int LC> struct HarmSums {
 };
 
 #if defined(__SSE2__) && !PM_SOFT_DOUBLE
-/* Doubles on x86-64: the six sums as three pairs in SSE2 registers, each
-** lane doing the scalar version's operations in its order (same results,
-** half the instructions). */
+/* Doubles on x86-64: the six sums as three pairs in SSE2 registers (half
+** the instructions), the odd and even harmonics summed apart (so the
+** sums round differently from the scalar version's, by an ulp). */
 template <int LC> struct HarmSums<double, double, LC> {
     static void sum(int N, const double (*dense)[6], const double *Y, double *S)
     {
@@ -736,14 +739,26 @@ template <int LC> struct HarmSums<double, double, LC> {
         const v2u *r = (const v2u *)dense[1];
         v2d y = {Y[1], Y[1]};
         v2d s0 = r[0] * y, s1 = r[1] * y, s2 = r[2] * y;
+        /* the odd and the even harmonics apart, added at the end: half the
+        ** dependency chain (the inverse iterates on it) */
+        v2d t0 = {0, 0}, t1 = {0, 0}, t2 = {0, 0};
 #pragma GCC unroll 32
         for (int j = 2; j < N; j++) {
             r = (const v2u *)dense[j];
             y = (v2d){Y[j], Y[j]};
-            s0 += r[0] * y;
-            s1 += r[1] * y;
-            s2 += r[2] * y;
+            if (j & 1) {
+                s0 += r[0] * y;
+                s1 += r[1] * y;
+                s2 += r[2] * y;
+            } else {
+                t0 += r[0] * y;
+                t1 += r[1] * y;
+                t2 += r[2] * y;
+            }
         }
+        s0 += t0;
+        s1 += t1;
+        s2 += t2;
         S[0] = s0[0];
         S[1] = s0[1];
         S[2] = s1[0];
@@ -901,6 +916,8 @@ template <typename T> inline bool unit_pair(T *s, T *c)
 template <typename T> struct Target {
     V3<T> q0;
     T rho2, irho2, icd;
+    T sdq;  /* sin d q0_z */
+    T P, Q; /* (q0_y cos c' - q0_x sin c', q0_x cos c' + q0_y sin c') / rho2 */
 };
 
 template <typename T> inline Target<T> target_of(const Iso<T> &k, const V3<T> &q)
@@ -910,6 +927,9 @@ template <typename T> inline Target<T> target_of(const Iso<T> &k, const V3<T> &q
     o.rho2 = o.q0.x * o.q0.x + o.q0.y * o.q0.y;
     o.irho2 = o.rho2 > (T)1e-12 ? 1 / o.rho2 : 0; /* 0: normalise by unit_pair */
     o.icd = 1 / k.cd;
+    o.sdq = k.sd * o.q0.z;
+    o.P = (o.q0.y * k.cc - o.q0.x * k.sc) * o.irho2;
+    o.Q = (o.q0.x * k.cc + o.q0.y * k.sc) * o.irho2;
     return o;
 }
 
@@ -929,7 +949,9 @@ inline bool iso_inverse(const Iso<T> &k, const Target<T> &tg, T dt, T dd, int si
     /* With g = Pd(d') v and u = X(d) g: u_z = q0_z fixes g3, then u_y,
     ** and |u_xy| = |q0_xy| fixes g1 up to the side. */
     T g3 = (q0.z - k.sd * v.y) * tg.icd;
-    T uy = k.cd * v.y - k.sd * g3;
+    /* uy = cd vy - sd g3 = (vy - sd q0_z) / cd: two operations after v.y
+    ** (this is the iteration's critical path) */
+    T uy = (v.y - tg.sdq) * tg.icd;
     T rho2 = tg.rho2;
     T disc = rho2 - uy * uy;
     bool ok = true, on_edge = false;
@@ -944,26 +966,28 @@ inline bool iso_inverse(const Iso<T> &k, const Target<T> &tg, T dt, T dd, int si
         on_edge = true;
     }
     T g1 = (T)side * m_sqrt(disc);
-    /* (g1 + i g3) = (vx + i vz) exp(i d'): d' = arg(g1 + i g3) - arg(v) */
-    T sdp = g3 * v.x - g1 * v.z;
-    T cdp = g1 * v.x + g3 * v.z;
-    /* t' = arg(q0_xy) - arg(u_xy), u_x = g1 */
-    T stp = q0.y * g1 - q0.x * uy;
-    T ctp = q0.x * g1 + q0.y * uy;
     T vxz = v.x * v.x + v.z * v.z;
     if (!on_edge && tg.irho2 > 0 && vxz > (T)1e-12) {
-        /* Both pairs have known lengths: |g| = |u| = |q| = |v| = 1 gives
-        ** |(g1, g3)| = |(vx, vz)|, so |(sdp, cdp)| = vx^2 + vz^2, and
-        ** g1^2 + uy^2 = rho2, so |(stp, ctp)| = rho2: a division by a
-        ** loop constant and one off the iteration's chain instead of two
-        ** square roots and four divisions on it (the pairs come out unit
-        ** to rounding). */
+        /* The pairs below have known lengths: |g| = |u| = |q| = |v| = 1
+        ** gives |(g1, g3)| = |(vx, vz)|, so |(sdp, cdp)| = vx^2 + vz^2, and
+        ** g1^2 + uy^2 = rho2, so |(stp, ctp)| = rho2.  Normalised by them
+        ** and turned back by the index shifts, written out: every factor
+        ** but g1 is ready before the square root, so the iteration's
+        ** chain ends two operations after it (no square root or division
+        ** of its own; the pairs come out unit to rounding). */
         T f = 1 / vxz;
-        sdp *= f;
-        cdp *= f;
-        stp *= tg.irho2;
-        ctp *= tg.irho2;
+        T fU = f * (v.x * k.ce + v.z * k.se), fW = f * (v.x * k.se - v.z * k.ce);
+        g->sd = g3 * fU + g1 * fW;
+        g->cd = g1 * fU - g3 * fW;
+        g->st = g1 * tg.P - uy * tg.Q;
+        g->ct = g1 * tg.Q + uy * tg.P;
     } else {
+        /* (g1 + i g3) = (vx + i vz) exp(i d'): d' = arg(g1 + i g3) - arg(v) */
+        T sdp = g3 * v.x - g1 * v.z;
+        T cdp = g1 * v.x + g3 * v.z;
+        /* t' = arg(q0_xy) - arg(u_xy), u_x = g1 */
+        T stp = q0.y * g1 - q0.x * uy;
+        T ctp = q0.x * g1 + q0.y * uy;
         if (!unit_pair<T>(&sdp, &cdp)) {
             sdp = 0;
             cdp = 1;
@@ -972,12 +996,12 @@ inline bool iso_inverse(const Iso<T> &k, const Target<T> &tg, T dt, T dd, int si
             stp = 0;
             ctp = 1;
         }
+        /* undo the index shifts: t = t' - c', d = d' + e' */
+        g->st = stp * k.cc - ctp * k.sc;
+        g->ct = ctp * k.cc + stp * k.sc;
+        g->sd = sdp * k.ce + cdp * k.se;
+        g->cd = cdp * k.ce - sdp * k.se;
     }
-    /* undo the index shifts: t = t' - c', d = d' + e' */
-    g->st = stp * k.cc - ctp * k.sc;
-    g->ct = ctp * k.cc + stp * k.sc;
-    g->sd = sdp * k.ce + cdp * k.se;
-    g->cd = cdp * k.ce - sdp * k.se;
     g->t = g->d = 0;
     g->have_angles = false;
     return ok;
