@@ -93,12 +93,18 @@ int side_of(const pm_model *m, double d)
     return m_cos(x) >= 0 ? 1 : -1;
 }
 
-/* atan(r) for |r| <= 0.01 by its series (the terms left out are below
-** 1e-23). */
+/* atan(r) and asin(r) for |r| <= 0.01 by their series (the terms left out
+** are below 1e-23), by Estrin's scheme (a short dependency chain: these
+** end the forward model's). */
 inline double atan_small(double r)
 {
-    double r2 = r * r;
-    return r * (1 - r2 * (1.0 / 3 - r2 * (1.0 / 5 - r2 * (1.0 / 7 - r2 * (1.0 / 9)))));
+    double r2 = r * r, r4 = r2 * r2;
+    return r * ((1 - r2 * (1.0 / 3)) + r4 * ((1.0 / 5 - r2 * (1.0 / 7)) + r4 * (1.0 / 9)));
+}
+inline double asin_small(double r)
+{
+    double r2 = r * r, r4 = r2 * r2;
+    return r * ((1 + r2 * (1.0 / 6)) + r4 * ((3.0 / 40 + r2 * (5.0 / 112)) + r4 * (35.0 / 1152)));
 }
 
 /* The angle x + s (+ pi if half) in (-pi, pi], for |x| <= 64 and |s| <= 1:
@@ -137,10 +143,12 @@ bool frame_angles(const pm_model *m, double t, double d, const double sh[4],
     const double sD = sh[2], cD = flip ? -sh[3] : sh[3];
     double x1 = cT * p.x + sT * p.y, y1 = cT * p.y - sT * p.x;
     double rho = m_sqrt(x1 * x1 + y1 * y1);
+    /* sin(D - D0) = p_z cos D0 - rho sin D0 (|p| = 1 to rounding: asin, no
+    ** division after the square root) */
     double zn = p.z * cD - rho * sD, zd = rho * cD + p.z * sD;
-    if (!(m_fabs(y1) <= 0.01 * x1) || !(m_fabs(zn) <= 0.01 * zd))
+    if (!(m_fabs(y1) <= 0.01 * x1) || !(m_fabs(zn) <= 0.01) || !(zd > 0))
         return false;
-    double dT = atan_small(y1 / x1), dD = atan_small(zn / zd);
+    double dT = atan_small(y1 / x1), dD = asin_small(zn);
     /* T = t + c' + dT (+ pi), in (-pi, pi] */
     *T = turn_sum(t, c + dT, flip);
     /* D = d - e' + dD, or beyond the pole +-pi - (d - e') + dD */
@@ -249,16 +257,15 @@ struct Aim {
     V3<double> q;
 };
 
-/* Angle of the pair (s, c) near the angle a0 whose sine and cosine are
-** (s0, c0): a0 + atan2(sin(a - a0), cos(a - a0)), the small angle by its
-** series, returned as the parts (a0, the small angle) in *small; false if
-** it is not small (beyond 0.01 rad). */
+/* Angle of the unit pair (s, c) near the angle a0 whose sine and cosine
+** are (s0, c0): a - a0 = asin(sin(a - a0)) with cos(a - a0) > 0, by its
+** series, in *small; false if it is not small (beyond 0.01 rad). */
 inline bool near_angle(double s, double c, double s0, double c0, double *small)
 {
     double y = s * c0 - c * s0, x = c * c0 + s * s0;
-    if (!(m_fabs(y) <= 0.01 * x))
+    if (!(m_fabs(y) <= 0.01) || !(x > 0))
         return false;
-    *small = atan_small(y / x);
+    *small = asin_small(y);
     return true;
 }
 

@@ -141,12 +141,17 @@ template <typename V> inline void sincos_core(V x, V *sr, V *cr, V *kr)
     const V rh = a - b;
     const V rl = ((a - rh) - b) - kd * PIO2_3; /* a - b - rh exactly, as |a| >= |b| or a ~ b */
     const V r2 = rh * rh;
-    const V ps = r2 * (-1.0 / 6 + r2 * (1.0 / 120 + r2 * (-1.0 / 5040 +
-                 r2 * (1.0 / 362880 + r2 * (-1.0 / 39916800 + r2 * (1.0 / 6227020800.0 +
-                 r2 * (-1.0 / 1307674368000.0 + r2 * (1.0 / 355687428096000.0))))))));
-    const V pc = r2 * r2 * (1.0 / 24 + r2 * (-1.0 / 720 + r2 * (1.0 / 40320 +
-                 r2 * (-1.0 / 3628800 + r2 * (1.0 / 479001600 + r2 * (-1.0 / 87178291200.0 +
-                 r2 * (1.0 / 20922789888000.0 + r2 * (-1.0 / 6402373705728000.0))))))));
+    /* the series by Estrin's scheme (pairs, then powers r^4, r^8): a third
+    ** of Horner's dependency chain, which is the forward model's longest */
+    const V r4 = r2 * r2, r8 = r4 * r4;
+    const V ps = r2 * (((-1.0 / 6 + r2 * (1.0 / 120)) +
+                        r4 * (-1.0 / 5040 + r2 * (1.0 / 362880))) +
+                       r8 * ((-1.0 / 39916800 + r2 * (1.0 / 6227020800.0)) +
+                             r4 * (-1.0 / 1307674368000.0 + r2 * (1.0 / 355687428096000.0))));
+    const V pc = r4 * (((1.0 / 24 + r2 * (-1.0 / 720)) +
+                        r4 * (1.0 / 40320 + r2 * (-1.0 / 3628800))) +
+                       r8 * ((1.0 / 479001600 + r2 * (-1.0 / 87178291200.0)) +
+                             r4 * (1.0 / 20922789888000.0 + r2 * (-1.0 / 6402373705728000.0))));
     *sr = rh + (rh * ps + rl); /* sin(rh + rl) = sin rh + rl cos rh */
     const V hz = 0.5 * r2, w = 1.0 - hz;
     *cr = w + (((1.0 - w) - hz) + (pc - rh * rl));
@@ -310,7 +315,12 @@ template <typename T, int LC> inline void harmonics_n(int Lrt, const Trig<T> &g,
     T pmm = 1;         /* P_m^m */
 #pragma GCC unroll 16
     for (int m = 0; m <= L; m++) {
-        if (m > 0) {
+        if (m == 1) { /* (cos t, sin t) themselves: 1 * ct - 0 * st is two
+                         ** operations on the chain the compiler may not fold */
+            cm = g.ct;
+            sm = g.st;
+            pmm = g.cd;
+        } else if (m > 1) {
             T c2 = cm * g.ct - sm * g.st;
             sm = sm * g.ct + cm * g.st;
             cm = c2;
@@ -820,9 +830,11 @@ inline void aniso(const pm_model *m, const Iso<T> &k, const Trig<T> &g0,
     PM_EVAL_PROBE();
     T S[6];
     sh_sums<T, double>(m->order, g0, m->dense, S);
-    /* sum_k S_k (u_k, v_k), written out */
-    *dt = -g0.sd * (S[0] * g0.ct + S[1] * g0.st + S[3]) + g0.cd * S[2] + S[5];
-    *dd = S[0] * g0.st - S[1] * g0.ct - S[4];
+    /* sum_k S_k (u_k, v_k), written out (the products of the position's
+    ** trig formed beside the sums: a short chain after them) */
+    const T sc = g0.sd * g0.ct, ss = g0.sd * g0.st;
+    *dt = ((g0.cd * S[2] + S[5]) - sc * S[0]) - (ss * S[1] + g0.sd * S[3]);
+    *dd = (S[0] * g0.st - S[4]) - S[1] * g0.ct;
     if (m->n_terms > m->n_base) {
         Trig<T> g = g0;
         if (!g.have_angles) {
