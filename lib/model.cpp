@@ -113,9 +113,16 @@ inline double asin_small(double r)
 ** that rounds onto or beyond +-pi is pi). */
 inline double turn_sum(double x, double s, bool half)
 {
-    double n = ((x + s) * 0.15915494309189535 + (half ? 0.5 : 0.0) + RND_INT) - RND_INT;
+    /* the turn from x alone (ready before s: a shorter chain), from x + s
+    ** where s carries the sum across +-pi */
+    double n = (x * 0.15915494309189535 + (half ? 0.5 : 0.0) + RND_INT) - RND_INT;
     double q = 4 * n - (half ? 2 : 0); /* x + s + (pi) - 2 pi n = x + s - q pi/2 */
     double a = (x - q * PIO2_1) + ((s - q * PIO2_2) - q * PIO2_3);
+    if (abs_beyond(a, PI)) {
+        n = ((x + s) * 0.15915494309189535 + (half ? 0.5 : 0.0) + RND_INT) - RND_INT;
+        q = 4 * n - (half ? 2 : 0);
+        a = (x - q * PIO2_1) + ((s - q * PIO2_2) - q * PIO2_3);
+    }
     return abs_beyond(a, PI) || same_as(a, -PI) ? PI : a;
 }
 

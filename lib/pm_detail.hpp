@@ -427,6 +427,22 @@ template <typename T> inline V3<T> expmap(T a, T b)
     return v3(c, a * s, b * s);
 }
 
+/* rot_z(si, ci, expmap(a, b)) for the inverse's iteration, whose chain
+** runs through the y-component: in the series case y = si c + ci a s
+** summed by powers of r^2 (c, s as in expmap), two operations shorter. */
+template <typename T> inline V3<T> expmap_z(T si, T ci, T a, T b)
+{
+    V3<T> v = rot_z<T>(si, ci, expmap<T>(a, b));
+    T r2 = a * a + b * b;
+    if (r2 < (T)1e-4) {
+        T A = ci * a, r4 = r2 * r2;
+        v.y = ((si + A) - r2 * (si * (T)0.5 + A * (T)(1.0 / 6))) +
+              (r4 * (si * (T)(1.0 / 24) + A * (T)(1.0 / 120)) -
+               (r2 * r4) * (si * (T)(1.0 / 720) + A * (T)(1.0 / 5040)));
+    }
+    return v;
+}
+
 /* Inverse of expmap: tangent offset of unit vector q as seen from (1,0,0). */
 template <typename T> inline void logmap(const V3<T> &q, T *a, T *b)
 {
@@ -957,7 +973,7 @@ inline bool iso_inverse(const Iso<T> &k, const Target<T> &tg, T dt, T dd, int si
                         Trig<T> *g)
 {
     const V3<T> &q0 = tg.q0;
-    V3<T> v = rot_z<T>(k.si, k.ci, expmap<T>(dt, dd));
+    V3<T> v = expmap_z<T>(k.si, k.ci, dt, dd);
     /* With g = Pd(d') v and u = X(d) g: u_z = q0_z fixes g3, then u_y,
     ** and |u_xy| = |q0_xy| fixes g1 up to the side. */
     T g3 = (q0.z - k.sd * v.y) * tg.icd;
