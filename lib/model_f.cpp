@@ -241,7 +241,10 @@ void forward_f(const pm_model_f *m, const pm_context *ctx, double t, double d, d
     double tr, dr;
     float dT, dD;
     forward_parts_f(m, ctx, t, d, &tr, &dr, &dT, &dD);
-    *T = wrap_pi(tr + (double)dT);
+    /* the frame angle reduced first: t + c' can be far beyond pi (a huge
+    ** index term), where adding the correction would round at its ulp
+    ** (fuzz finding: c' = 7.8e7 rad, 7.5e-9 rad) */
+    *T = wrap_pi(wrap_pi(tr) + (double)dT);
     *D = dr + (double)dD;
 }
 
@@ -387,7 +390,7 @@ pm_status fixed_f(const pm_model_f *m, const pm_context *ctx, double T, double D
             ** with cos D1 <= cos D - sin D eD + eD^2 (|eD| < 1); the angle
             ** exceeds the chord by a part in chord^2 / 24, and the float
             ** sums by a few parts in 1e7: 1% of tol^2 covers both. */
-            float eT = (float)wrap_pi(tr - T0) + kT, eD = (float)(dr - D) + kD;
+            float eT = (float)wrap_pi(wrap_pi(tr) - T0) + kT, eD = (float)(dr - D) + kD;
             float cD1 = cD - sD * eD + eD * eD;
             float cc = cD1 > 0 ? cD1 * cD : 0.0f;
             if (!(m_fabs(eD) < 1 && eD * eD + cc * eT * eT <= 0.99f * tol * tol))
