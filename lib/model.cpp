@@ -126,6 +126,13 @@ inline double turn_sum(double x, double s, bool half)
     return abs_beyond(a, PI) || same_as(a, -PI) ? PI : a;
 }
 
+/* pi - x + s for a small s, pi in the parts of pi/2: 2 PIO2_1 - x is exact
+** or rounded once, s added apart (the declination beyond the pole). */
+inline double pi_minus(double x, double s)
+{
+    return (2 * PIO2_1 - x) + ((s + 2 * PIO2_2) + 2 * PIO2_3);
+}
+
 /*
 ** Apparent angles (T, D) of the forward model's unit vector p at encoder
 ** (t, d), without atan2: measured from the shifted position (t + c',
@@ -133,8 +140,8 @@ inline double turn_sum(double x, double s, bool half)
 ** pi - (d - e')) -- whose trig sh (forward_vec) is known, p's offsets
 ** (dT, dD) are small (the anisotropic displacement, a, b, d, i): two short
 ** series.  The sums are formed so that about one rounding falls on the
-** result: multiples of pi/2 in three parts (turn_sum; +-2 PIO2_1 - d is
-** exact or rounded once), the small parts added apart.  Returns false
+** result: multiples of pi/2 in three parts (turn_sum, pi_minus), the
+** small parts added apart.  Returns false
 ** where this does not apply -- |t| > 64, |d| > 4, |c'| or |e'| > 0.5, an
 ** offset beyond 0.01 rad (near the pole) -- and the caller takes atan2.
 */
@@ -163,9 +170,9 @@ bool frame_angles(const pm_model *m, double t, double d, const double sh[4],
     if (!flip)
         da = d + (dD - e);
     else if (d - e > 0)
-        da = (2 * PIO2_1 - d) + (((e + dD) + 2 * PIO2_2) + 2 * PIO2_3);
-    else
-        da = (-2 * PIO2_1 - d) + (((e + dD) - 2 * PIO2_2) - 2 * PIO2_3);
+        da = pi_minus(d, e + dD);
+    else /* -pi - (d - e') + dD */
+        da = -pi_minus(-d, -(e + dD));
     /* the exact angle is in [-pi/2, pi/2]: rounding only can leave it */
     *D = abs_beyond(da, PI / 2) ? (below0(da) ? -PI / 2 : PI / 2) : da;
     return true;
@@ -307,8 +314,7 @@ void on_turn(const pm_model *m, const Iso<double> &k, const Aim &a, Trig<double>
         cd0 = -(a.cd * k.ce + a.sd * k.se);
     }
     if (!abs_beyond(e, 0.5) && near_angle(g->sd, g->cd, sd0, cd0, &small))
-        d = flip ? (2 * PIO2_1 - a.dec) + (((e + small) + 2 * PIO2_2) + 2 * PIO2_3)
-                 : a.dec + (small + e);
+        d = flip ? pi_minus(a.dec, e + small) : a.dec + (small + e);
     else
         d = m_atan2(g->sd, g->cd);
     g->t = ref_t + wrap_pi(t - ref_t);
