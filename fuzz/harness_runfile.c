@@ -128,13 +128,19 @@ static int rf_walk(const pmrun *run, const char *path, int skip_bad)
         if (!(fabs(o->app_dec) <= M_PI / 2 + RF_EPS) || !(fabs(o->enc_dec) <= M_PI + RF_EPS))
             return pmfz_fail("runfile: record %zu axis 2 out of range: enc %.17g app %.17g", i,
                              o->enc_dec, o->app_dec);
-        if (!(fabs(o->enc_ha) <= 5 * M_PI + RF_EPS) || !(fabs(o->app_ha) <= 5 * M_PI + RF_EPS))
-            return pmfz_fail("runfile: record %zu axis 1 out of range: enc %.17g app %.17g", i,
-                             o->enc_ha, o->app_ha);
-        if (tpoint_eq && (!(o->app_ha > -M_PI && o->app_ha <= M_PI) ||
-                          !(o->enc_ha > -M_PI && o->enc_ha <= M_PI)))
-            return pmfz_fail("runfile: record %zu TPOINT HA not in (-pi, pi]: enc %.17g app %.17g",
-                             i, o->enc_ha, o->app_ha);
+        /* encoder angles are modular: every reader reduces them into
+        ** (-pi, pi] (the file's value in enc_raw); apparent axis 1 is an HA
+        ** in (-pi, pi] or an azimuth in [0, 2pi) */
+        if (!(o->enc_ha > -M_PI - RF_EPS && o->enc_ha <= M_PI + RF_EPS) ||
+            !(o->enc_dec > -M_PI - RF_EPS && o->enc_dec <= M_PI + RF_EPS))
+            return pmfz_fail("runfile: record %zu encoder not in (-pi, pi]: %.17g %.17g", i,
+                             o->enc_ha, o->enc_dec);
+        if (mount == PMRUN_MOUNT_ALTAZ ? !(o->app_ha >= 0 && o->app_ha < 2 * M_PI + RF_EPS)
+                                       : !(o->app_ha > -M_PI - RF_EPS && o->app_ha <= M_PI + RF_EPS))
+            return pmfz_fail("runfile: record %zu apparent axis 1 %.17g out of range", i,
+                             o->app_ha);
+        if (!pmfz_finite(o->enc_raw[0]) || !pmfz_finite(o->enc_raw[1]))
+            return pmfz_fail("runfile: record %zu enc_raw not finite", i);
         if (fmt == PMRUN_FORMAT_TPOINT && mount == PMRUN_MOUNT_ALTAZ &&
             !(o->app_ha >= 0 && o->app_ha < 2 * M_PI))
             return pmfz_fail("runfile: record %zu TPOINT azimuth %.17g not in [0, 2pi)", i,

@@ -14,6 +14,13 @@
 **    where the telescope really points (the star's observed place).
 **  - An encoder dec beyond +-pi/2 means the telescope is flipped over the
 **    pole (German equatorial mount on the other pier side).
+**  - Encoder angles are modular: every function takes any finite encoder
+**    angle on either axis (a flipped mount's 194.17 deg as well as
+**    -165.83 deg, a controller's 0..2pi), and angles a turn apart give the
+**    same result to the rounding of 2pi, with one deliberate exception: a
+**    periodic term of non-integer G reads the angle on the mount's own
+**    turn (docs/model.md).  The host readers reduce the angles of a file
+**    into (-pi, pi] exactly, in degrees (docs/formats.md).
 **  - The caller owns every struct.  All structs are fully defined here so
 **    that they can be allocated statically; their sizes depend on the
 **    capacity macros PM_MAX_L and PM_MAX_EXTRA, which must be the same when

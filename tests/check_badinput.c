@@ -590,15 +590,12 @@ struct range_case {
 START_TEST(test_badinput_angles_out_of_range)
 {
     static const struct range_case cases[] = {
-        /* four-column: |tau|, |T| <= 720; |delta| <= 180; |D| <= 90 */
-        {"10 20 10.1 20.1\n1e9 20 10.1 20.1\n", NULL, 2, "field 1 (tau) '1e9': beyond +-720"},
-        {"10 20 10.1 20.1\n10 20 -721 20.1\n", NULL, 2, "field 3 (T) '-721': beyond +-720"},
-        {"10 20 10.1 20.1\n10 180.5 10.1 20.1\n", NULL, 2,
-         "field 2 (delta) '180.5': declination beyond +-180"},
+        /* four-column: encoder angles and T are modular (any finite
+        ** value); the apparent D is a place on the sky, |D| <= 90 */
         {"10 20 10.1 20.1\n10 20 10.1 120\n", NULL, 2,
          "field 4 (D) '120': apparent declination beyond +-90"},
-        /* alt-az: elevations within +-90 */
-        {NULL, "bad_named_altaz_el.dat", 3, "elevation beyond +-90"},
+        {"10 20 10.1 20.1\n10 1e999 10.1 20.1\n", NULL, 2, "field 2 (delta) '1e999'"},
+        /* alt-az: apparent elevations within +-90 */
         {"# mount: altaz\n# tau delta T D\n10 45 10.1 45\n10 45 10.1 90.5\n", NULL, 4,
          "field 4 (D) '90.5': elevation beyond +-90"},
         {NULL, "bad_altaz_el.dat", 4, "field 2 (observed elevation) '91.5'"},
@@ -610,7 +607,6 @@ START_TEST(test_badinput_angles_out_of_range)
         {NULL, "bad_seconds.dat", 4, "field 6 (Dec seconds) '60.5': out of range"},
         {NULL, "bad_ra_hours.dat", 4, "field 1 (RA hours) '24': out of range"},
         {NULL, "bad_cat_dec.dat", 4, "catalogue Dec +90 30 00.000 is beyond +-90"},
-        {NULL, "bad_raw_dec.dat", 4, "raw Dec +180 30 00.000 is beyond +-180"},
         {NULL, "bad_sign_minutes.dat", 4, "field 2 (RA minutes) '-36'"},
         {"LST test\n:EQUAT\n+39 00 25 2023 9 1\n"
          "18 36 26.0213 +77 47 53.139 18 04 46.8191 +77 36 25.053  22 60.0\n",
@@ -635,19 +631,33 @@ START_TEST(test_badinput_angles_out_of_range)
 END_TEST
 
 /* What the docs allow is not an error: a German mount's encoder dec beyond
-** +-90 (over the pole), encoder HA up to +-720 (cable wrap). */
+** +-90 (over the pole), written in -180..180 or 0..360 deg, and any finite
+** encoder angle: reduced exactly into (-180, 180], the file's value kept in
+** enc_raw. */
 START_TEST(test_badinput_angles_legitimate)
 {
     char path[256];
     pmrun *run;
     make_tmpdir();
     tmp_path(path, sizeof path, "legit.dat");
-    write_text(path, "10 20 10.1 20.1\n190 120 10.1 60.1\n-350 -30 10.2 -30.1\n");
+    write_text(path, "10 20 10.1 20.1\n190 120 10.1 60.1\n-350 -30 10.2 -30.1\n"
+                     "190.25 194.16885990 10.1 -14.1\n1000000090 20 10.1 20.2\n-180 -180 10.1 -1\n");
     run = read_ok(path, NULL);
-    ck_assert_uint_eq(pmrun_count(run), 3);
+    ck_assert_uint_eq(pmrun_count(run), 6);
     ck_assert_int_eq(pmrun_get(run, 1)->pier, PMRUN_PIER_WEST);
     ck_assert_double_eq_tol(pmrun_get(run, 1)->enc_dec, 120 * DEG, 1e-12);
-    ck_assert_double_eq_tol(pmrun_get(run, 2)->enc_ha, -350 * DEG, 1e-12);
+    ck_assert_double_eq_tol(pmrun_get(run, 1)->enc_ha, -170 * DEG, 1e-12);
+    ck_assert(pmrun_get(run, 2)->enc_ha == 10 * DEG);
+    ck_assert(pmrun_get(run, 2)->enc_raw[0] == -350 * DEG);
+    /* the flipped mount's southern target: 194.17 deg is -165.83 deg */
+    ck_assert_int_eq(pmrun_get(run, 3)->pier, PMRUN_PIER_WEST);
+    ck_assert(pmrun_get(run, 3)->enc_dec == (194.16885990 - 360.0) * DEG);
+    ck_assert(pmrun_get(run, 3)->enc_raw[1] == 194.16885990 * DEG);
+    /* 1000000090 deg = 2777778 turns + 10 deg, exactly */
+    ck_assert(pmrun_get(run, 4)->enc_ha == 10 * DEG);
+    /* the half-open interval: -180 is +180 */
+    ck_assert(pmrun_get(run, 5)->enc_ha == 180 * DEG);
+    ck_assert(pmrun_get(run, 5)->enc_dec == 180 * DEG);
     ck_assert_int_eq(pmrun_n_warnings(run), 0);
     pmrun_free(run);
 }

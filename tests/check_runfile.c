@@ -210,7 +210,9 @@ START_TEST(test_pmrun_read_named_altaz)
     ck_assert(isnan(pmrun_latitude_rad(run)));
     ck_assert_uint_eq(pmrun_count(run), 2);
     o = pmrun_get(run, 1);
-    ck_assert_double_eq_tol(o->enc_ha, 270.5 * DEG, TOL_PARSE_RAD);
+    /* encoder azimuth reduced into (-180, 180], the file's 270.5 kept */
+    ck_assert_double_eq_tol(o->enc_ha, -89.5 * DEG, TOL_PARSE_RAD);
+    ck_assert_double_eq_tol(o->enc_raw[0], 270.5 * DEG, TOL_PARSE_RAD);
     ck_assert_double_eq_tol(o->app_ha, 270.48 * DEG, TOL_PARSE_RAD);
     ck_assert_double_eq_tol(o->app_dec, 30.01 * DEG, TOL_PARSE_RAD);
     ck_assert_int_eq(o->pier, PMRUN_PIER_UNKNOWN);
@@ -280,7 +282,8 @@ START_TEST(test_pmrun_read_tpoint_altaz)
     /* azimuth from south through east -> from north through east */
     o = pmrun_get(run, 0);
     ck_assert_double_eq_tol(o->app_ha, (180.0 - 192.3860283 + 360.0) * DEG, TOL_PARSE_RAD);
-    ck_assert_double_eq_tol(o->enc_ha, (180.0 + 167.2778909) * DEG, TOL_PARSE_RAD);
+    ck_assert_double_eq_tol(o->enc_ha, (180.0 + 167.2778909 - 360.0) * DEG, TOL_PARSE_RAD);
+    ck_assert_double_eq_tol(o->enc_raw[0], (180.0 + 167.2778909) * DEG, TOL_PARSE_RAD);
     ck_assert_double_eq_tol(o->app_dec, 77.3468410 * DEG, TOL_PARSE_RAD);
     ck_assert_double_eq_tol(o->enc_dec, 77.3475476 * DEG, TOL_PARSE_RAD);
     ck_assert_int_eq(o->pier, PMRUN_PIER_UNKNOWN);
@@ -289,7 +292,7 @@ START_TEST(test_pmrun_read_tpoint_altaz)
     o = pmrun_get(run, 1); /* east stays east */
     ck_assert_double_eq_tol(o->app_ha, 90.0 * DEG, TOL_PARSE_RAD);
     ck_assert_double_eq_tol(o->enc_ha, 89.9 * DEG, TOL_PARSE_RAD);
-    o = pmrun_get(run, 2); /* south: apparent normalised to [0, 2pi), encoder as given */
+    o = pmrun_get(run, 2); /* south: apparent in [0, 2pi), encoder in (-pi, pi] */
     ck_assert_double_eq_tol(o->app_ha, 180.0 * DEG, TOL_PARSE_RAD);
     ck_assert_double_eq_tol(o->enc_ha, -179.9 * DEG, TOL_PARSE_RAD);
     /* two extra readings: aux1, aux2 */
@@ -725,9 +728,20 @@ START_TEST(test_pmrun_read_catalogue_dec_beyond_90)
 }
 END_TEST
 
+/* A raw Dec beyond 180 deg (a controller writing 0..360) is the same
+** reading as 360 deg less: +180 30 00 is -179 30 00, beyond the pole. */
 START_TEST(test_pmrun_read_raw_dec_beyond_180)
 {
-    expect_error("bad_raw_dec.dat", 4, "raw Dec +180 30 00.000 is beyond +-180 deg");
+    pmrun *run = read_ok("tpoint_raw_dec_360.dat", NULL);
+    const pmrun_obs *o = pmrun_get(run, 0);
+    ck_assert_uint_eq(pmrun_count(run), 2);
+    ck_assert(o->enc_dec == -(179 + 30 / 60.0) * DEG);
+    ck_assert_double_eq_tol(o->enc_raw[1], (180 + 30 / 60.0) * DEG, TOL_PARSE_RAD);
+    ck_assert_int_eq(o->pier, PMRUN_PIER_WEST);
+    /* raw RA 25 h (line 5) is 1 h (line 6): the same encoder HA */
+    ck_assert(pmrun_get(run, 1)->enc_ha == o->enc_ha);
+    ck_assert(pmrun_get(run, 1)->enc_dec == o->enc_dec);
+    pmrun_free(run);
 }
 END_TEST
 
@@ -749,9 +763,17 @@ START_TEST(test_pmrun_read_altaz_elevation_beyond_90_tpoint)
 }
 END_TEST
 
+/* An alt-az encoder elevation is modular too: 95 deg is over the zenith
+** (the core's far side), 370 deg is 10 deg; the observed one is not. */
 START_TEST(test_pmrun_read_altaz_elevation_beyond_90_named)
 {
-    expect_error("bad_named_altaz_el.dat", 3, "field 2 (delta) '95.0': elevation beyond");
+    pmrun *run = read_ok("named_altaz_el_modular.dat", NULL);
+    ck_assert_uint_eq(pmrun_count(run), 2);
+    ck_assert_double_eq_tol(pmrun_get(run, 0)->enc_dec, 95.0 * DEG, TOL_PARSE_RAD);
+    ck_assert(pmrun_get(run, 1)->enc_dec == 10.0 * DEG);
+    ck_assert(pmrun_get(run, 1)->enc_ha == -170.0 * DEG);
+    ck_assert_int_eq(pmrun_get(run, 0)->pier, PMRUN_PIER_UNKNOWN);
+    pmrun_free(run);
 }
 END_TEST
 

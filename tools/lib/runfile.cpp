@@ -17,6 +17,23 @@ namespace pmrun_detail {
 
 double nan() { return std::numeric_limits<double>::quiet_NaN(); }
 
+double reduce_deg(double v)
+{
+    double r = std::fmod(v, 360.0);   // exact, |r| < 360, sign of v
+    if (r > 180.0)
+        r -= 360.0;                    // exact: r in (180, 360)
+    else if (r <= -180.0)
+        r += 360.0;                    // exact: r in (-360, -180]
+    return r;
+}
+
+double reduce_deg_positive(double v)
+{
+    double r = std::fmod(v, 360.0);
+    if (r < 0) r += 360.0;             // rounds for r in (-180, 0)
+    return r < 360.0 ? r : 0.0;        // -1e-20 + 360 rounds to 360
+}
+
 // ---------------------------------------------------------------- messages
 
 std::string vformat(const char *fmt, va_list ap)
@@ -446,7 +463,7 @@ bool check_conventions(Context &ctx)
     for (size_t i = 0; i < obs.size(); ++i) {
         const pmrun_obs &o = obs[i];
         double a1 = o.enc_ha, a2 = o.enc_dec;
-        if (!altaz && std::fabs(a2) > half) {
+        if (std::fabs(a2) > half) {   // beyond the pole / over the zenith
             a1 += kPi;
             a2 = (a2 > 0 ? kPi : -kPi) - a2;
         }

@@ -87,15 +87,14 @@ enum pmrun_pier_id {
 **  north through east (the ERFA convention: N = 0, E = pi/2), whatever the
 **  file used.
 **
-**     enc_ha    double   encoder axis 1 (radians); TPOINT equatorial:
-**                        LST - raw RA in (-pi, pi]; otherwise as given,
-**                        never wrapped
-**     enc_dec   double   encoder axis 2 (radians), as given: a declination
-**                        beyond +-pi/2 means the telescope is beyond the
-**                        pole and is kept so
-**     app_ha    double   apparent (observed) axis 1 of the star (radians);
-**                        computed values are normalised: HA to (-pi, pi],
-**                        azimuth to [0, 2pi); four-column/named: as given
+**     enc_ha    double   encoder axis 1 (radians), reduced into (-pi, pi]
+**                        (TPOINT equatorial: LST - raw RA)
+**     enc_dec   double   encoder axis 2 (radians), reduced into (-pi, pi]:
+**                        a declination beyond +-pi/2 means the telescope
+**                        is beyond the pole (a flipped German mount's
+**                        194.17 deg and -165.83 deg are the same reading)
+**     app_ha    double   apparent (observed) axis 1 of the star (radians):
+**                        HA in (-pi, pi], azimuth in [0, 2pi)
 **     app_dec   double   apparent (observed) axis 2 of the star (radians)
 **     pier      int      PMRUN_PIER_EAST (+1), _WEST (-1), _UNKNOWN (0):
 **                        from the pier column if there is one, else for an
@@ -111,6 +110,14 @@ enum pmrun_pier_id {
 **     line      int      1-based line number in the file
 **     aux       double[] auxiliary columns in the order of pmrun_aux_name,
 **                        NaN when absent
+**     enc_raw   double[2] the encoder axes as the file wrote them, before
+**                        the reduction (radians; the turn of a cable wrap,
+**                        a controller's 0..360 deg writing)
+**
+**  Encoder angles are modular: the readers accept any finite value and
+**  reduce it exactly (in degrees, before the conversion to radians), so a
+**  run written with encoder angles in 0..360 deg and the same run in
+**  -180..180 deg read the same (docs/formats.md, "Ranges").
 */
 typedef struct pmrun_obs {
     double enc_ha, enc_dec;
@@ -120,6 +127,7 @@ typedef struct pmrun_obs {
     int dir;
     int line;
     double aux[PMRUN_MAX_AUX];
+    double enc_raw[2];
 } pmrun_obs;
 
 /*

@@ -17,9 +17,6 @@ struct Column {
     int aux = -1;       // index into aux[] for kAux
 };
 
-// Largest |axis 1| accepted (degrees): room for cable wraps, not garbage.
-constexpr double kMaxAxis1Deg = 720.0;
-
 bool known_column(const std::string &lname, Col &kind)
 {
     static const struct {
@@ -262,22 +259,17 @@ private:
         bool altaz = mount_ == PMRUN_MOUNT_ALTAZ;
         switch (c.kind) {
         case Col::kTau:
+            // Encoder angles are modular: any finite value, reduced exactly
+            // (the file's own value kept in enc_raw).
+            o.enc_raw[0] = v * kDeg;
+            o.enc_ha = reduce_deg(v) * kDeg;
+            return true;
         case Col::kT:
-            if (std::fabs(v) > kMaxAxis1Deg) {
-                why = format("beyond +-%g deg, expected an %s in degrees", kMaxAxis1Deg,
-                             altaz ? "azimuth" : "hour angle");
-                return false;
-            }
-            (c.kind == Col::kTau ? o.enc_ha : o.app_ha) = v * kDeg;
+            o.app_ha = (altaz ? reduce_deg_positive(v) : reduce_deg(v)) * kDeg;
             return true;
         case Col::kDelta:
-            if (altaz ? std::fabs(v) > 90 : std::fabs(v) > 180) {
-                why = altaz ? "elevation beyond +-90 deg, expected -90..+90"
-                            : "declination beyond +-180 deg, expected -180..+180 (beyond +-90: "
-                              "over the pole)";
-                return false;
-            }
-            o.enc_dec = v * kDeg;
+            o.enc_raw[1] = v * kDeg;
+            o.enc_dec = reduce_deg(v) * kDeg;
             return true;
         case Col::kD:
             if (std::fabs(v) > 90) {

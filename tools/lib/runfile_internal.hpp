@@ -33,6 +33,15 @@ constexpr double kHour = kPi / 12.0;
 
 double nan();
 
+// Encoder angles are modular (docs/formats.md, "Ranges"): an angle in
+// degrees reduced into (-180, 180] exactly.  fmod is exact, and so is the
+// one step of 360 after it (the operands are within a factor of two:
+// Sterbenz), so two writings of one angle (194.16885990 and -165.83114010)
+// give the same double to the rounding of their decimal text.
+double reduce_deg(double v);
+// The same into [0, 360) (azimuths).
+double reduce_deg_positive(double v);
+
 // Reading context: file name, options, messages and the run being built.
 class Context {
 public:

@@ -13,7 +13,6 @@ namespace pmrun_detail {
 namespace {
 
 // Largest |azimuth| accepted (degrees): room for cable wraps, not garbage.
-constexpr double kMaxAzDeg = 720.0;
 // Mean solar day in sidereal days' units: sidereal hours per solar hour.
 constexpr double kSiderealPerSolar = 1.00273790935;
 
@@ -43,7 +42,8 @@ bool whole(double v) { return v == std::floor(v); }
 // A record of an equatorial file before the reduction.
 struct EqRecord {
     int line;
-    double ra, dec, raw_ra, raw_dec, lst;   // radians
+    double ra, dec, raw_ra, raw_dec, lst;   // radians (raw: reduced)
+    double raw_ra_file, raw_dec_file;       // raw, as written (radians)
     double aux[PMRUN_MAX_AUX];
 };
 
@@ -419,19 +419,22 @@ private:
             if (!parse_number(tok[i], v[i], w))
                 return ctx_.bad_record(n, format("field %zu (%s) '%s': %s (degrees)", i + 1,
                                                  kAzFields[i], excerpt(tok[i]).c_str(), w.c_str()));
-            bool el = (i % 2) == 1;
-            if (el ? std::fabs(v[i]) > 90 : std::fabs(v[i]) > kMaxAzDeg)
-                return ctx_.bad_record(
-                    n, format("field %zu (%s) '%s': %s", i + 1, kAzFields[i], excerpt(tok[i]).c_str(),
-                              el ? "elevation beyond +-90 deg, expected -90..+90"
-                                 : "azimuth beyond +-720 deg, expected degrees"));
+            // the observed elevation is a place on the sky; the other three
+            // are angles on a circle (the raw ones modular encoder readings)
+            if (i == 1 && std::fabs(v[i]) > 90)
+                return ctx_.bad_record(n, format("field 2 (%s) '%s': elevation beyond +-90 deg, "
+                                                 "expected -90..+90",
+                                                 kAzFields[i], excerpt(tok[i]).c_str()));
         }
         pmrun_obs o = blank(n, aux);
-        // TPOINT azimuth is from south through east: A_NE = 180 deg - A_SE.
-        o.app_ha = eraAnp((180.0 - v[0]) * kDeg);
+        // TPOINT azimuth is from south through east: A_NE = 180 deg - A_SE
+        // (of the exactly reduced raw azimuth, so both writings agree).
+        o.app_ha = reduce_deg_positive(180.0 - reduce_deg(v[0])) * kDeg;
         o.app_dec = v[1] * kDeg;
-        o.enc_ha = (180.0 - v[2]) * kDeg;
-        o.enc_dec = v[3] * kDeg;
+        o.enc_ha = reduce_deg(180.0 - reduce_deg(v[2])) * kDeg;
+        o.enc_dec = reduce_deg(v[3]) * kDeg;
+        o.enc_raw[0] = (180.0 - v[2]) * kDeg;
+        o.enc_raw[1] = v[3] * kDeg;
         ctx_.run()->obs.push_back(o);
         return true;
     }
@@ -444,12 +447,12 @@ private:
         std::string why;
         double ra, dec, raw_ra, raw_dec, lst;
         if (!sexa(tok, 0, 3, false, kEqFields, ra, why) || !sexa(tok, 3, 3, true, kEqFields, dec, why) ||
-            !sexa(tok, 6, 3, false, kEqFields, raw_ra, why) ||
+            !sexa(tok, 6, 3, true, kEqFields, raw_ra, why) ||
             !sexa(tok, 9, 3, true, kEqFields, raw_dec, why) ||
             !sexa(tok, 12, 2, false, kEqFields, lst, why))
             return ctx_.bad_record(n, why);
-        if (ra >= 24 || raw_ra >= 24 || lst >= 24) {
-            int f = ra >= 24 ? 1 : raw_ra >= 24 ? 7 : 13;
+        if (ra >= 24 || lst >= 24) {
+            int f = ra >= 24 ? 1 : 13;
             return ctx_.bad_record(n, format("field %d (%s) '%s': out of range, expected 0 <= hours < 24",
                                              f, kEqFields[f - 1], tok[static_cast<size_t>(f - 1)].c_str()));
         }
@@ -457,10 +460,15 @@ private:
             return ctx_.bad_record(n, format("catalogue Dec %s %s %s is beyond +-90 deg, expected a J2000 "
                                              "declination within -90..+90",
                                              tok[3].c_str(), tok[4].c_str(), tok[5].c_str()));
-        if (std::fabs(raw_dec) > 180)
-            return ctx_.bad_record(n, format("raw Dec %s %s %s is beyond +-180 deg, expected -180..+180 "
-                                             "(beyond +-90: the telescope is beyond the pole)",
-                                             tok[9].c_str(), tok[10].c_str(), tok[11].c_str()));
+        // The raw (encoder) RA and Dec are modular: any finite value, the
+        // file's own kept, reduced exactly (hours into [0, 24) by fmod and
+        // one exact step; degrees into (-180, 180]).
+        r.raw_ra_file = raw_ra * kHour;
+        r.raw_dec_file = raw_dec * kDeg;
+        raw_ra = std::fmod(raw_ra, 24.0);
+        if (raw_ra < 0) raw_ra += 24.0;
+        if (raw_ra >= 24.0) raw_ra = 0.0;
+        raw_dec = reduce_deg(raw_dec);
         r.ra = ra * kHour;
         r.dec = dec * kDeg;
         r.raw_ra = raw_ra * kHour;
@@ -530,6 +538,8 @@ private:
                 return ctx_.fail(r.line, "%s", why.c_str());
             o.enc_ha = eraAnpm(r.lst - r.raw_ra);
             o.enc_dec = r.raw_dec;
+            o.enc_raw[0] = r.lst - r.raw_ra_file;
+            o.enc_raw[1] = r.raw_dec_file;
             o.pier = std::fabs(r.raw_dec) > kPi / 2 ? PMRUN_PIER_WEST : PMRUN_PIER_EAST;
             o.time_h = utc[i];
             double az, el;
