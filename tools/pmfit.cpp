@@ -663,6 +663,20 @@ void write_explain_plots(const std::string &dir, const Run &run, const Explanati
     }
 }
 
+// The --robust preface of explain's text report.
+void print_robust_explained(const RobustFit &rf, const Run &full, const Run &run)
+{
+    std::string lines;
+    for (int i : rf.outliers)
+        lines += (lines.empty() ? " (line" + std::string(rf.outliers.size() > 1 ? "s " : " ")
+                                : std::string(", ")) +
+                 std::to_string(full.obs[i].line);
+    std::printf("robust: %zu of %zu observations rejected by a robust fit of the baseline%s%s;\n"
+                "  explained below: the %zu kept (robust sigma %.3f\", clip K = %.2f)\n\n",
+                rf.outliers.size(), full.obs.size(), lines.c_str(), lines.empty() ? "" : ")",
+                run.obs.size(), rf.sigma_robust * RAD2AS, rf.clip);
+}
+
 // pmfit explain: report, JSON, plots.
 int cmd_explain(const Options &o, const Run &full)
 {
@@ -695,125 +709,17 @@ int cmd_explain(const Options &o, const Run &full)
     }
     const Run &run = o.robust ? clean : full;
     Explanation ex = explain(run, eo);
-    auto num = [](double v) {
-        char b[40];
-        std::snprintf(b, sizeof b, std::isfinite(v) ? "%.6g" : "null", v);
-        return std::string(b);
-    };
     if (o.json) {
-        std::string j = "{\"n_obs\": " + std::to_string(run.obs.size()) +
-                        (o.robust ? ", " + robust_json(rf, full.obs) : std::string()) +
-                        ", \"baseline\": {\"order\": " + std::to_string(o.order) +
-                        ", \"sigma_arcsec\": " + num(ex.base_sigma_arcsec) +
-                        ", \"cv_rms_arcsec\": " + num(ex.base_cv_rms_arcsec) +
-                        ", \"n_params\": " + std::to_string(ex.base_n_params) + "}, \"located\": [";
-        for (size_t i = 0; i < ex.located.size() && i < 8; i++)
-            j += std::string(i ? ", " : "") + "{\"what\": \"" + json_escape(ex.located[i].what) +
-                 "\", \"value\": " + num(ex.located[i].rms_arcsec) + ", \"ratio\": " +
-                 num(ex.located[i].ratio) + ", \"p\": " + num(ex.located[i].p) + "}";
-        j += "], \"periodograms\": [";
-        for (size_t i = 0; i < ex.periodograms.size(); i++)
-            j += std::string(i ? ", " : "") + "{\"axis\": \"" + ex.periodograms[i].axis +
-                 "\", \"peak_cycles_per_rev\": " + num(ex.periodograms[i].peak_g) +
-                 ", \"peak_power\": " + num(ex.periodograms[i].peak_power) +
-                 ", \"threshold\": " + num(ex.periodograms[i].threshold) + "}";
-        j += "], \"findings\": [";
-        for (size_t i = 0; i < ex.findings.size(); i++) {
-            const Finding &f = ex.findings[i];
-            j += std::string(i ? ", " : "") + "{\"effect\": \"" + f.effect + "\"";
-            if (f.effect == "ha_periodic" || f.effect == "dec_periodic")
-                j += ", \"cycles_per_rev\": " + num(f.cycles_per_rev) + ", \"phase_deg\": " +
-                     num(f.phase_deg);
-            j += ", \"amplitude_arcsec\": " + num(f.amplitude_arcsec) +
-                 ", \"amplitude_error_arcsec\": " + num(f.amplitude_err_arcsec) +
-                 ", \"false_alarm_probability\": " + num(f.false_alarm_probability) +
-                 ", \"log10_false_alarm_probability\": " + num(f.log10_p) +
-                 ", \"sigma_after_arcsec\": " + num(f.sigma_after_arcsec) +
-                 ", \"cv_rms_after_arcsec\": " + num(f.cv_rms_after_arcsec) +
-                 ", \"n_params_after\": " + std::to_string(f.n_params_after) + ", \"terms\": [";
-            for (size_t k = 0; k < f.adds.size(); k++)
-                j += std::string(k ? ", " : "") + "\"" + json_escape(f.adds[k]) + "\"";
-            j += "]";
-            if (!f.lines.empty()) {
-                j += ", \"lines\": [";
-                for (size_t k = 0; k < f.lines.size(); k++)
-                    j += std::string(k ? ", " : "") + std::to_string(f.lines[k]);
-                j += "]";
-            }
-            j += ", \"text\": \"" + json_escape(f.text) + "\", \"where\": \"" +
-                 json_escape(f.where) + "\"}";
-        }
-        j += "], \"final\": {\"sigma_arcsec\": " + num(ex.final_sigma_arcsec) +
-             ", \"cv_rms_arcsec\": " + num(ex.final_cv_rms_arcsec) +
-             ", \"n_params\": " + std::to_string(ex.final_n_params) + "}}";
-        std::printf("%s\n", j.c_str());
+        std::printf("{\"n_obs\": %zu%s, %s}\n", run.obs.size(),
+                    o.robust ? (", " + robust_json(rf, full.obs)).c_str() : "",
+                    explain_json(run, ex, o.order).c_str());
     } else {
         std::printf("pmfit explain %s: %s mount, %zu observations\n\n", run.path.c_str(),
                     run.mount == PM_MOUNT_ALTAZ ? "alt-az" : "equatorial", run.obs.size());
-        if (o.robust) {
-            std::string lines;
-            for (int i : rf.outliers)
-                lines += (lines.empty() ? " (line" + std::string(rf.outliers.size() > 1 ? "s " : " ")
-                                        : std::string(", ")) +
-                         std::to_string(full.obs[i].line);
-            std::printf("robust: %zu of %zu observations rejected by a robust fit of the "
-                        "baseline%s%s;\n  explained below: the %zu kept (robust sigma %.3f\", "
-                        "clip K = %.2f)\n\n",
-                        rf.outliers.size(), full.obs.size(), lines.c_str(),
-                        lines.empty() ? "" : ")", run.obs.size(), rf.sigma_robust * RAD2AS,
-                        rf.clip);
-        }
-        std::printf("baseline: order %d%s, P = %d, unbiased sigma %.3f\", cross-validated RMS "
-                    "%.3f\"\n",
-                    o.order, o.adds.empty() ? "" : " + added terms", ex.base_n_params,
-                    ex.base_sigma_arcsec, ex.base_cv_rms_arcsec);
-        std::printf("\nwhere the baseline residuals are too large (p: chance of so much, "
-                    "uncorrected):\n");
-        int shown = 0;
-        for (const Located &l : ex.located) {
-            if (shown >= 6 || l.p > 0.05)
-                break;
-            if (l.what.find(" vs ") != std::string::npos)
-                std::printf("  %-44s correlation %+.2f (|t| = %.1f), p = %.2g\n", l.what.c_str(),
-                            l.rms_arcsec, l.ratio, l.p);
-            else
-                std::printf("  %-44s RMS %.2f\" (%.2f x typical), p = %.2g\n", l.what.c_str(),
-                            l.rms_arcsec, l.ratio, l.p);
-            shown++;
-        }
-        if (!shown)
-            std::printf("  nowhere in particular (no group or variable at p < 0.05)\n");
-        for (const Periodogram &pg : ex.periodograms)
-            std::printf("  periodogram of the %s axis: highest peak at G = %.6g cycles/rev%s, power "
-                        "%.1f (false-alarm %g level: %.1f)\n",
-                        pg.axis.c_str(), pg.peak_g,
-                        (pg.axis == "ha" ? o.gears_ha : o.gears_dec).empty()
-                            ? "" : " of the --gear periods",
-                        pg.peak_power, o.alpha, pg.threshold);
-        std::printf("\nfindings:\n");
-        if (ex.findings.empty())
-            std::printf("  none: nothing significant is left out (false-alarm probability "
-                        "below %g and a better cross-validated RMS were required)\n",
-                        o.alpha);
-        for (size_t i = 0; i < ex.findings.size(); i++) {
-            const Finding &f = ex.findings[i];
-            std::printf("  %zu. %s: %s\n     where: %s\n     false-alarm probability %.2g "
-                        "(10^%.1f); with it sigma %.3f\", CV RMS %.3f\", P = %d\n",
-                        i + 1, f.effect.c_str(), f.text.c_str(), f.where.c_str(),
-                        f.false_alarm_probability, f.log10_p, f.sigma_after_arcsec,
-                        f.cv_rms_after_arcsec, f.n_params_after);
-        }
-        std::printf("\n  %-22s %5s %10s %10s\n", "step", "P", "sigma(\")", "CV RMS(\")");
-        std::printf("  %-22s %5d %10.3f %10.3f\n", "baseline", ex.base_n_params,
-                    ex.base_sigma_arcsec, ex.base_cv_rms_arcsec);
-        for (const Finding &f : ex.findings)
-            std::printf("  %-22s %5d %10.3f %10.3f\n", ("+ " + f.effect).c_str(), f.n_params_after,
-                        f.sigma_after_arcsec, f.cv_rms_after_arcsec);
-        std::printf("\n  pmfit fit %s --order %d", run.path.c_str(), ex.final_order);
-        for (const std::string &a : ex.final_adds)
-            std::printf(a.find('\'') == std::string::npos ? " --add '%s'" : " --add \"%s\"",
-                        a.c_str());
-        std::printf("   # fits the explained model\n");
+        if (o.robust)
+            print_robust_explained(rf, full, run);
+        print_explain_text(run, ex, o.order, !o.adds.empty(), o.alpha, !o.gears_ha.empty(),
+                           !o.gears_dec.empty());
     }
     if (!o.plots.empty())
         write_explain_plots(o.plots, run, ex);

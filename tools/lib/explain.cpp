@@ -1,6 +1,10 @@
-// explain.cpp - find the physics a pointing model left out (host side).
+// explain.cpp - find the physics a pointing model left out (host side): the
+// pipeline and its stages locate, candidates, select (singles, pairs,
+// alternatives); describe is in explain_describe.cpp, interpret in
+// explain_interpret.cpp, the report in explain_report.cpp.
 #include "explain.hpp"
 #include "explain.h"
+#include "explain_internal.hpp"
 #include "hostutil.hpp"
 
 #include <algorithm>
@@ -13,21 +17,8 @@
 #include <stdexcept>
 
 namespace pmhost {
+namespace xdetail {
 
-namespace {
-
-const double LN10 = 2.302585092994046;
-
-struct Fit {
-    bool ok = false;
-    FitOut f;
-    double chi2 = 0;
-    int P = 0;
-    long N = 0;
-};
-
-// Fit (order, adds) to the observations `use`.  Not applicable (a needed
-// input missing, a singular term) gives ok = false.
 Fit fit_spec(const Run &run, const std::vector<int> &use, int order,
              const std::vector<std::string> &adds)
 {
@@ -51,17 +42,13 @@ Fit fit_spec(const Run &run, const std::vector<int> &use, int order,
     return r;
 }
 
-double arcsec(double rad) { return rad * RAD2AS; }
+} // namespace xdetail
 
-double elevation_of(const Run &run, const Obs &o)
-{
-    if (run.mount == PM_MOUNT_ALTAZ)
-        return o.ad;
-    if (std::isnan(run.latitude))
-        return NAN;
-    double l = run.latitude;
-    return std::asin(std::sin(l) * std::sin(o.ad) + std::cos(l) * std::cos(o.ad) * std::cos(o.ah));
-}
+using namespace xdetail;
+
+namespace {
+
+// ------------------------------------------------------------ stage: locate
 
 // Residuals (transported frame) of a fitted model at the observations.
 void frame_residuals(const Run &run, const FitOut &f, std::vector<double> *r0,
@@ -103,11 +90,39 @@ double period_power(const Run &run, const std::vector<int> &idx, const std::vect
     return (syy * bx * bx - 2 * sxy * bx * by + sxx * by * by) / det;
 }
 
+// The three highest integer peaks refined to non-integer G; the nearest
+// integer kept (a worm has whole teeth) unless the data reject it: its
+// chi^2 exceeds the best G's by more than 3.84 times the noise variance
+// left once the sinusoid is removed (chi^2 with one degree of freedom).
+void refine_peak(const Run &run, const FitOut &f, const std::vector<double> &r, int comp,
+                 double sigma2, Periodogram &pg)
+{
+    std::vector<size_t> order(pg.g.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(),
+              [&](size_t a, size_t b) { return pg.power[a] > pg.power[b]; });
+    for (size_t k = 0; k < order.size() && k < 3; k++) {
+        double g0 = pg.g[order[k]];
+        for (double G = g0 - 1; G <= g0 + 1; G += 0.02) {
+            double p = period_power(run, f.idx, r, comp, G) / sigma2;
+            if (p > pg.peak_power) {
+                pg.peak_power = p;
+                pg.peak_g = G;
+            }
+        }
+    }
+    double gi = std::round(pg.peak_g);
+    double red_peak = pg.peak_power * sigma2;
+    double red_int = period_power(run, f.idx, r, comp, gi);
+    long dof = 2 * f.res.n_obs - f.res.n_par;
+    double s2_after = (f.res.chi2 - red_peak) / (double)std::max(1L, dof - 2);
+    if (std::fabs(pg.peak_g - gi) < 0.5 && s2_after > 0 && (red_peak - red_int) / s2_after <= 3.84)
+        pg.peak_g = gi;
+}
+
 Periodogram periodogram(const Run &run, const FitOut &f, int comp, const ExplainOptions &opt,
                         double sigma2)
 {
-    double chi2 = f.res.chi2;
-    long dof = 2 * f.res.n_obs - f.res.n_par;
     Periodogram pg;
     pg.axis = comp == 0 ? "ha" : "dec";
     std::vector<double> r0, r1;
@@ -128,35 +143,10 @@ Periodogram periodogram(const Run &run, const FitOut &f, int comp, const Explain
             }
         }
         pg.trials = (double)gears.size();
-        pg.threshold = -2 * std::log(opt.alpha / pg.trials);
-        return pg;
+    } else {
+        refine_peak(run, f, r, comp, sigma2, pg);
+        pg.trials = (double)pg.g.size();
     }
-    // refine the three highest integer peaks to non-integer G
-    std::vector<size_t> order(pg.g.size());
-    std::iota(order.begin(), order.end(), 0);
-    std::sort(order.begin(), order.end(),
-              [&](size_t a, size_t b) { return pg.power[a] > pg.power[b]; });
-    for (size_t k = 0; k < order.size() && k < 3; k++) {
-        double g0 = pg.g[order[k]];
-        for (double G = g0 - 1; G <= g0 + 1; G += 0.02) {
-            double p = period_power(run, f.idx, r, comp, G) / sigma2;
-            if (p > pg.peak_power) {
-                pg.peak_power = p;
-                pg.peak_g = G;
-            }
-        }
-    }
-    // An integer G (a worm with a whole number of teeth) unless the data
-    // reject it: the chi^2 of the nearest integer exceeds the best G's by
-    // more than 3.84 times the noise variance left once the sinusoid is
-    // removed (chi^2 with one degree of freedom at 95%).
-    double gi = std::round(pg.peak_g);
-    double red_peak = pg.peak_power * sigma2;
-    double red_int = period_power(run, f.idx, r, comp, gi);
-    double s2_after = (chi2 - red_peak) / (double)std::max(1L, dof - 2);
-    if (std::fabs(pg.peak_g - gi) < 0.5 && s2_after > 0 && (red_peak - red_int) / s2_after <= 3.84)
-        pg.peak_g = gi;
-    pg.trials = (double)pg.g.size();
     pg.threshold = -2 * std::log(opt.alpha / pg.trials); // chi^2(2) tail at alpha / M
     return pg;
 }
@@ -191,124 +181,31 @@ bool input_usable(const Run &run, const std::vector<int> &use, int which)
     return hi - lo > (which == 0 ? 0.2 : which == 1 ? 0.05 : 1);
 }
 
-bool has(const std::vector<std::string> &v, const std::string &s)
+// The chi^2 excess of a group of residuals (components: 1 axis 1, 2 axis 2,
+// 3 both), with the fit's sigma: Wilson-Hilferty tail.
+void add_group(std::vector<Located> &out, const FitOut &f, double s2, double rms,
+               const std::string &what, const std::vector<size_t> &members, int comps)
 {
-    return std::find(v.begin(), v.end(), s) != v.end();
+    if (members.size() < 3)
+        return;
+    double ss = 0;
+    for (size_t j : members)
+        ss += (comps & 1 ? f.r0[j] * f.r0[j] : 0) + (comps & 2 ? f.r1[j] * f.r1[j] : 0);
+    int per = (comps & 1 ? 1 : 0) + (comps & 2 ? 1 : 0);
+    double grms = std::sqrt(ss / (double)(members.size() * per));
+    double k = (double)(members.size() * per);
+    double z = (std::cbrt(ss / s2 / k) - (1 - 2 / (9 * k))) / std::sqrt(2 / (9 * k));
+    out.push_back({what, arcsec(grms), grms / (rms / std::sqrt(2.0)), 0.5 * std::erfc(z / std::sqrt(2.0))});
 }
 
-// Angular size (radians) of model b minus model a at each observation.
-std::vector<double> model_difference(const Run &run, const std::vector<int> &use,
-                                     const pm_model &a, const pm_model &b)
+void locate_groups(const Run &run, const FitOut &f, double s2, double rms, std::vector<Located> &out)
 {
-    std::vector<double> d;
-    for (int i : use) {
-        const Obs &o = run.obs[i];
-        double t1, d1, t2, d2;
-        if (pm_model_apply(&a, &o.ctx, o.eh, o.ed, &t1, &d1) != PM_OK ||
-            pm_model_apply(&b, &o.ctx, o.eh, o.ed, &t2, &d2) != PM_OK) {
-            d.push_back(0);
-            continue;
-        }
-        double c = std::sin(d1) * std::sin(d2) + std::cos(d1) * std::cos(d2) * std::cos(t1 - t2);
-        double s = std::hypot(std::cos(d2) * std::sin(t2 - t1),
-                              std::cos(d1) * std::sin(d2) -
-                                  std::sin(d1) * std::cos(d2) * std::cos(t2 - t1));
-        d.push_back(std::atan2(s, c));
-    }
-    return d;
-}
-
-// Where a quantity (one value per observation in `use`) is largest: the sky
-// bin (elevation band, hour-angle quarter, pier side) with the largest mean.
-std::string where_largest(const Run &run, const std::vector<int> &use,
-                          const std::vector<double> &v, const char *unit)
-{
-    struct Bin {
-        double sum = 0;
-        int n = 0;
-    };
-    std::map<std::string, Bin> bins;
-    for (size_t j = 0; j < use.size(); j++) {
-        const Obs &o = run.obs[use[j]];
-        double el = elevation_of(run, o);
-        if (std::isfinite(el)) {
-            double e = el * 180 / PI;
-            const char *b = e < 20 ? "elevation below 20 deg"
-                            : e < 35 ? "elevation 20-35 deg"
-                            : e < 50 ? "elevation 35-50 deg"
-                            : e < 65 ? "elevation 50-65 deg" : "elevation above 65 deg";
-            bins[b].sum += v[j];
-            bins[b].n++;
-        }
-        double h = std::remainder(o.ah, 2 * PI) * 180 / PI;
-        const char *hb = run.mount == PM_MOUNT_ALTAZ
-                             ? (h < -90 ? "azimuth 180-270" : h < 0 ? "azimuth 270-360"
-                                : h < 90 ? "azimuth 0-90" : "azimuth 90-180")
-                             : (h < -90 ? "hour angle -12h..-6h" : h < 0 ? "hour angle -6h..0h"
-                                : h < 90 ? "hour angle 0h..6h" : "hour angle 6h..12h");
-        bins[hb].sum += v[j];
-        bins[hb].n++;
-        if (o.pier) {
-            bins[o.pier > 0 ? "pier east (normal side)" : "pier west (beyond the pole)"].sum += v[j];
-            bins[o.pier > 0 ? "pier east (normal side)" : "pier west (beyond the pole)"].n++;
-        }
-    }
-    std::string best, low;
-    double bv = -1, lv = 1e300, all = 0;
-    for (double x : v)
-        all += x;
-    all /= v.empty() ? 1 : (double)v.size();
-    for (const auto &b : bins) {
-        if (b.second.n < 3)
-            continue;
-        double m = b.second.sum / b.second.n;
-        if (m > bv) {
-            bv = m;
-            best = b.first;
-        }
-        if (m < lv) {
-            lv = m;
-            low = b.first;
-        }
-    }
-    char buf[256];
-    std::snprintf(buf, sizeof buf, "largest at %s (mean %.2f%s), smallest at %s (mean %.2f%s); "
-                                   "mean over the run %.2f%s",
-                  best.c_str(), bv, unit, low.c_str(), lv, unit, all, unit);
-    return buf;
-}
-
-std::vector<Located> locate(const Run &run, const FitOut &f, double sigma)
-{
-    std::vector<Located> out;
     size_t n = f.idx.size();
-    if (n < 3)
-        return out;
-    double s2 = sigma * sigma;
-    double all = 0;
-    for (size_t j = 0; j < n; j++)
-        all += f.r0[j] * f.r0[j] + f.r1[j] * f.r1[j];
-    double rms = std::sqrt(all / (double)n);
-    auto add_group = [&](const std::string &what, const std::vector<size_t> &members, int comps) {
-        if (members.size() < 3)
-            return;
-        double ss = 0;
-        for (size_t j : members)
-            ss += (comps & 1 ? f.r0[j] * f.r0[j] : 0) + (comps & 2 ? f.r1[j] * f.r1[j] : 0);
-        int per = (comps & 1 ? 1 : 0) + (comps & 2 ? 1 : 0);
-        double grms = std::sqrt(ss / (double)(members.size() * per));
-        double ref = rms / std::sqrt(2.0);
-        // chi^2 excess of the group (sigma from the fit), Wilson-Hilferty tail
-        double k = (double)(members.size() * per);
-        double x = ss / s2;
-        double z = (std::cbrt(x / k) - (1 - 2 / (9 * k))) / std::sqrt(2 / (9 * k));
-        double p = 0.5 * std::erfc(z / std::sqrt(2.0));
-        out.push_back({what, arcsec(grms), grms / ref, p});
-    };
     std::vector<size_t> alli(n);
     std::iota(alli.begin(), alli.end(), 0);
-    add_group("axis 1 (HA/azimuth direction)", alli, 1);
-    add_group("axis 2 (Dec/elevation direction)", alli, 2);
+    bool az = run.mount == PM_MOUNT_ALTAZ;
+    add_group(out, f, s2, rms, az ? "axis 1 (azimuth direction)" : "axis 1 (HA direction)", alli, 1);
+    add_group(out, f, s2, rms, az ? "axis 2 (elevation direction)" : "axis 2 (Dec direction)", alli, 2);
     std::map<std::string, std::vector<size_t>> groups;
     for (size_t j = 0; j < n; j++) {
         const Obs &o = run.obs[f.idx[j]];
@@ -319,21 +216,29 @@ std::vector<Located> locate(const Run &run, const FitOut &f, double sigma)
                    : e < 65 ? "elevation 35-65 deg" : "elevation above 65 deg"].push_back(j);
         }
         double h = std::remainder(o.ah, 2 * PI) * 180 / PI;
-        if (run.mount == PM_MOUNT_EQUATORIAL) {
+        if (!az) {
             groups[h < -90 ? "hour angle -12h..-6h" : h < 0 ? "hour angle -6h..0h"
                    : h < 90 ? "hour angle 0h..6h" : "hour angle 6h..12h"].push_back(j);
             if (std::fabs(o.ad) > 75 * PI / 180)
                 groups["near the pole (|dec| > 75 deg)"].push_back(j);
+        } else {
+            groups[h < 45 || h >= 315 ? "azimuth north" : h < 135 ? "azimuth east"
+                   : h < 225 ? "azimuth south" : "azimuth west"].push_back(j);
         }
         if (o.pier)
             groups[o.pier > 0 ? "pier east" : "pier west"].push_back(j);
     }
     for (const auto &g : groups)
-        add_group(g.first, g.second, 3);
-    // correlations with the inputs
+        add_group(out, f, s2, rms, g.first, g.second, 3);
+}
+
+// Correlation of each residual component with temperature, time, slew direction.
+void locate_inputs(const Run &run, const FitOut &f, std::vector<Located> &out)
+{
     const char *names[3] = {"temperature", "time", "slew direction"};
+    size_t n = f.idx.size();
+    std::vector<int> use(f.idx.begin(), f.idx.end());
     for (int w = 0; w < 3; w++) {
-        std::vector<int> use(f.idx.begin(), f.idx.end());
         if (!input_usable(run, use, w))
             continue;
         for (int comp = 0; comp < 2; comp++) {
@@ -355,41 +260,412 @@ std::vector<Located> locate(const Run &run, const FitOut &f, double sigma)
                 continue;
             double r = cov / std::sqrt(vx * vy);
             double t = r * std::sqrt((dn - 2) / std::max(1e-12, 1 - r * r));
-            double p = std::erfc(std::fabs(t) / std::sqrt(2.0));
             out.push_back({std::string(names[w]) + " vs axis " + (comp ? "2" : "1") + " residual", r,
-                           std::fabs(t), p});
+                           std::fabs(t), std::erfc(std::fabs(t) / std::sqrt(2.0))});
         }
     }
+}
+
+std::vector<Located> locate(const Run &run, const FitOut &f, double sigma)
+{
+    std::vector<Located> out;
+    size_t n = f.idx.size();
+    if (n < 3)
+        return out;
+    double all = 0;
+    for (size_t j = 0; j < n; j++)
+        all += f.r0[j] * f.r0[j] + f.r1[j] * f.r1[j];
+    locate_groups(run, f, sigma * sigma, std::sqrt(all / (double)n), out);
+    locate_inputs(run, f, out);
     std::sort(out.begin(), out.end(), [](const Located &a, const Located &b) { return a.p < b.p; });
     return out;
 }
 
-// A term's name with a user input shown by its column name.
-std::string input_name(const Run &run, const pm_model &m, int i)
+// -------------------------------------------------------- stage: candidates
+
+// A candidate adding the families `more` to the current model (none if any
+// is there already).
+void add_candidate(std::vector<Candidate> &cands, const State &st, const std::string &effect,
+                   const std::vector<std::string> &more)
 {
-    std::string n = term_name(m, i);
-    const pm_term &t = m.term[i];
-    if (t.kind == PM_TERM_AUX && t.aux >= PM_AUX_USER &&
-        (size_t)(t.aux - PM_AUX_USER) < run.aux_names.size()) {
-        std::string tag = "aux" + std::to_string(t.aux - PM_AUX_USER);
-        size_t p = n.find(tag);
-        if (p != std::string::npos)
-            n.replace(p, tag.size(), run.aux_names[(size_t)(t.aux - PM_AUX_USER)]);
+    Candidate c;
+    c.effect = effect;
+    c.members = {effect};
+    c.order = st.order;
+    c.adds = st.adds;
+    for (const std::string &a : more) {
+        if (has(st.adds, a))
+            return;
+        c.adds.push_back(a);
+        c.new_adds.push_back(a);
     }
-    return n;
+    cands.push_back(c);
 }
 
-struct Candidate {
-    std::string effect;
-    int order;
-    std::vector<std::string> adds;
-    std::vector<std::string> new_adds; // what this candidate adds
-    double trials = 1;                 // periods scanned
-    double peak_g = 0;
-    std::vector<int> drop;             // outliers: observations to drop
-    Fit fit;
-    double log_fap = 0;
-};
+void periodic_candidates(const Run &run, const State &st, const ExplainOptions &opt,
+                         std::vector<Candidate> &cands)
+{
+    double sg2 = st.cur.f.res.sigma * st.cur.f.res.sigma;
+    for (int comp = 0; comp < 2; comp++) {
+        const char *prefix = comp ? "dec_periodic:" : "ha_periodic:";
+        bool already = false;
+        for (const std::string &a : st.adds)
+            already = already || a.rfind(prefix, 0) == 0;
+        Periodogram pg = periodogram(run, st.cur.f, comp, opt, sg2);
+        if (already || !(pg.peak_g > 0))
+            continue;
+        char spec[64];
+        std::snprintf(spec, sizeof spec, "%s%.6g", prefix, pg.peak_g);
+        add_candidate(cands, st, comp ? "dec_periodic" : "ha_periodic", {spec});
+        cands.back().trials = pg.trials;
+        cands.back().peak_g = pg.peak_g;
+    }
+}
+
+void physical_candidates(const Run &run, const State &st, std::vector<Candidate> &cands)
+{
+    if (run.mount == PM_MOUNT_ALTAZ || !std::isnan(run.latitude)) {
+        add_candidate(cands, st, "refraction", {"refraction"});
+        if (st.order == 0) // cos(el) toward the zenith is an L=1 combination
+            add_candidate(cands, st, "tube_flexure", {"tube_flexure"});
+    }
+    if (run.mount == PM_MOUNT_EQUATORIAL && both_sides(run, st.use))
+        add_candidate(cands, st, "pier_side", {"e'@W", "i@W"});
+    if (input_usable(run, st.use, 0))
+        add_candidate(cands, st, "temperature", {"temperature"});
+    if (input_usable(run, st.use, 1))
+        add_candidate(cands, st, "time_drift", {"time_drift"});
+    // backlash: the last slew direction on axis 1 (HA index) and, when
+    // known, on axis 2 (the derived "dec_dir" input, Dec index)
+    std::vector<std::string> h;
+    if (input_usable(run, st.use, 2))
+        h.push_back("hysteresis");
+    if (has(run.aux_names, "dec_dir"))
+        h.push_back("aux:dec_dir:e'");
+    if (!h.empty())
+        add_candidate(cands, st, "hysteresis", h);
+}
+
+// Outliers: the points beyond the Bonferroni-corrected chi^2(2) tail.
+void outlier_candidate(const State &st, const ExplainOptions &opt, std::vector<Candidate> &cands)
+{
+    Candidate c;
+    c.effect = "outlier";
+    c.members = {"outlier"};
+    c.order = st.order;
+    c.adds = st.adds;
+    const FitOut &f = st.cur.f;
+    double sg2 = f.res.sigma * f.res.sigma, worst = 0, ln_n = std::log((double)f.idx.size());
+    for (size_t j = 0; j < f.idx.size(); j++) {
+        double z2 = (f.r0[j] * f.r0[j] + f.r1[j] * f.r1[j]) / sg2;
+        if (-z2 / 2 + ln_n < std::log(opt.alpha))
+            c.drop.push_back(f.idx[j]);
+        worst = std::max(worst, z2);
+    }
+    c.log_fap = -worst / 2 + ln_n;
+    if (!c.drop.empty())
+        cands.push_back(c);
+}
+
+std::vector<Candidate> candidates(const Run &run, const State &st, const ExplainOptions &opt)
+{
+    std::vector<Candidate> cands;
+    periodic_candidates(run, st, opt, cands);
+    if (st.order < PM_MAX_L) {
+        Candidate c;
+        c.effect = "higher_order";
+        c.members = {"higher_order"};
+        c.order = st.order + 1;
+        c.adds = st.adds;
+        cands.push_back(c);
+    }
+    physical_candidates(run, st, cands);
+    outlier_candidate(st, opt, cands);
+    return cands;
+}
+
+// ------------------------------------------------------------ stage: select
+
+std::vector<int> without(const std::vector<int> &use, const std::vector<int> &drop)
+{
+    std::vector<int> keep;
+    for (int i : use)
+        if (std::find(drop.begin(), drop.end(), i) == drop.end())
+            keep.push_back(i);
+    return keep;
+}
+
+// Fit each candidate; its false-alarm probability is the nested F-test's p
+// times the periods scanned times K, the number of candidates of the step.
+void score(const Run &run, const State &st, std::vector<Candidate> &cands, double K)
+{
+    for (Candidate &c : cands) {
+        if (c.effect == "outlier") {
+            c.fit = fit_spec(run, without(st.use, c.drop), st.order, st.adds);
+            c.log_fap += std::log(K);
+            continue;
+        }
+        c.fit = fit_spec(run, st.use, c.order, c.adds);
+        if (!c.fit.ok || c.fit.P <= st.cur.P) {
+            c.log_fap = 0;
+            continue;
+        }
+        double d1 = c.fit.P - st.cur.P, d2 = (double)(2 * c.fit.N - c.fit.P);
+        double F = ((st.cur.chi2 - c.fit.chi2) / d1) / (c.fit.chi2 / d2);
+        c.log_fap = log_f_tail(F, d1, d2) + std::log(c.trials) + std::log(K);
+    }
+    std::sort(cands.begin(), cands.end(),
+              [](const Candidate &a, const Candidate &b) { return a.log_fap < b.log_fap; });
+}
+
+// The first candidate (in order of evidence) that beats alpha and improves
+// the cross-validated RMS; -1 if none.
+int choose(const Run &run, const State &st, std::vector<Candidate> &cands,
+           const ExplainOptions &opt)
+{
+    for (size_t k = 0; k < cands.size(); k++) {
+        Candidate &c = cands[k];
+        if (!(c.log_fap < std::log(opt.alpha)) || !c.fit.ok)
+            break;
+        bool out = c.effect == "outlier";
+        std::vector<int> nuse = out ? without(st.use, c.drop) : st.use;
+        c.cv = cv_rms(run, nuse, c.order, c.adds, opt.folds, opt.seed);
+        // outliers: the same points predicted by models trained with them
+        double cv_old = out ? cv_rms(run, nuse, st.order, st.adds, opt.folds, opt.seed, c.drop)
+                            : st.cur_cv;
+        if (c.cv < cv_old)
+            return (int)k;
+    }
+    return -1;
+}
+
+// Pairs of the single families (not higher_order, not outliers) where no
+// single one passes.  Each member must earn its place in the pair: its
+// partial F-test, corrected for the periods scanned, below alpha.
+std::vector<Candidate> pairs(const Run &run, const State &st, const std::vector<Candidate> &singles,
+                             const ExplainOptions &opt)
+{
+    std::vector<const Candidate *> ok;
+    for (const Candidate &c : singles)
+        if (c.fit.ok && c.effect != "higher_order" && c.effect != "outlier" && c.fit.P > st.cur.P)
+            ok.push_back(&c);
+    std::vector<Candidate> out;
+    double K = (double)(singles.size() + ok.size() * (ok.size() - 1) / 2);
+    for (size_t a = 0; a < ok.size(); a++)
+        for (size_t b = a + 1; b < ok.size(); b++) {
+            const Candidate &x = *ok[a], &y = *ok[b];
+            Candidate c;
+            c.effect = x.effect + "+" + y.effect;
+            c.members = {x.effect, y.effect};
+            c.member_terms = {x.fit.P - st.cur.P, y.fit.P - st.cur.P};
+            c.member_g = {x.peak_g, y.peak_g};
+            c.order = st.order;
+            c.adds = x.adds;
+            c.new_adds = x.new_adds;
+            for (const std::string &s : y.new_adds) {
+                c.adds.push_back(s);
+                c.new_adds.push_back(s);
+            }
+            c.fit = fit_spec(run, st.use, c.order, c.adds);
+            if (!c.fit.ok)
+                continue;
+            double d2 = (double)(2 * c.fit.N - c.fit.P), s2 = c.fit.chi2 / d2;
+            double d1 = c.fit.P - st.cur.P;
+            double F = ((st.cur.chi2 - c.fit.chi2) / d1) / s2;
+            c.log_fap = log_f_tail(F, d1, d2) + std::log(x.trials) + std::log(y.trials) + std::log(K);
+            // partial tests: each member given the other
+            double fx = ((y.fit.chi2 - c.fit.chi2) / c.member_terms[0]) / s2;
+            double fy = ((x.fit.chi2 - c.fit.chi2) / c.member_terms[1]) / s2;
+            bool both = log_f_tail(fx, c.member_terms[0], d2) + std::log(x.trials) < std::log(opt.alpha) &&
+                        log_f_tail(fy, c.member_terms[1], d2) + std::log(y.trials) < std::log(opt.alpha);
+            if (both)
+                out.push_back(c);
+        }
+    std::sort(out.begin(), out.end(),
+              [](const Candidate &a, const Candidate &b) { return a.log_fap < b.log_fap; });
+    return out;
+}
+
+// -------------------------------------------------------- stage: alternatives
+
+// The observation that would tell two readings apart: physics where it is
+// known, and always where the two fitted models differ most on this run.
+std::string separate_by(const Run &run, const State &st, const Candidate &a, const Candidate &b)
+{
+    auto pair_is = [&](const char *x, const char *y) {
+        return (a.effect == x && b.effect == y) || (a.effect == y && b.effect == x);
+    };
+    auto one_is = [&](const char *x) { return a.effect == x || b.effect == x; };
+    bool elev = one_is("refraction") || one_is("tube_flexure");
+    std::string s;
+    if (pair_is("refraction", "tube_flexure"))
+        s = "points below 20 deg elevation (cot el grows there while cos el levels off)";
+    else if (elev && one_is("higher_order"))
+        s = "low points spread over every azimuth (an elevation effect is the same at all of them)";
+    else if (elev && one_is("temperature"))
+        s = "one star followed at fixed elevation while the temperature changes";
+    else if (pair_is("temperature", "time_drift"))
+        s = "a night whose temperature does not follow the clock, or a second night";
+    else if (one_is("hysteresis"))
+        s = "the same places approached from both directions";
+    else if (one_is("ha_periodic") || one_is("dec_periodic"))
+        s = "a denser sample along the drive's axis, a few points per period";
+    else
+        s = "more points where the two readings differ most";
+    std::vector<double> d = model_difference(run, st.use, a.fit.f.model, b.fit.f.model);
+    std::string bin = largest_bin(run, st.use, d);
+    if (!bin.empty())
+        s += "; on this run they differ most at " + bin;
+    return s;
+}
+
+// Readings whose evidence is close to the chosen one's: Delta BIC below
+// opt.close_delta_bic, with the noise fixed at the chosen fit's sigma,
+// each significant on its own.
+std::vector<Alternative> alternatives(const Run &run, const State &st, const Candidate &c,
+                                      const std::vector<Candidate> &cands, const ExplainOptions &opt)
+{
+    std::vector<Alternative> out;
+    if (c.effect == "outlier" || c.members.size() != 1)
+        return out;
+    double s2 = c.fit.chi2 / (double)(2 * c.fit.N - c.fit.P);
+    double ln2n = std::log((double)(2 * c.fit.N));
+    for (const Candidate &a : cands) {
+        if (&a == &c || a.effect == "outlier" || !a.fit.ok || a.fit.P <= st.cur.P ||
+            !(a.log_fap < std::log(opt.alpha)))
+            continue;
+        double dchi = (a.fit.chi2 - c.fit.chi2) / s2;
+        double dbic = dchi + (a.fit.P - c.fit.P) * ln2n;
+        double log10_lr = dchi / 2 / LN10;
+        // Delta BIC charges the extra parameters; for two readings of as
+        // many parameters it is 2 ln(likelihood ratio): below 6 = LR below 20
+        if (!(dbic < opt.close_delta_bic))
+            continue;
+        Alternative al;
+        al.effect = a.effect;
+        al.log10_fap = a.log_fap / LN10;
+        al.delta_bic = dbic;
+        al.log10_lr = log10_lr;
+        al.separate_by = separate_by(run, st, c, a);
+        out.push_back(al);
+    }
+    return out;
+}
+
+// ------------------------------------------------------------- the pipeline
+
+// The baseline fit, or an exception that says why it failed.
+State baseline(const Run &run, const ExplainOptions &opt)
+{
+    State st;
+    st.use.resize(run.obs.size());
+    std::iota(st.use.begin(), st.use.end(), 0);
+    st.order = opt.order;
+    st.adds = opt.adds;
+    st.cur = fit_spec(run, st.use, st.order, st.adds);
+    if (st.cur.ok) {
+        st.cur_cv = cv_rms(run, st.use, st.order, st.adds, opt.folds, opt.seed);
+        return st;
+    }
+    // let the user see why (singular, too few, diverged): the plain fit
+    FitOut f = do_fit(run.obs, st.use,
+                      build_model(st.order, st.adds, run.obs, run.mount, run.latitude, run.aux_names));
+    std::string why = "status " + std::to_string((int)f.status);
+    if (f.status == PM_ERR_TOO_FEW)
+        why = "too few observations (P = " + std::to_string(f.model.n_terms) +
+              " terms need at least " + std::to_string(f.model.n_terms / 2 + 1) + ", there are " +
+              std::to_string(st.use.size()) + ")";
+    else if (f.status == PM_ERR_SINGULAR && f.bad_term >= 0)
+        why = "term " + term_name(f.model, f.bad_term) + " cannot be determined from these observations";
+    else if (f.status == PM_ERR_DIVERGED)
+        why = "the fit did not converge";
+    throw std::runtime_error(run.path + ": the baseline fit failed: " + why +
+                             "; try pmfit fit for details");
+}
+
+// The findings of one accepted candidate, with their common numbers.
+void record(const Run &run, State &st, const Candidate &c, const std::vector<Candidate> &cands,
+            const ExplainOptions &opt, Explanation &ex)
+{
+    bool out = c.effect == "outlier";
+    std::vector<int> nuse = out ? without(st.use, c.drop) : st.use;
+    std::vector<double> d = model_difference(run, out ? nuse : st.use, st.cur.f.model, c.fit.f.model);
+    for (double &x : d)
+        x = arcsec(x);
+    std::vector<Alternative> alts = alternatives(run, st, c, cands, opt);
+    for (Finding &fd : describe(run, st, c)) {
+        fd.adds = c.new_adds;
+        fd.false_alarm_probability = std::exp(c.log_fap);
+        fd.log10_p = c.log_fap / LN10;
+        fd.sigma_after_arcsec = arcsec(c.fit.f.res.sigma);
+        fd.cv_rms_after_arcsec = arcsec(c.cv);
+        fd.n_params_after = c.fit.P;
+        fd.where = out ? "individual points (see lines)" : where_largest(run, st.use, d, "\"");
+        fd.alternatives = alts;
+        ex.findings.push_back(fd);
+    }
+    st.order = c.order;
+    st.adds = c.adds;
+    st.use = nuse;
+    st.cur = c.fit;
+    st.cur_cv = c.cv;
+}
+
+// One step: the best single family, else (opt.pairs) the best pair.
+bool step(const Run &run, State &st, const ExplainOptions &opt, Explanation &ex)
+{
+    std::vector<Candidate> cands = candidates(run, st, opt);
+    ex.candidates_tried.clear();
+    for (const Candidate &c : cands)
+        ex.candidates_tried.push_back(c.effect);
+    score(run, st, cands, (double)cands.size());
+    int k = choose(run, st, cands, opt);
+    if (k >= 0) {
+        record(run, st, cands[(size_t)k], cands, opt, ex);
+        return true;
+    }
+    if (!opt.pairs)
+        return false;
+    std::vector<Candidate> two = pairs(run, st, cands, opt);
+    k = choose(run, st, two, opt);
+    if (k < 0)
+        return false;
+    record(run, st, two[(size_t)k], two, opt, ex);
+    return true;
+}
+
+// Order 0 plus one physical term against the order-1 baseline: if it
+// predicts as well (cross-validated), the order-1 terms are that one term.
+std::string physical_reading(const Run &run, const Explanation &ex, const ExplainOptions &opt)
+{
+    if (opt.order != 1 || !opt.adds.empty() ||
+        (run.mount != PM_MOUNT_ALTAZ && std::isnan(run.latitude)))
+        return "";
+    std::string best;
+    double best_cv = ex.base_cv_rms_arcsec, best_val = 0, best_err = 0;
+    for (const char *term : {"tube_flexure", "refraction"}) {
+        std::vector<int> use(run.obs.size());
+        std::iota(use.begin(), use.end(), 0);
+        double cv = arcsec(cv_rms(run, use, 0, {term}, opt.folds, opt.seed));
+        Fit f = fit_spec(run, use, 0, {term});
+        if (!f.ok || !(cv <= best_cv))
+            continue;
+        best = term;
+        best_cv = cv;
+        best_val = arcsec(f.f.model.coef[6]);
+        best_err = arcsec(f.f.res.err[6]);
+    }
+    if (best.empty())
+        return "";
+    char buf[512];
+    std::snprintf(buf, sizeof buf,
+                  "order 0 + %s (%.2f\" +- %.2f\") predicts as well as the order-1 baseline "
+                  "(cross-validated RMS %.3f\" vs %.3f\"): for this run the %d extra harmonic "
+                  "terms of order 1 are that one term; fit it with pmfit fit --order 0 --add %s",
+                  best.c_str(), best_val, best_err, best_cv, ex.base_cv_rms_arcsec,
+                  ex.base_n_params - 6, best.c_str());
+    return buf;
+}
 
 } // namespace
 
@@ -425,318 +701,26 @@ double cv_rms(const Run &run, const std::vector<int> &use, int order,
 Explanation explain(const Run &run, const ExplainOptions &opt)
 {
     Explanation ex;
-    std::vector<int> use(run.obs.size());
-    std::iota(use.begin(), use.end(), 0);
-    int order = opt.order;
-    std::vector<std::string> adds = opt.adds;
-    Fit cur = fit_spec(run, use, order, adds);
-    if (!cur.ok) {
-        // let the user see why (singular, too few, diverged): the plain fit
-        FitOut f = do_fit(run.obs, use,
-                          build_model(order, adds, run.obs, run.mount, run.latitude, run.aux_names));
-        std::string why = "status " + std::to_string((int)f.status);
-        if (f.status == PM_ERR_TOO_FEW)
-            why = "too few observations (P = " + std::to_string(f.model.n_terms) +
-                  " terms need at least " + std::to_string(f.model.n_terms / 2 + 1) +
-                  ", there are " + std::to_string(use.size()) + ")";
-        else if (f.status == PM_ERR_SINGULAR && f.bad_term >= 0)
-            why = "term " + term_name(f.model, f.bad_term) +
-                  " cannot be determined from these observations";
-        else if (f.status == PM_ERR_DIVERGED)
-            why = "the fit did not converge";
-        throw std::runtime_error(run.path + ": the baseline fit failed: " + why +
-                                 "; try pmfit fit for details");
+    State st = baseline(run, opt);
+    ex.baseline = st.cur.f;
+    ex.base_sigma_arcsec = arcsec(st.cur.f.res.sigma);
+    ex.base_cv_rms_arcsec = arcsec(st.cur_cv);
+    ex.base_n_params = st.cur.P;
+    ex.located = locate(run, st.cur.f, st.cur.f.res.sigma);
+    double s2 = st.cur.f.res.sigma * st.cur.f.res.sigma;
+    ex.periodograms.push_back(periodogram(run, st.cur.f, 0, opt, s2));
+    ex.periodograms.push_back(periodogram(run, st.cur.f, 1, opt, s2));
+    ex.interpretation = interpret(run, st.cur.f);
+    ex.physical_reading = physical_reading(run, ex, opt);
+    while ((int)ex.findings.size() < opt.max_findings && step(run, st, opt, ex)) {
     }
-    ex.baseline = cur.f;
-    double cur_cv = cv_rms(run, use, order, adds, opt.folds, opt.seed);
-    ex.base_sigma_arcsec = arcsec(cur.f.res.sigma);
-    ex.base_cv_rms_arcsec = arcsec(cur_cv);
-    ex.base_n_params = cur.P;
-    ex.located = locate(run, cur.f, cur.f.res.sigma);
-    double s2 = cur.f.res.sigma * cur.f.res.sigma;
-    ex.periodograms.push_back(periodogram(run, cur.f, 0, opt, s2));
-    ex.periodograms.push_back(periodogram(run, cur.f, 1, opt, s2));
-
-    for (int step = 0; step < opt.max_findings; step++) {
-        std::vector<Candidate> cands;
-        auto with = [&](const std::string &effect, const std::vector<std::string> &more) {
-            Candidate c;
-            c.effect = effect;
-            c.order = order;
-            c.adds = adds;
-            for (const std::string &a : more) {
-                if (has(adds, a))
-                    return;
-                c.adds.push_back(a);
-                c.new_adds.push_back(a);
-            }
-            cands.push_back(c);
-        };
-        double sg2 = cur.f.res.sigma * cur.f.res.sigma;
-        for (int comp = 0; comp < 2; comp++) {
-            Periodogram pg = periodogram(run, cur.f, comp, opt, sg2);
-            char spec[64];
-            std::snprintf(spec, sizeof spec, "%s_periodic:%.6g", comp ? "dec" : "ha", pg.peak_g);
-            bool already = false;
-            for (const std::string &a : adds)
-                already = already || a.rfind(comp ? "dec_periodic:" : "ha_periodic:", 0) == 0;
-            if (!already && pg.peak_g > 0) {
-                with(comp ? "dec_periodic" : "ha_periodic", {spec});
-                cands.back().trials = pg.trials;
-                cands.back().peak_g = pg.peak_g;
-            }
-        }
-        if (order < PM_MAX_L) {
-            Candidate c;
-            c.effect = "higher_order";
-            c.order = order + 1;
-            c.adds = adds;
-            cands.push_back(c);
-        }
-        if (run.mount == PM_MOUNT_ALTAZ || !std::isnan(run.latitude)) {
-            with("refraction", {"refraction"});
-            if (order == 0) // cos(el) toward the zenith is an L=1 combination
-                with("tube_flexure", {"tube_flexure"});
-        }
-        if (run.mount == PM_MOUNT_EQUATORIAL && both_sides(run, use))
-            with("pier_side", {"e'@W", "i@W"});
-        if (input_usable(run, use, 0))
-            with("temperature", {"temperature"});
-        if (input_usable(run, use, 1))
-            with("time_drift", {"time_drift"});
-        {
-            // backlash: the last slew direction on axis 1 (HA index) and, when
-            // known, on axis 2 (the derived "dec_dir" input, Dec index)
-            std::vector<std::string> h;
-            if (input_usable(run, use, 2))
-                h.push_back("hysteresis");
-            if (has(run.aux_names, "dec_dir"))
-                h.push_back("aux:dec_dir:e'");
-            if (!h.empty())
-                with("hysteresis", h);
-        }
-        // outliers: points beyond the Bonferroni-corrected chi^2(2) tail
-        {
-            Candidate c;
-            c.effect = "outlier";
-            c.order = order;
-            c.adds = adds;
-            double worst = 0;
-            for (size_t j = 0; j < cur.f.idx.size(); j++) {
-                double z2 = (cur.f.r0[j] * cur.f.r0[j] + cur.f.r1[j] * cur.f.r1[j]) / sg2;
-                double lp = -z2 / 2 + std::log((double)cur.f.idx.size());
-                if (lp < std::log(opt.alpha))
-                    c.drop.push_back(cur.f.idx[j]);
-                worst = std::max(worst, z2);
-            }
-            c.log_fap = -worst / 2 + std::log((double)cur.f.idx.size());
-            if (!c.drop.empty())
-                cands.push_back(c);
-        }
-        double K = (double)cands.size();
-        ex.candidates_tried.clear();
-        for (Candidate &c : cands) {
-            ex.candidates_tried.push_back(c.effect);
-            if (c.effect == "outlier") {
-                std::vector<int> keep;
-                for (int i : use)
-                    if (std::find(c.drop.begin(), c.drop.end(), i) == c.drop.end())
-                        keep.push_back(i);
-                c.fit = fit_spec(run, keep, order, adds);
-                c.log_fap += std::log(K);
-                continue;
-            }
-            c.fit = fit_spec(run, use, c.order, c.adds);
-            if (!c.fit.ok || c.fit.P <= cur.P) {
-                c.log_fap = 0;
-                continue;
-            }
-            double d1 = c.fit.P - cur.P, d2 = (double)(2 * c.fit.N - c.fit.P);
-            double F = ((cur.chi2 - c.fit.chi2) / d1) / (c.fit.chi2 / d2);
-            c.log_fap = log_f_tail(F, d1, d2) + std::log(c.trials) + std::log(K);
-        }
-        std::sort(cands.begin(), cands.end(),
-                  [](const Candidate &a, const Candidate &b) { return a.log_fap < b.log_fap; });
-        bool accepted = false;
-        for (Candidate &c : cands) {
-            if (!(c.log_fap < std::log(opt.alpha)) || !c.fit.ok)
-                break;
-            std::vector<int> nuse = use;
-            if (c.effect == "outlier") {
-                nuse.clear();
-                for (int i : use)
-                    if (std::find(c.drop.begin(), c.drop.end(), i) == c.drop.end())
-                        nuse.push_back(i);
-            }
-            // confirm out of sample: the cross-validated RMS must improve
-            double cv_new = cv_rms(run, nuse, c.order, c.adds, opt.folds, opt.seed);
-            // outliers: the same points predicted by models trained with them
-            double cv_old = c.effect == "outlier"
-                                ? cv_rms(run, nuse, order, adds, opt.folds, opt.seed, c.drop)
-                                : cur_cv;
-            if (!(cv_new < cv_old))
-                continue;
-            // the finding
-            Finding fd;
-            fd.effect = c.effect;
-            fd.adds = c.new_adds;
-            fd.false_alarm_probability = std::exp(c.log_fap);
-            fd.log10_p = c.log_fap / LN10;
-            fd.sigma_after_arcsec = arcsec(c.fit.f.res.sigma);
-            fd.cv_rms_after_arcsec = arcsec(cv_new);
-            fd.n_params_after = c.fit.P;
-            const pm_model &m = c.fit.f.model;
-            const pm_fit_result &res = c.fit.f.res;
-            // the new terms and their values
-            std::vector<int> newi;
-            for (int i = cur.f.model.n_terms; i < m.n_terms; i++)
-                newi.push_back(i);
-            char buf[512];
-            if (c.effect == "ha_periodic" || c.effect == "dec_periodic") {
-                double cc = m.coef[newi[0]], ss = m.coef[newi[1]];
-                double ec = res.err[newi[0]], es = res.err[newi[1]];
-                double A = std::hypot(cc, ss);
-                fd.cycles_per_rev = c.peak_g;
-                fd.amplitude_arcsec = arcsec(A);
-                fd.amplitude_err_arcsec =
-                    arcsec(A > 0 ? std::hypot(cc * ec, ss * es) / A : std::hypot(ec, es));
-                fd.phase_deg = std::atan2(ss, cc) * 180 / PI;
-                std::snprintf(buf, sizeof buf,
-                              "periodic error of the %s drive: %.6g cycles per revolution "
-                              "(period %.4g deg of the axis), amplitude %.2f\" +- %.2f\", phase "
-                              "%.0f deg at %s = 0",
-                              c.effect == "ha_periodic"
-                                  ? (run.mount == PM_MOUNT_ALTAZ ? "azimuth" : "hour-angle")
-                                  : (run.mount == PM_MOUNT_ALTAZ ? "elevation" : "declination"),
-                              c.peak_g, 360 / c.peak_g, fd.amplitude_arcsec,
-                              fd.amplitude_err_arcsec, fd.phase_deg,
-                              c.effect == "ha_periodic"
-                                  ? (run.mount == PM_MOUNT_ALTAZ ? "raw azimuth" : "raw HA")
-                                  : (run.mount == PM_MOUNT_ALTAZ ? "raw elevation" : "raw Dec"));
-                fd.text = buf;
-            } else if (c.effect == "outlier") {
-                double worst = 0;
-                for (size_t j = 0; j < cur.f.idx.size(); j++)
-                    if (std::find(c.drop.begin(), c.drop.end(), cur.f.idx[j]) != c.drop.end()) {
-                        worst = std::max(worst, std::hypot(cur.f.r0[j], cur.f.r1[j]));
-                        fd.lines.push_back(run.obs[cur.f.idx[j]].line);
-                    }
-                fd.amplitude_arcsec = arcsec(worst);
-                std::string lines;
-                for (int l : fd.lines)
-                    lines += (lines.empty() ? "" : ", ") + std::to_string(l);
-                std::snprintf(buf, sizeof buf,
-                              "%zu individual bad point%s (failed plate solve, wrong star?) at "
-                              "line%s %s; the worst misses by %.1f\" (%.1f sigma)",
-                              fd.lines.size(), fd.lines.size() > 1 ? "s" : "",
-                              fd.lines.size() > 1 ? "s" : "", lines.c_str(), fd.amplitude_arcsec,
-                              worst / cur.f.res.sigma);
-                fd.text = buf;
-            } else if (c.effect == "higher_order") {
-                std::vector<double> d = model_difference(run, use, cur.f.model, m);
-                double ss2 = 0;
-                for (double x : d)
-                    ss2 += x * x;
-                fd.amplitude_arcsec = arcsec(std::sqrt(ss2 / (double)std::max<size_t>(1, d.size())));
-                std::snprintf(buf, sizeof buf,
-                              "anisotropy beyond order %d: the %d terms of order %d change the "
-                              "pointing by %.2f\" RMS (flexure or gear errors with more structure "
-                              "than the model had)",
-                              order, c.fit.P - cur.P, order + 1, fd.amplitude_arcsec);
-                fd.text = buf;
-            } else if (c.effect == "pier_side") {
-                // the side-specific displacement, RMS over the west-pier points
-                pm_model z = m;
-                for (int i : newi)
-                    z.coef[i] = 0;
-                pm_model_prepare(&z);
-                std::vector<int> west;
-                for (int i : use)
-                    if (run.obs[i].pier < 0)
-                        west.push_back(i);
-                std::vector<double> d = model_difference(run, west, z, m);
-                double ss2 = 0;
-                for (double x : d)
-                    ss2 += x * x;
-                fd.amplitude_arcsec = arcsec(std::sqrt(ss2 / (double)std::max<size_t>(1, d.size())));
-                std::string vals;
-                for (int i : newi) {
-                    char v[96];
-                    std::snprintf(v, sizeof v, "%s%s = %.2f +- %.2f", vals.empty() ? "" : ", ",
-                                  term_name(m, i).c_str(), arcsec(m.coef[i]), arcsec(res.err[i]));
-                    vals += v;
-                }
-                std::snprintf(buf, sizeof buf,
-                              "the pointing differs across the meridian flip (pier side) by "
-                              "%.2f\" RMS on the west side: collimation/index offsets change "
-                              "with the side, as flexure or a side-dependent cone error does; %s "
-                              "arcsec",
-                              fd.amplitude_arcsec, vals.c_str());
-                fd.text = buf;
-            } else {
-                // one coefficient family: report the largest and its error
-                int big = newi.empty() ? -1 : newi[0];
-                for (int i : newi)
-                    if (std::fabs(m.coef[i]) > std::fabs(m.coef[big]))
-                        big = i;
-                fd.amplitude_arcsec = big >= 0 ? arcsec(std::fabs(m.coef[big])) : 0;
-                fd.amplitude_err_arcsec = big >= 0 ? arcsec(res.err[big]) : 0;
-                std::string vals;
-                for (int i : newi) {
-                    char v[160];
-                    std::snprintf(v, sizeof v, "%s%s = %.2f +- %.2f", vals.empty() ? "" : ", ",
-                                  input_name(run, m, i).c_str(), arcsec(m.coef[i]),
-                                  arcsec(res.err[i]));
-                    vals += v;
-                }
-                const char *what =
-                    c.effect == "refraction"
-                        ? "an elevation-dependent shift toward the zenith growing as cot(el): "
-                          "refraction missing or wrong in the reduction"
-                    : c.effect == "tube_flexure"
-                        ? "tube flexure: a sag toward the horizon growing as cos(el)"
-                    : c.effect == "pier_side"
-                        ? "the pointing differs across the meridian flip (pier side): "
-                          "collimation/index offsets change with the side, as flexure or a "
-                          "cone error that depends on the side does"
-                    : c.effect == "temperature"
-                        ? "the pointing drifts with temperature (arcsec per deg C): thermal "
-                          "expansion of the tube or mount"
-                    : c.effect == "time_drift"
-                        ? "the pointing drifts through the night (arcsec per hour): settling, "
-                          "slipping encoders or a clock error"
-                        : "the pointing depends on the direction of the last slew: backlash or "
-                          "hysteresis in the drive (half the backlash per unit of direction)";
-                std::snprintf(buf, sizeof buf, "%s; %s arcsec", what, vals.c_str());
-                fd.text = buf;
-            }
-            {
-                std::vector<double> d = model_difference(run, c.effect == "outlier" ? nuse : use,
-                                                         cur.f.model, m);
-                for (double &x : d)
-                    x = arcsec(x);
-                fd.where = c.effect == "outlier" ? "individual points (see lines)"
-                                                 : where_largest(run, use, d, "\"");
-            }
-            ex.findings.push_back(fd);
-            order = c.order;
-            adds = c.adds;
-            use = nuse;
-            cur = c.fit;
-            cur_cv = cv_new;
-            accepted = true;
-            break;
-        }
-        if (!accepted)
-            break;
-    }
-    ex.final = cur.f;
-    ex.kept = use;
-    ex.final_sigma_arcsec = arcsec(cur.f.res.sigma);
-    ex.final_cv_rms_arcsec = arcsec(cur_cv);
-    ex.final_n_params = cur.P;
-    ex.final_adds = adds;
-    ex.final_order = order;
+    ex.final = st.cur.f;
+    ex.kept = st.use;
+    ex.final_sigma_arcsec = arcsec(st.cur.f.res.sigma);
+    ex.final_cv_rms_arcsec = arcsec(st.cur_cv);
+    ex.final_n_params = st.cur.P;
+    ex.final_adds = st.adds;
+    ex.final_order = st.order;
     return ex;
 }
 

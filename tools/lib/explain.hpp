@@ -28,6 +28,9 @@ struct ExplainOptions {
     // and the false-alarm correction counts only them (--gear).
     std::vector<double> gears_ha, gears_dec;
     unsigned seed = 1;             // fold assignment
+    bool pairs = true;             // where no single family passes, try pairs
+    double close_delta_bic = 6;    // alternatives: Delta BIC below this (for readings of
+                                   // as many terms: a likelihood ratio below 20)
 };
 
 // One located statistic: a part of the data whose residuals are too large.
@@ -45,6 +48,25 @@ struct Periodogram {
     double trials = 0;             // periods the peak was chosen among (known gears or the scan)
 };
 
+// Another reading of the same residuals whose evidence is close to the
+// chosen one's (docs/explain.md, "Confusable effects").
+struct Alternative {
+    std::string effect;
+    double log10_fap = 0;      // its own false-alarm probability (log10)
+    double delta_bic = 0;      // BIC(alternative) - BIC(chosen), >= 0
+    double log10_lr = 0;       // log10 of the likelihood ratio chosen : alternative
+    std::string separate_by;   // the observation that would tell them apart
+};
+
+// One physical reading of the fitted baseline (docs/explain.md,
+// "What the baseline holds").
+struct Interpretation {
+    std::string what;          // key: polar_altitude, polar_azimuth, ...
+    double value = 0, error = 0;
+    std::string unit;          // "arcmin", "arcsec", "deg"
+    std::string text;          // in plain words, with the size
+};
+
 struct Finding {
     std::string effect;       // vocabulary: ha_periodic, dec_periodic, pier_side, refraction,
                               // tube_flexure, temperature, time_drift, hysteresis,
@@ -57,6 +79,8 @@ struct Finding {
     double sigma_after_arcsec = 0, cv_rms_after_arcsec = 0;
     int n_params_after = 0;
     std::vector<int> lines;   // outliers: their file lines
+    std::string with;         // found together with this effect (a pair), else ""
+    std::vector<Alternative> alternatives; // readings with close evidence
 };
 
 struct Explanation {
@@ -68,13 +92,28 @@ struct Explanation {
     std::vector<Periodogram> periodograms; // of the baseline residuals
     std::vector<Finding> findings;
     std::vector<std::string> candidates_tried; // per step, for the report
+    std::vector<Interpretation> interpretation; // the physical reading of the baseline
+    std::string physical_reading;        // order 0 + one term predicts as well as order 1
     FitOut baseline, final;              // the two fits (residuals for plots)
     std::vector<int> kept;               // observations used by the final fit
     std::vector<std::string> final_adds;
     int final_order = 1;
 };
 
+// The pipeline: baseline -> locate -> candidates -> select (singles, then
+// pairs) -> describe, repeated while something is found; then interpret.
 Explanation explain(const Run &run, const ExplainOptions &opt);
+
+// The physical reading of a fitted model (stage "interpret"): polar axis,
+// non-perpendicularity, collimation, indices, the tube-flexure-like part of
+// the order-1 terms; explain_interpret.cpp.
+std::vector<Interpretation> interpret(const Run &run, const FitOut &f);
+
+// The report (explain_report.cpp): one JSON object (docs/formats.md), or
+// text on stdout.
+std::string explain_json(const Run &run, const Explanation &ex, int order);
+void print_explain_text(const Run &run, const Explanation &ex, int order, bool added,
+                        double alpha, bool gears_ha, bool gears_dec);
 
 // k-fold cross-validated RMS per axis (radians) of a model spec on the
 // observations `use`; train_also are added to every training fold, never

@@ -259,6 +259,14 @@ FitOut do_fit(const std::vector<Obs> &obs, const std::vector<int> &use, const pm
     }
     if (f.status != PM_OK)
         return f;
+    int P = f.model.n_terms;
+    f.cov.assign((size_t)P * (size_t)P, 0.0);
+    for (int i = 0; i < P; i++)
+        for (int j = 0; j <= i; j++) {
+            double c = 0;
+            pm_fit_covariance(&fit, &f.res, i, j, &c, nullptr);
+            f.cov[(size_t)i * P + j] = f.cov[(size_t)j * P + i] = c;
+        }
     residuals(f, obs, use);
     return f;
 }

@@ -32,6 +32,7 @@ struct FitOut {
     std::vector<double> r0, r1; // residuals (rad), sky frame
     std::vector<int> idx;       // indices into the run
     double rms = 0;
+    std::vector<double> cov;    // P x P coefficient covariance (rad^2), row-major
 };
 
 // A pointing run read from a file, with per-observation contexts.

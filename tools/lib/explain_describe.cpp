@@ -1,0 +1,337 @@
+// explain_describe.cpp - stage "describe" of pmfit explain: an accepted
+// candidate in words, with its size and where on the sky it matters, in the
+// vocabulary of the mount (equatorial or alt-az).  docs/explain.md.
+#include "explain_internal.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+namespace pmhost {
+namespace xdetail {
+
+double elevation_of(const Run &run, const Obs &o)
+{
+    if (run.mount == PM_MOUNT_ALTAZ)
+        return o.ad;
+    if (std::isnan(run.latitude))
+        return NAN;
+    double l = run.latitude;
+    return std::asin(std::sin(l) * std::sin(o.ad) + std::cos(l) * std::cos(o.ad) * std::cos(o.ah));
+}
+
+bool has(const std::vector<std::string> &v, const std::string &s)
+{
+    return std::find(v.begin(), v.end(), s) != v.end();
+}
+
+std::vector<double> model_difference(const Run &run, const std::vector<int> &use,
+                                     const pm_model &a, const pm_model &b)
+{
+    std::vector<double> d;
+    for (int i : use) {
+        const Obs &o = run.obs[i];
+        double t1, d1, t2, d2;
+        if (pm_model_apply(&a, &o.ctx, o.eh, o.ed, &t1, &d1) != PM_OK ||
+            pm_model_apply(&b, &o.ctx, o.eh, o.ed, &t2, &d2) != PM_OK) {
+            d.push_back(0);
+            continue;
+        }
+        double c = std::sin(d1) * std::sin(d2) + std::cos(d1) * std::cos(d2) * std::cos(t1 - t2);
+        double s = std::hypot(std::cos(d2) * std::sin(t2 - t1),
+                              std::cos(d1) * std::sin(d2) -
+                                  std::sin(d1) * std::cos(d2) * std::cos(t2 - t1));
+        d.push_back(std::atan2(s, c));
+    }
+    return d;
+}
+
+const char *axis_word(const Run &run, int axis, bool raw)
+{
+    bool az = run.mount == PM_MOUNT_ALTAZ;
+    if (axis == 1)
+        return raw ? (az ? "raw azimuth" : "raw HA") : (az ? "azimuth" : "hour-angle");
+    return raw ? (az ? "raw elevation" : "raw Dec") : (az ? "elevation" : "declination");
+}
+
+namespace {
+
+struct Bin {
+    double sum = 0;
+    int n = 0;
+};
+
+// Sky bins of the observations: elevation bands, axis-1 quarters, pier sides.
+std::map<std::string, Bin> bin_means(const Run &run, const std::vector<int> &use,
+                                     const std::vector<double> &v)
+{
+    std::map<std::string, Bin> bins;
+    for (size_t j = 0; j < use.size(); j++) {
+        const Obs &o = run.obs[use[j]];
+        double el = elevation_of(run, o);
+        if (std::isfinite(el)) {
+            double e = el * 180 / PI;
+            const char *b = e < 20 ? "elevation below 20 deg"
+                            : e < 35 ? "elevation 20-35 deg"
+                            : e < 50 ? "elevation 35-50 deg"
+                            : e < 65 ? "elevation 50-65 deg" : "elevation above 65 deg";
+            bins[b].sum += v[j];
+            bins[b].n++;
+        }
+        double h = std::remainder(o.ah, 2 * PI) * 180 / PI;
+        const char *hb = run.mount == PM_MOUNT_ALTAZ
+                             ? (h < -90 ? "azimuth 180-270" : h < 0 ? "azimuth 270-360"
+                                : h < 90 ? "azimuth 0-90" : "azimuth 90-180")
+                             : (h < -90 ? "hour angle -12h..-6h" : h < 0 ? "hour angle -6h..0h"
+                                : h < 90 ? "hour angle 0h..6h" : "hour angle 6h..12h");
+        bins[hb].sum += v[j];
+        bins[hb].n++;
+        if (o.pier) {
+            const char *pb = o.pier > 0 ? "pier east (normal side)" : "pier west (beyond the pole)";
+            bins[pb].sum += v[j];
+            bins[pb].n++;
+        }
+    }
+    return bins;
+}
+
+} // namespace
+
+std::string largest_bin(const Run &run, const std::vector<int> &use, const std::vector<double> &v)
+{
+    std::string best;
+    double bv = -1;
+    for (const auto &b : bin_means(run, use, v))
+        if (b.second.n >= 3 && b.second.sum / b.second.n > bv) {
+            bv = b.second.sum / b.second.n;
+            best = b.first;
+        }
+    return best;
+}
+
+std::string where_largest(const Run &run, const std::vector<int> &use,
+                          const std::vector<double> &v, const char *unit)
+{
+    std::string best, low;
+    double bv = -1, lv = 1e300, all = 0;
+    for (double x : v)
+        all += x;
+    all /= v.empty() ? 1 : (double)v.size();
+    for (const auto &b : bin_means(run, use, v)) {
+        if (b.second.n < 3)
+            continue;
+        double m = b.second.sum / b.second.n;
+        if (m > bv) {
+            bv = m;
+            best = b.first;
+        }
+        if (m < lv) {
+            lv = m;
+            low = b.first;
+        }
+    }
+    char buf[256];
+    std::snprintf(buf, sizeof buf, "largest at %s (mean %.2f%s), smallest at %s (mean %.2f%s); "
+                                   "mean over the run %.2f%s",
+                  best.c_str(), bv, unit, low.c_str(), lv, unit, all, unit);
+    return buf;
+}
+
+namespace {
+
+// A term's name with a user input shown by its column name.
+std::string input_name(const Run &run, const pm_model &m, int i)
+{
+    std::string n = term_name(m, i);
+    const pm_term &t = m.term[i];
+    if (t.kind == PM_TERM_AUX && t.aux >= PM_AUX_USER &&
+        (size_t)(t.aux - PM_AUX_USER) < run.aux_names.size()) {
+        std::string tag = "aux" + std::to_string(t.aux - PM_AUX_USER);
+        size_t p = n.find(tag);
+        if (p != std::string::npos)
+            n.replace(p, tag.size(), run.aux_names[(size_t)(t.aux - PM_AUX_USER)]);
+    }
+    return n;
+}
+
+std::string values_of(const Run &run, const pm_model &m, const pm_fit_result &res,
+                      const std::vector<int> &newi)
+{
+    std::string vals;
+    for (int i : newi) {
+        char v[160];
+        std::snprintf(v, sizeof v, "%s%s = %.2f +- %.2f", vals.empty() ? "" : ", ",
+                      input_name(run, m, i).c_str(), arcsec(m.coef[i]), arcsec(res.err[i]));
+        vals += v;
+    }
+    return vals;
+}
+
+double rms_of(const std::vector<double> &d)
+{
+    double ss = 0;
+    for (double x : d)
+        ss += x * x;
+    return std::sqrt(ss / (double)std::max<size_t>(1, d.size()));
+}
+
+void describe_periodic(const Run &run, const Candidate &c, const std::vector<int> &newi,
+                       const std::string &effect, double G, Finding &fd)
+{
+    const pm_model &m = c.fit.f.model;
+    const pm_fit_result &res = c.fit.f.res;
+    double cc = m.coef[newi[0]], ss = m.coef[newi[1]];
+    double ec = res.err[newi[0]], es = res.err[newi[1]];
+    double A = std::hypot(cc, ss);
+    int axis = effect == "ha_periodic" ? 1 : 2;
+    fd.cycles_per_rev = G;
+    fd.amplitude_arcsec = arcsec(A);
+    fd.amplitude_err_arcsec = arcsec(A > 0 ? std::hypot(cc * ec, ss * es) / A : std::hypot(ec, es));
+    fd.phase_deg = std::atan2(ss, cc) * 180 / PI;
+    // an alt-az mount's azimuth error of a few cycles per turn is the track
+    // or bearing, not a worm
+    const char *what = "periodic error of the %s drive";
+    if (run.mount == PM_MOUNT_ALTAZ && axis == 1 && G <= 4.5)
+        what = "azimuth track or bearing runout (periodic in %s)";
+    char head[96], buf[512];
+    std::snprintf(head, sizeof head, what, axis_word(run, axis, false));
+    std::snprintf(buf, sizeof buf,
+                  "%s: %.6g cycles per revolution (period %.4g deg of the axis), amplitude "
+                  "%.2f\" +- %.2f\", phase %.0f deg at %s = 0",
+                  head, G, 360 / G, fd.amplitude_arcsec, fd.amplitude_err_arcsec,
+                  fd.phase_deg, axis_word(run, axis, true));
+    fd.text = buf;
+}
+
+void describe_outlier(const Run &run, const State &st, const Candidate &c, Finding &fd)
+{
+    const FitOut &cur = st.cur.f;
+    double worst = 0;
+    for (size_t j = 0; j < cur.idx.size(); j++)
+        if (std::find(c.drop.begin(), c.drop.end(), cur.idx[j]) != c.drop.end()) {
+            worst = std::max(worst, std::hypot(cur.r0[j], cur.r1[j]));
+            fd.lines.push_back(run.obs[cur.idx[j]].line);
+        }
+    fd.amplitude_arcsec = arcsec(worst);
+    std::string lines;
+    for (int l : fd.lines)
+        lines += (lines.empty() ? "" : ", ") + std::to_string(l);
+    char buf[512];
+    std::snprintf(buf, sizeof buf,
+                  "%zu individual bad point%s (failed plate solve, wrong star?) at line%s %s; the "
+                  "worst misses by %.1f\" (%.1f sigma)",
+                  fd.lines.size(), fd.lines.size() > 1 ? "s" : "", fd.lines.size() > 1 ? "s" : "",
+                  lines.c_str(), fd.amplitude_arcsec, worst / cur.res.sigma);
+    fd.text = buf;
+}
+
+void describe_higher(const Run &run, const State &st, const Candidate &c, Finding &fd)
+{
+    std::vector<double> d = model_difference(run, st.use, st.cur.f.model, c.fit.f.model);
+    fd.amplitude_arcsec = arcsec(rms_of(d));
+    char buf[512];
+    std::snprintf(buf, sizeof buf,
+                  "anisotropy beyond order %d: the %d terms of order %d change the pointing by "
+                  "%.2f\" RMS (flexure or gear errors with more structure than the model had)",
+                  st.order, c.fit.P - st.cur.P, st.order + 1, fd.amplitude_arcsec);
+    fd.text = buf;
+}
+
+void describe_pier(const Run &run, const State &st, const Candidate &c,
+                   const std::vector<int> &newi, Finding &fd)
+{
+    const pm_model &m = c.fit.f.model;
+    pm_model z = m;  // the side-specific displacement, RMS over the west points
+    for (int i : newi)
+        z.coef[i] = 0;
+    pm_model_prepare(&z);
+    std::vector<int> west;
+    for (int i : st.use)
+        if (run.obs[i].pier < 0)
+            west.push_back(i);
+    fd.amplitude_arcsec = arcsec(rms_of(model_difference(run, west, z, m)));
+    char buf[700];
+    std::snprintf(buf, sizeof buf,
+                  "the pointing differs across the meridian flip (pier side) by %.2f\" RMS on the "
+                  "west side: collimation/index offsets change with the side, as flexure or a "
+                  "side-dependent cone error does; %s arcsec",
+                  fd.amplitude_arcsec, values_of(run, m, c.fit.f.res, newi).c_str());
+    fd.text = buf;
+}
+
+// What a one-family effect is, in the mount's vocabulary.
+const char *family_words(const Run &run, const std::string &e)
+{
+    bool az = run.mount == PM_MOUNT_ALTAZ;
+    if (e == "refraction")
+        return "an elevation-dependent shift toward the zenith growing as cot(el): refraction "
+               "missing or wrong in the reduction";
+    if (e == "tube_flexure")
+        return az ? "elevation-dependent flexure: the tube sags toward the horizon as cos(el)"
+                  : "tube flexure: a sag toward the horizon growing as cos(el)";
+    if (e == "temperature")
+        return az ? "the pointing follows temperature (arcsec per deg C): on the elevation and "
+                    "azimuth index, as thermal expansion of the tube or the structure moves them"
+                  : "the pointing drifts with temperature (arcsec per deg C): thermal expansion "
+                    "of the tube or mount";
+    if (e == "time_drift")
+        return "the pointing drifts through the night (arcsec per hour): settling, slipping "
+               "encoders or a clock error";
+    return az ? "the pointing depends on the direction of the last slew: cable-wrap or bearing "
+                "hysteresis, or backlash in the drive (half the offset per unit of direction)"
+              : "the pointing depends on the direction of the last slew: backlash or hysteresis "
+                "in the drive (half the backlash per unit of direction)";
+}
+
+void describe_family(const Run &run, const Candidate &c, const std::vector<int> &newi,
+                     const std::string &effect, Finding &fd)
+{
+    const pm_model &m = c.fit.f.model;
+    int big = newi.empty() ? -1 : newi[0];
+    for (int i : newi)
+        if (std::fabs(m.coef[i]) > std::fabs(m.coef[big]))
+            big = i;
+    fd.amplitude_arcsec = big >= 0 ? arcsec(std::fabs(m.coef[big])) : 0;
+    fd.amplitude_err_arcsec = big >= 0 ? arcsec(c.fit.f.res.err[big]) : 0;
+    char buf[700];
+    std::snprintf(buf, sizeof buf, "%s; %s arcsec", family_words(run, effect),
+                  values_of(run, m, c.fit.f.res, newi).c_str());
+    fd.text = buf;
+}
+
+} // namespace
+
+std::vector<Finding> describe(const Run &run, const State &st, const Candidate &c)
+{
+    std::vector<Finding> out;
+    int first = st.cur.f.model.n_terms;
+    for (size_t k = 0; k < c.members.size(); k++) {
+        const std::string &e = c.members[k];
+        std::vector<int> newi;
+        int n = k < c.member_terms.size() ? c.member_terms[k] : c.fit.f.model.n_terms - first;
+        for (int i = first; i < first + n && i < c.fit.f.model.n_terms; i++)
+            newi.push_back(i);
+        first += n;
+        Finding fd;
+        fd.effect = e;
+        if (c.members.size() == 2)
+            fd.with = c.members[1 - k];
+        if (e == "ha_periodic" || e == "dec_periodic")
+            describe_periodic(run, c, newi, e, k < c.member_g.size() ? c.member_g[k] : c.peak_g,
+                              fd);
+        else if (e == "outlier")
+            describe_outlier(run, st, c, fd);
+        else if (e == "higher_order")
+            describe_higher(run, st, c, fd);
+        else if (e == "pier_side")
+            describe_pier(run, st, c, newi, fd);
+        else
+            describe_family(run, c, newi, e, fd);
+        out.push_back(fd);
+    }
+    return out;
+}
+
+} // namespace xdetail
+} // namespace pmhost

@@ -1,0 +1,83 @@
+// explain_internal.hpp - the parts the stages of pmfit explain share
+// (explain.cpp: locate, candidates, select; explain_describe.cpp: the
+// findings in words; explain_interpret.cpp: the baseline in physical terms).
+// Not installed, not a public API.
+#ifndef PM_EXPLAIN_INTERNAL_HPP
+#define PM_EXPLAIN_INTERNAL_HPP
+
+#include "explain.hpp"
+
+#include <string>
+#include <vector>
+
+namespace pmhost {
+namespace xdetail {
+
+const double LN10 = 2.302585092994046;
+
+inline double arcsec(double rad) { return rad * RAD2AS; }
+
+// A fit of one model spec (order, adds) to a set of observations.
+struct Fit {
+    bool ok = false;
+    FitOut f;
+    double chi2 = 0;
+    int P = 0;
+    long N = 0;
+};
+
+// Fit (order, adds) to the observations `use`.  Not applicable (a needed
+// input missing, a singular term) gives ok = false.
+Fit fit_spec(const Run &run, const std::vector<int> &use, int order,
+             const std::vector<std::string> &adds);
+
+// Where the search stands: the observations used and the current model.
+struct State {
+    std::vector<int> use;
+    int order = 1;
+    std::vector<std::string> adds;
+    Fit cur;
+    double cur_cv = 0;
+};
+
+// One candidate explanation: a family of terms (or a pair of families, or
+// outliers to drop) and its fit.
+struct Candidate {
+    std::string effect;                // "refraction", or "a+b" for a pair
+    std::vector<std::string> members;  // the families of a pair (else {effect})
+    std::vector<int> member_terms;     // per member, how many terms it adds
+    int order = 1;
+    std::vector<std::string> adds;
+    std::vector<std::string> new_adds; // what this candidate adds
+    double trials = 1;                 // periods scanned
+    double peak_g = 0;
+    std::vector<double> member_g;      // per member of a pair: its G (periodic), else 0
+    std::vector<int> drop;             // outliers: observations to drop
+    Fit fit;
+    double log_fap = 0;                // natural log of the false-alarm probability
+    double cv = 0;                     // cross-validated RMS once checked
+};
+
+double elevation_of(const Run &run, const Obs &o);
+bool has(const std::vector<std::string> &v, const std::string &s);
+// Angular size (radians) of model b minus model a at each observation.
+std::vector<double> model_difference(const Run &run, const std::vector<int> &use,
+                                     const pm_model &a, const pm_model &b);
+// Where a quantity (one value per observation in `use`) is largest and
+// smallest, over elevation bands, axis-1 quarters and pier sides.
+std::string where_largest(const Run &run, const std::vector<int> &use,
+                          const std::vector<double> &v, const char *unit);
+// The bin name where a quantity is largest (for "separate by" advice).
+std::string largest_bin(const Run &run, const std::vector<int> &use,
+                        const std::vector<double> &v);
+
+// Words for an axis of this mount: "hour-angle"/"azimuth", ...
+const char *axis_word(const Run &run, int axis, bool raw);
+
+// The finding(s) one accepted candidate makes: one per member family.
+std::vector<Finding> describe(const Run &run, const State &st, const Candidate &c);
+
+} // namespace xdetail
+} // namespace pmhost
+
+#endif

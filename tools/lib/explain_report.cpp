@@ -1,0 +1,186 @@
+// explain_report.cpp - stage "report" of pmfit explain: the explanation as
+// one JSON object (keys in docs/formats.md, "pmfit explain --json") or as
+// text.
+#include "explain_internal.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+namespace pmhost {
+
+namespace {
+
+std::string num(double v)
+{
+    char b[40];
+    std::snprintf(b, sizeof b, std::isfinite(v) ? "%.6g" : "null", v);
+    return b;
+}
+
+std::string str(const std::string &s) { return "\"" + json_escape(s) + "\""; }
+
+std::string alternatives_json(const std::vector<Alternative> &alts)
+{
+    std::string j = "[";
+    for (size_t k = 0; k < alts.size(); k++) {
+        const Alternative &a = alts[k];
+        j += std::string(k ? ", " : "") + "{\"effect\": " + str(a.effect) +
+             ", \"log10_false_alarm_probability\": " + num(a.log10_fap) +
+             ", \"delta_bic\": " + num(a.delta_bic) + ", \"log10_likelihood_ratio\": " +
+             num(a.log10_lr) + ", \"separate_by\": " + str(a.separate_by) + "}";
+    }
+    return j + "]";
+}
+
+std::string finding_json(const Finding &f)
+{
+    std::string j = "{\"effect\": " + str(f.effect);
+    if (f.effect == "ha_periodic" || f.effect == "dec_periodic")
+        j += ", \"cycles_per_rev\": " + num(f.cycles_per_rev) + ", \"phase_deg\": " + num(f.phase_deg);
+    j += ", \"amplitude_arcsec\": " + num(f.amplitude_arcsec) +
+         ", \"amplitude_error_arcsec\": " + num(f.amplitude_err_arcsec) +
+         ", \"false_alarm_probability\": " + num(f.false_alarm_probability) +
+         ", \"log10_false_alarm_probability\": " + num(f.log10_p) +
+         ", \"sigma_after_arcsec\": " + num(f.sigma_after_arcsec) +
+         ", \"cv_rms_after_arcsec\": " + num(f.cv_rms_after_arcsec) +
+         ", \"n_params_after\": " + std::to_string(f.n_params_after) + ", \"terms\": [";
+    for (size_t k = 0; k < f.adds.size(); k++)
+        j += std::string(k ? ", " : "") + str(f.adds[k]);
+    j += "]";
+    if (!f.lines.empty()) {
+        j += ", \"lines\": [";
+        for (size_t k = 0; k < f.lines.size(); k++)
+            j += std::string(k ? ", " : "") + std::to_string(f.lines[k]);
+        j += "]";
+    }
+    if (!f.with.empty())
+        j += ", \"with\": " + str(f.with);
+    j += ", \"alternatives\": " + alternatives_json(f.alternatives);
+    return j + ", \"text\": " + str(f.text) + ", \"where\": " + str(f.where) + "}";
+}
+
+std::string interpretation_json(const Explanation &ex)
+{
+    std::string j = "[";
+    for (size_t k = 0; k < ex.interpretation.size(); k++) {
+        const Interpretation &it = ex.interpretation[k];
+        j += std::string(k ? ", " : "") + "{\"what\": " + str(it.what) + ", \"value\": " +
+             num(it.value) + ", \"error\": " + num(it.error) + ", \"unit\": " + str(it.unit) +
+             ", \"text\": " + str(it.text) + "}";
+    }
+    return j + "]";
+}
+
+} // namespace
+
+std::string explain_json(const Run &run, const Explanation &ex, int order)
+{
+    std::string j = "\"baseline\": {\"order\": " + std::to_string(order) +
+                    ", \"sigma_arcsec\": " + num(ex.base_sigma_arcsec) +
+                    ", \"cv_rms_arcsec\": " + num(ex.base_cv_rms_arcsec) +
+                    ", \"n_params\": " + std::to_string(ex.base_n_params) + "}, \"mount\": " +
+                    str(run.mount == PM_MOUNT_ALTAZ ? "altaz" : "equatorial") +
+                    ", \"interpretation\": " + interpretation_json(ex) + ", \"physical_reading\": " +
+                    (ex.physical_reading.empty() ? "null" : str(ex.physical_reading)) +
+                    ", \"located\": [";
+    for (size_t i = 0; i < ex.located.size() && i < 8; i++)
+        j += std::string(i ? ", " : "") + "{\"what\": " + str(ex.located[i].what) + ", \"value\": " +
+             num(ex.located[i].rms_arcsec) + ", \"ratio\": " + num(ex.located[i].ratio) +
+             ", \"p\": " + num(ex.located[i].p) + "}";
+    j += "], \"periodograms\": [";
+    for (size_t i = 0; i < ex.periodograms.size(); i++)
+        j += std::string(i ? ", " : "") + "{\"axis\": " + str(ex.periodograms[i].axis) +
+             ", \"peak_cycles_per_rev\": " + num(ex.periodograms[i].peak_g) +
+             ", \"peak_power\": " + num(ex.periodograms[i].peak_power) +
+             ", \"threshold\": " + num(ex.periodograms[i].threshold) + "}";
+    j += "], \"findings\": [";
+    for (size_t i = 0; i < ex.findings.size(); i++)
+        j += std::string(i ? ", " : "") + finding_json(ex.findings[i]);
+    return j + "], \"final\": {\"sigma_arcsec\": " + num(ex.final_sigma_arcsec) +
+           ", \"cv_rms_arcsec\": " + num(ex.final_cv_rms_arcsec) +
+           ", \"n_params\": " + std::to_string(ex.final_n_params) + "}";
+}
+
+namespace {
+
+void print_located(const Explanation &ex, double alpha, bool gears_ha, bool gears_dec, bool altaz)
+{
+    std::printf("\nwhere the baseline residuals are too large (p: chance of so much, uncorrected):\n");
+    int shown = 0;
+    for (const Located &l : ex.located) {
+        if (shown >= 6 || l.p > 0.05)
+            break;
+        if (l.what.find(" vs ") != std::string::npos)
+            std::printf("  %-44s correlation %+.2f (|t| = %.1f), p = %.2g\n", l.what.c_str(),
+                        l.rms_arcsec, l.ratio, l.p);
+        else
+            std::printf("  %-44s RMS %.2f\" (%.2f x typical), p = %.2g\n", l.what.c_str(),
+                        l.rms_arcsec, l.ratio, l.p);
+        shown++;
+    }
+    if (!shown)
+        std::printf("  nowhere in particular (no group or variable at p < 0.05)\n");
+    for (const Periodogram &pg : ex.periodograms)
+        std::printf("  periodogram of the %s axis: highest peak at G = %.6g cycles/rev%s, power "
+                    "%.1f (false-alarm %g level: %.1f)\n",
+                    pg.axis == "ha" ? (altaz ? "azimuth" : "hour-angle") : (altaz ? "elevation" : "declination"),
+                    pg.peak_g,
+                    (pg.axis == "ha" ? gears_ha : gears_dec) ? " of the --gear periods" : "",
+                    pg.peak_power, alpha, pg.threshold);
+}
+
+void print_findings(const Explanation &ex, double alpha)
+{
+    std::printf("\nfindings:\n");
+    if (ex.findings.empty())
+        std::printf("  none: nothing significant is left out (false-alarm probability below %g "
+                    "and a better cross-validated RMS were required)\n",
+                    alpha);
+    for (size_t i = 0; i < ex.findings.size(); i++) {
+        const Finding &f = ex.findings[i];
+        std::printf("  %zu. %s: %s\n", i + 1, f.effect.c_str(), f.text.c_str());
+        if (!f.with.empty())
+            std::printf("     found together with %s: neither alone passed, the pair does\n",
+                        f.with.c_str());
+        std::printf("     where: %s\n     false-alarm probability %.2g (10^%.1f); with it sigma "
+                    "%.3f\", CV RMS %.3f\", P = %d\n",
+                    f.where.c_str(), f.false_alarm_probability, f.log10_p, f.sigma_after_arcsec,
+                    f.cv_rms_after_arcsec, f.n_params_after);
+        for (const Alternative &a : f.alternatives)
+            std::printf("     as good a reading: %s (false-alarm 10^%.1f, Delta BIC %+.1f, "
+                        "likelihood ratio 10^%.2f in favour of %s); to separate them: %s\n",
+                        a.effect.c_str(), a.log10_fap, a.delta_bic, a.log10_lr, f.effect.c_str(),
+                        a.separate_by.c_str());
+    }
+}
+
+} // namespace
+
+void print_explain_text(const Run &run, const Explanation &ex, int order, bool added,
+                        double alpha, bool gears_ha, bool gears_dec)
+{
+    std::printf("baseline: order %d%s, P = %d, unbiased sigma %.3f\", cross-validated RMS %.3f\"\n",
+                order, added ? " + added terms" : "", ex.base_n_params, ex.base_sigma_arcsec,
+                ex.base_cv_rms_arcsec);
+    if (!ex.interpretation.empty()) {
+        std::printf("\nwhat the baseline holds (its physical reading):\n");
+        for (const Interpretation &it : ex.interpretation)
+            std::printf("  %s\n", it.text.c_str());
+        if (!ex.physical_reading.empty())
+            std::printf("  %s\n", ex.physical_reading.c_str());
+    }
+    print_located(ex, alpha, gears_ha, gears_dec, run.mount == PM_MOUNT_ALTAZ);
+    print_findings(ex, alpha);
+    std::printf("\n  %-22s %5s %10s %10s\n", "step", "P", "sigma(\")", "CV RMS(\")");
+    std::printf("  %-22s %5d %10.3f %10.3f\n", "baseline", ex.base_n_params, ex.base_sigma_arcsec,
+                ex.base_cv_rms_arcsec);
+    for (const Finding &f : ex.findings)
+        std::printf("  %-22s %5d %10.3f %10.3f\n", ("+ " + f.effect).c_str(), f.n_params_after,
+                    f.sigma_after_arcsec, f.cv_rms_after_arcsec);
+    std::printf("\n  pmfit fit %s --order %d", run.path.c_str(), ex.final_order);
+    for (const std::string &a : ex.final_adds)
+        std::printf(a.find('\'') == std::string::npos ? " --add '%s'" : " --add \"%s\"", a.c_str());
+    std::printf("   # fits the explained model\n");
+}
+
+} // namespace pmhost
