@@ -735,16 +735,44 @@ extern "C" int pmx_explain(const char *path, int order, double alpha, pmx_result
 extern "C" int pmx_explain_gears(const char *path, int order, double alpha, const double *gears,
                                  int n_gears, pmx_result *out, char *err, size_t errlen)
 {
+    pmx_options o;
+    pmx_options_default(&o);
+    o.order = order;
+    o.alpha = alpha;
+    o.gears = gears;
+    o.n_gears = n_gears;
+    return pmx_explain_opts(path, &o, out, err, errlen);
+}
+
+extern "C" void pmx_options_default(pmx_options *o)
+{
+    pmhost::ExplainOptions d;
+    o->order = d.order;
+    o->alpha = d.alpha;
+    o->gears = NULL;
+    o->n_gears = 0;
+    o->pairs = d.pairs ? 1 : 0;
+    o->folds = d.folds;
+}
+
+extern "C" int pmx_explain_opts(const char *path, const pmx_options *opt, pmx_result *out,
+                                char *err, size_t errlen)
+{
     using namespace pmhost;
-    if (!path || !out || n_gears < 0 || (n_gears > 0 && !gears)) {
+    if (!path || !out || !opt || opt->n_gears < 0 || (opt->n_gears > 0 && !opt->gears) ||
+        opt->folds < 2) {
         set_err(err, errlen, "pmx_explain: invalid arguments");
         return -1;
     }
+    const double *gears = opt->gears;
+    int n_gears = opt->n_gears;
     try {
         Run run = load_run(path, true, false);
         ExplainOptions o;
-        o.order = order;
-        o.alpha = alpha;
+        o.order = opt->order;
+        o.alpha = opt->alpha;
+        o.pairs = opt->pairs != 0;
+        o.folds = opt->folds;
         for (int i = 0; i < n_gears; i++) {
             if (!(gears[i] > 0 && gears[i] <= 1e6)) {
                 set_err(err, errlen, "pmx_explain: a gear period must be in (0, 1e6]");
@@ -778,7 +806,28 @@ extern "C" int pmx_explain_gears(const char *path, int order, double alpha, cons
             g.n_lines = (int)f.lines.size();
             for (size_t k = 0; k < f.lines.size() && k < 16; k++)
                 g.lines[k] = f.lines[k];
+            std::snprintf(g.with, sizeof g.with, "%s", f.with.c_str());
+            for (const Alternative &a : f.alternatives) {
+                if (g.n_alternatives >= PMX_MAX_ALTERNATIVES)
+                    break;
+                pmx_alternative &b = g.alternatives[g.n_alternatives++];
+                std::snprintf(b.effect, sizeof b.effect, "%s", a.effect.c_str());
+                std::snprintf(b.separate_by, sizeof b.separate_by, "%s", a.separate_by.c_str());
+                b.delta_bic = a.delta_bic;
+                b.log10_lr = a.log10_lr;
+                b.log10_fap = a.log10_fap;
+            }
         }
+        for (const Interpretation &it : ex.interpretation) {
+            if (r.n_readings >= PMX_MAX_READINGS)
+                break;
+            pmx_reading &b = r.readings[r.n_readings++];
+            std::snprintf(b.what, sizeof b.what, "%s", it.what.c_str());
+            std::snprintf(b.unit, sizeof b.unit, "%s", it.unit.c_str());
+            b.value = it.value;
+            b.error = it.error;
+        }
+        r.physical_reading = !ex.physical_reading.empty();
         *out = r;
     } catch (const std::exception &x) {
         set_err(err, errlen, x.what());

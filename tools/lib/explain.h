@@ -12,6 +12,24 @@ extern "C" {
 #endif
 
 #define PMX_MAX_FINDINGS 8
+#define PMX_MAX_ALTERNATIVES 4
+#define PMX_MAX_READINGS 12
+
+/* Another reading of the same residuals with close evidence. */
+typedef struct pmx_alternative {
+    char effect[24];
+    double delta_bic;                /* BIC(alternative) - BIC(chosen), >= 0 */
+    double log10_lr;                 /* log10 likelihood ratio chosen : alternative */
+    double log10_fap;                /* its own false-alarm probability, log10 */
+    char separate_by[160];           /* the observation that would tell them apart */
+} pmx_alternative;
+
+/* One item of the physical reading of the baseline. */
+typedef struct pmx_reading {
+    char what[32];                   /* polar_altitude, collimation, ... */
+    double value, error;
+    char unit[8];                    /* "arcmin" or "arcsec" */
+} pmx_reading;
 
 typedef struct pmx_finding {
     char effect[24];                 /* ha_periodic, refraction, ... */
@@ -22,6 +40,9 @@ typedef struct pmx_finding {
     int n_params_after;
     int n_lines;                     /* outliers: how many points */
     int lines[16];                   /* their file lines (the first 16) */
+    char with[24];                   /* found as a pair with this effect, else "" */
+    int n_alternatives;
+    pmx_alternative alternatives[PMX_MAX_ALTERNATIVES];
 } pmx_finding;
 
 typedef struct pmx_result {
@@ -31,6 +52,9 @@ typedef struct pmx_result {
     pmx_finding findings[PMX_MAX_FINDINGS];
     double final_sigma_arcsec, final_cv_rms_arcsec;
     int final_n_params;
+    int n_readings;                  /* the physical reading of the baseline */
+    pmx_reading readings[PMX_MAX_READINGS];
+    int physical_reading;            /* 1: order 0 + one term predicts as well as order 1 */
 } pmx_result;
 
 /* Explain the run in file path from a baseline of the given order; alpha is
@@ -43,6 +67,22 @@ int pmx_explain(const char *path, int order, double alpha, pmx_result *out, char
 ** axes; pmfit explain --gear): the periodic search looks at these only. */
 int pmx_explain_gears(const char *path, int order, double alpha, const double *gears,
                       int n_gears, pmx_result *out, char *err, size_t errlen);
+
+/* Every option (pmx_options_default: order 1, alpha 0.01, no gears,
+** pairs on, folds 5). */
+typedef struct pmx_options {
+    int order;                       /* baseline harmonic order */
+    double alpha;                    /* false-alarm probability to beat */
+    const double *gears;             /* known gear periods, both axes (may be NULL) */
+    int n_gears;
+    int pairs;                       /* 1: where no single family passes, try pairs */
+    int folds;                       /* k of the k-fold cross-validation */
+} pmx_options;
+
+void pmx_options_default(pmx_options *o);
+
+int pmx_explain_opts(const char *path, const pmx_options *o, pmx_result *out, char *err,
+                     size_t errlen);
 
 #ifdef __cplusplus
 }

@@ -99,6 +99,18 @@ Interpretation item(const char *what, double v, double e, const char *unit, cons
     return it;
 }
 
+// An angle and its error (radians) as text: arcminutes from 1', else
+// arcseconds (0.01' would hide a well-measured 0.7").
+std::string angle_text(double v, double e)
+{
+    char b[80];
+    if (std::fabs(v) * RAD2AS >= 60)
+        std::snprintf(b, sizeof b, "%.2f' +- %.2f'", v * RAD2AS / 60, e * RAD2AS / 60);
+    else
+        std::snprintf(b, sizeof b, "%.2f\" +- %.2f\"", v * RAD2AS, e * RAD2AS);
+    return b;
+}
+
 void polar_items(const Run &run, const FitOut &f, std::vector<Interpretation> &out)
 {
     bool az = run.mount == PM_MOUNT_ALTAZ;
@@ -109,25 +121,25 @@ void polar_items(const Run &run, const FitOut &f, std::vector<Interpretation> &o
     char buf[400];
     if (az) {
         // the azimuth axis's tilt: toward azimuth 0 (north) and 90 (east)
-        std::snprintf(buf, sizeof buf, "azimuth axis tilted %.2f' +- %.2f' toward the north (negative: south)",
-                      v[0] * am, e[0] * am);
+        std::snprintf(buf, sizeof buf, "azimuth axis tilted %s toward the %s",
+                      angle_text(std::fabs(v[0]), e[0]).c_str(), v[0] >= 0 ? "north" : "south");
         out.push_back(item("axis_tilt_north", v[0] * am, e[0] * am, "arcmin", buf));
-        std::snprintf(buf, sizeof buf, "azimuth axis tilted %.2f' +- %.2f' toward the east (negative: west)",
-                      v[1] * am, e[1] * am);
+        std::snprintf(buf, sizeof buf, "azimuth axis tilted %s toward the %s",
+                      angle_text(std::fabs(v[1]), e[1]).c_str(), v[1] >= 0 ? "east" : "west");
         out.push_back(item("axis_tilt_east", v[1] * am, e[1] * am, "arcmin", buf));
         return;
     }
     // from the pole, hour angle 0 is toward the zenith, +6h toward the west
     double cl = std::isfinite(run.latitude) ? std::cos(run.latitude) : NAN;
-    std::snprintf(buf, sizeof buf, "polar axis %.2f' +- %.2f' %s the pole in altitude%s", std::fabs(v[0]) * am,
-                  e[0] * am, v[0] >= 0 ? "above" : "below",
+    std::snprintf(buf, sizeof buf, "polar axis %s %s the pole in altitude%s",
+                  angle_text(std::fabs(v[0]), e[0]).c_str(), v[0] >= 0 ? "above" : "below",
                   std::isfinite(run.latitude) ? "" : " (latitude not given: the north pole taken)");
     out.push_back(item("polar_altitude", v[0] * am, e[0] * am, "arcmin", buf));
-    char az_deg[96] = "";
+    std::string az_deg;
     if (std::isfinite(cl) && cl > 0.05)
-        std::snprintf(az_deg, sizeof az_deg, "; %.2f' in azimuth at this latitude", std::fabs(v[1]) * am / cl);
-    std::snprintf(buf, sizeof buf, "polar axis %.2f' +- %.2f' %s of the pole on the sky%s", std::fabs(v[1]) * am,
-                  e[1] * am, v[1] >= 0 ? "west" : "east", az_deg);
+        az_deg = "; " + angle_text(std::fabs(v[1]) / cl, e[1] / cl) + " in azimuth at this latitude";
+    std::snprintf(buf, sizeof buf, "polar axis %s %s of the pole on the sky%s",
+                  angle_text(std::fabs(v[1]), e[1]).c_str(), v[1] >= 0 ? "west" : "east", az_deg.c_str());
     out.push_back(item("polar_azimuth_west", v[1] * am, e[1] * am, "arcmin", buf));
 }
 
@@ -136,17 +148,22 @@ void axis_items(const Run &run, const FitOut &f, std::vector<Interpretation> &ou
     bool az = run.mount == PM_MOUNT_ALTAZ;
     const double as = RAD2AS;
     char buf[300];
+    // the indices as "apparent minus encoder": c' shifts tau by +c', e'
+    // shifts delta by -e' (docs/model.md, the base vectors)
     struct {
         int k;
+        double sign;
         const char *key, *words;
-    } t[4] = {{3, "non_perpendicularity", az ? "elevation axis not perpendicular to the azimuth axis by"
-                                             : "declination axis not perpendicular to the polar axis by"},
-              {5, "collimation", az ? "optical axis not perpendicular to the elevation axis (collimation) by"
-                                    : "optical axis not perpendicular to the declination axis (collimation) by"},
-              {2, "index_axis1", az ? "azimuth encoder zero point (index) off by" : "hour-angle encoder zero point (index) off by"},
-              {4, "index_axis2", az ? "elevation encoder zero point (index) off by" : "declination encoder zero point (index) off by"}};
+    } t[4] = {{3, 1, "non_perpendicularity", az ? "elevation axis not perpendicular to the azimuth axis by"
+                                                : "declination axis not perpendicular to the polar axis by"},
+              {5, 1, "collimation", az ? "optical axis not perpendicular to the elevation axis (collimation) by"
+                                       : "optical axis not perpendicular to the declination axis (collimation) by"},
+              {2, 1, "index_axis1", az ? "azimuth index (true minus encoder azimuth)"
+                                       : "hour-angle index (true minus encoder hour angle)"},
+              {4, -1, "index_axis2", az ? "elevation index (true minus encoder elevation)"
+                                        : "declination index (true minus encoder declination, pier east)"}};
     for (const auto &x : t) {
-        double v = f.model.coef[x.k] * as, e = f.res.err[x.k] * as;
+        double v = x.sign * f.model.coef[x.k] * as, e = f.res.err[x.k] * as;
         if (std::fabs(v) < 600)
             std::snprintf(buf, sizeof buf, "%s %.2f\" +- %.2f\"", x.words, v, e);
         else // an index of degrees reads better in degrees; the error stays in arcsec
