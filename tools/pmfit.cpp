@@ -16,6 +16,7 @@
 #include "runfile.h"
 #include "modelfile.h"
 #include "simulate.h"
+#include "inject.hpp"
 #include "hostutil.hpp"
 #include "fitrun.hpp"
 #include "explain.hpp"
@@ -68,6 +69,9 @@ struct Options {
     std::vector<std::pair<std::string, double>> terms;
     std::vector<std::pair<std::string, double>> effects; // simulate --effect SPEC=ARCSEC
     double phase_deg = 0;
+    std::vector<std::string> inject; // simulate --inject EFFECT[=SIZE] --into RUN
+    std::string into;
+    std::string shape_opt;           // a simulate option that shapes a simulated run
 };
 
 void usage(FILE *f)
@@ -147,7 +151,15 @@ void usage(FILE *f)
         "                   time_drift: arcsec per deg C / per hour; hysteresis: arcsec per\n"
         "                   unit of direction, i.e. half the backlash), or outlier[:N] (N\n"
         "                   points off by V) or higher_order (order L+1 terms of RMS V);\n"
-        "                   repeatable\n",
+        "                   repeatable\n"
+        "\n"
+        "usage: pmfit simulate --inject EFFECT[=SIZE] [--inject ...] --into RUN OUT\n"
+        "                      [--phase DEG] [--seed S] [--no-refraction] [--skip-bad]\n"
+        "\n"
+        "  the real run RUN with a known effect added to its observed positions (its noise\n"
+        "  and everything it holds unchanged), written to OUT in the named-column format:\n"
+        "  EFFECT as for --effect; SIZE in arcsec (EFFECT=2.5), or in units of the run's\n"
+        "  baseline sigma (EFFECT=1.5sigma, also EFFECT:1.5sigma); default 1sigma\n",
         PM_MAX_L, ROBUST_DEFAULT_CLIP);
 }
 
@@ -199,6 +211,8 @@ Options parse_args(int argc, char **argv)
             return argv[++i];
         };
         if (!eval && a == "--order") {
+            if (sim)
+                o.shape_opt = a;
             const char *v = need("an order");
             if (!parse_int(v, &o.order) || o.order < 0 || o.order > PM_MAX_L)
                 die(std::string("--order: expected an integer 0..") +
@@ -240,26 +254,30 @@ Options parse_args(int argc, char **argv)
             o.save = need("a file name");
         } else if (!sim && !eval && !expl && a == "--emit-c") {
             o.emit_c = need("a file name");
-        } else if (sim && a == "--n") {
+        } else if (sim && a == "--inject") {
+            o.inject.push_back(need("EFFECT[=SIZE]"));
+        } else if (sim && a == "--into") {
+            o.into = need("a run file");
+        } else if (sim && a == "--n" && (o.shape_opt = a, true)) {
             o.n = (long)number(a, need("a count"), 1, 1e7);
         } else if (sim && a == "--seed") {
             o.seed = (unsigned long long)number(a, need("a seed"), 0, 1e15);
-        } else if (sim && a == "--lat") {
+        } else if (sim && a == "--lat" && (o.shape_opt = a, true)) {
             o.lat = number(a, need("degrees"), -90, 90);
-        } else if (sim && a == "--el-limit") {
+        } else if (sim && a == "--el-limit" && (o.shape_opt = a, true)) {
             o.el_limit = number(a, need("degrees"), -10, 80);
-        } else if (sim && a == "--noise") {
+        } else if (sim && a == "--noise" && (o.shape_opt = a, true)) {
             o.noise = number(a, need("arcseconds"), 0, 1e5);
-        } else if (sim && a == "--random-aniso") {
+        } else if (sim && a == "--random-aniso" && (o.shape_opt = a, true)) {
             o.random_aniso = number(a, need("arcseconds"), 0, 1e5);
-        } else if (sim && a == "--fork") {
+        } else if (sim && a == "--fork" && (o.shape_opt = a, true)) {
             o.fork = true;
-        } else if (sim && a == "--mount") {
+        } else if (sim && a == "--mount" && (o.shape_opt = a, true)) {
             std::string v = need("equatorial or altaz");
             if (v != "equatorial" && v != "altaz")
                 die("--mount: expected equatorial or altaz, got '" + v + "'");
             o.altaz = v == "altaz";
-        } else if (sim && a == "--effect") {
+        } else if (sim && a == "--effect" && (o.shape_opt = a, true)) {
             std::string v = need("SPEC=ARCSEC");
             size_t eq = v.rfind('=');
             if (eq == std::string::npos || eq == 0)
@@ -267,15 +285,15 @@ Options parse_args(int argc, char **argv)
             o.effects.push_back({v.substr(0, eq), number(a, v.c_str() + eq + 1, -1e6, 1e6)});
         } else if (sim && a == "--phase") {
             o.phase_deg = number(a, need("degrees"), -360, 360);
-        } else if (sim && a == "--term") {
+        } else if (sim && a == "--term" && (o.shape_opt = a, true)) {
             std::string v = need("NAME=ARCSEC");
             size_t eq = v.rfind('=');
             if (eq == std::string::npos || eq == 0)
                 die("--term: expected NAME=ARCSEC, got '" + v + "'");
             o.terms.push_back({v.substr(0, eq), number(a, v.c_str() + eq + 1, -1e6, 1e6)});
-        } else if (!sim && a == "--no-refraction") {
+        } else if (a == "--no-refraction") {
             o.refraction = false;
-        } else if (!sim && a == "--skip-bad") {
+        } else if (a == "--skip-bad") {
             o.skip_bad = true;
         } else if (!sim && !eval && a == "--robust") {
             o.robust = true;
@@ -292,6 +310,16 @@ Options parse_args(int argc, char **argv)
             die("more than one run file given ('" + o.run + "', '" + a + "')");
         }
     }
+    if (sim && !o.into.empty() && !o.shape_opt.empty())
+        die(o.shape_opt + " shapes a simulated run; with --into the run is the recording (only "
+                          "--inject, --phase, --seed, --no-refraction and --skip-bad apply)");
+    if (sim && o.into.empty() && !o.inject.empty())
+        die("--inject needs --into RUN (the recording to inject into); to simulate a run with "
+            "an effect use --effect");
+    if (sim && !o.into.empty() && o.inject.empty())
+        die("--into RUN needs at least one --inject EFFECT[=SIZE]");
+    if (sim && o.into.empty() && (!o.refraction || o.skip_bad))
+        die("--no-refraction and --skip-bad apply to reading a run: with --into only");
     if (o.clip_given && !o.robust)
         die("--clip K sets the threshold of --robust; add --robust");
     if (eval && o.model.empty())
@@ -726,8 +754,71 @@ int cmd_explain(const Options &o, const Run &full)
     return 0;
 }
 
+// pmfit simulate --inject EFFECT[=SIZE] --into RUN OUT
+int cmd_inject(const Options &o, int argc, char **argv)
+{
+    std::vector<Injection> list;
+    for (const std::string &spec : o.inject) {
+        Injection in;
+        try {
+            in = parse_injection(spec);
+        } catch (const std::exception &e) {
+            die(e.what());
+        }
+        in.phase_deg = o.phase_deg;
+        in.seed = o.seed;
+        list.push_back(in);
+    }
+    Run run = load_run(o.into, o.refraction, o.skip_bad);
+    for (const std::string &n : run.notes)
+        std::fprintf(stderr, "pmfit: note: %s\n", n.c_str());
+    InjectReport rep = inject(run, list);
+    std::vector<std::string> head;
+    std::string cmd = "made by:";
+    for (int i = 0; i < argc; i++)
+        cmd += std::string(" ") + argv[i];
+    head.push_back(cmd);
+    char b[512];
+    std::snprintf(b, sizeof b, "the recording %s (%zu points, baseline order %d, sigma %.4f arcsec)",
+                  o.into.c_str(), run.obs.size(), rep.order, rep.sigma_arcsec);
+    head.push_back(b);
+    std::vector<size_t> slot(list.size(), 0);
+    for (size_t k = 0; k < list.size(); k++) {
+        std::snprintf(b, sizeof b, "injected %s of size %.6g arcsec (%.4g sigma), phase %g deg, seed "
+                      "%llu: RMS displacement %.4f arcsec per axis (%.4g sigma)",
+                      list[k].effect.c_str(), rep.size_arcsec[k], rep.size_arcsec[k] / rep.sigma_arcsec,
+                      list[k].phase_deg, list[k].seed, rep.rms_arcsec[k],
+                      rep.rms_arcsec[k] / rep.sigma_arcsec);
+        head.push_back(b);
+        if (!rep.moved[k].empty()) {
+            slot[k] = head.size();
+            head.push_back(""); // the moved lines, below
+        }
+    }
+    // the moved points' lines in RUN and in OUT (after the comments, the
+    // latitude, mount and column lines)
+    size_t first = head.size() + (std::isfinite(run.latitude) ? 1 : 0) + 2 + 1;
+    for (size_t k = 0; k < list.size(); k++) {
+        if (rep.moved[k].empty())
+            continue;
+        std::string in_run = "moved lines " + o.into + ":", in_out = "; in " + o.run + ":";
+        for (int j : rep.moved[k]) {
+            in_run += " " + std::to_string(run.obs[(size_t)j].line);
+            in_out += " " + std::to_string(first + (size_t)j);
+        }
+        head[slot[k]] = in_run + in_out;
+    }
+    write_named_run(run, o.run, head);
+    for (size_t k = 1; k < head.size(); k++)
+        std::fprintf(stderr, "pmfit: %s\n", head[k].c_str());
+    std::fprintf(stderr, "pmfit: wrote %s\n", o.run.c_str());
+    return 0;
+}
+
 int cmd_simulate(const Options &o, int argc, char **argv)
 {
+    if (!o.into.empty())
+        return cmd_inject(o, argc, argv);
     pmsim_spec spec;
     pmsim_default(&spec);
     spec.n = o.n;

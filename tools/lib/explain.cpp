@@ -95,7 +95,7 @@ double period_power(const Run &run, const std::vector<int> &idx, const std::vect
 // chi^2 exceeds the best G's by more than 3.84 times the noise variance
 // left once the sinusoid is removed (chi^2 with one degree of freedom).
 void refine_peak(const Run &run, const FitOut &f, const std::vector<double> &r, int comp,
-                 double sigma2, Periodogram &pg)
+                 double sigma2, double g_lo, Periodogram &pg)
 {
     std::vector<size_t> order(pg.g.size());
     std::iota(order.begin(), order.end(), 0);
@@ -103,7 +103,7 @@ void refine_peak(const Run &run, const FitOut &f, const std::vector<double> &r, 
               [&](size_t a, size_t b) { return pg.power[a] > pg.power[b]; });
     for (size_t k = 0; k < order.size() && k < 3; k++) {
         double g0 = pg.g[order[k]];
-        for (double G = g0 - 1; G <= g0 + 1; G += 0.02) {
+        for (double G = std::max(g0 - 1, g_lo); G <= g0 + 1; G += 0.02) {
             double p = period_power(run, f.idx, r, comp, G) / sigma2;
             if (p > pg.peak_power) {
                 pg.peak_power = p;
@@ -120,6 +120,29 @@ void refine_peak(const Run &run, const FitOut &f, const std::vector<double> &r, 
         pg.peak_g = gi;
 }
 
+// The extent of the axis angle the run samples (radians): the circle less
+// its largest empty gap.
+double sampled_extent(const Run &run, const std::vector<int> &idx, int comp)
+{
+    std::vector<double> a;
+    for (int i : idx) {
+        double th = comp == 0 ? run.obs[i].eh : run.obs[i].ed;
+        a.push_back(th - 2 * PI * std::floor(th / (2 * PI)));
+    }
+    if (a.size() < 2)
+        return 0;
+    std::sort(a.begin(), a.end());
+    double gap = a.front() + 2 * PI - a.back();
+    for (size_t k = 1; k < a.size(); k++)
+        gap = std::max(gap, a[k] - a[k - 1]);
+    return 2 * PI - gap;
+}
+
+// The periodogram of one axis.  A period is identifiable as periodic only
+// if the run samples two of its cycles: G below 2 turns / extent is a
+// smooth function of the angle over the sampled range (flexure, higher
+// order), not a gear error -- an alt-az elevation axis sampled over 65 deg
+// starts at G = 12.
 Periodogram periodogram(const Run &run, const FitOut &f, int comp, const ExplainOptions &opt,
                         double sigma2)
 {
@@ -128,7 +151,9 @@ Periodogram periodogram(const Run &run, const FitOut &f, int comp, const Explain
     std::vector<double> r0, r1;
     frame_residuals(run, f, &r0, &r1);
     const std::vector<double> &r = comp == 0 ? r0 : r1;
-    for (double G = std::ceil(opt.g_min); G <= opt.g_max; G += 1) {
+    double extent = sampled_extent(run, f.idx, comp);
+    double g_lo = std::max(opt.g_min, extent > 0 ? 4 * PI / extent : opt.g_max);
+    for (double G = std::ceil(g_lo); G <= opt.g_max; G += 1) {
         pg.g.push_back(G);
         pg.power.push_back(period_power(run, f.idx, r, comp, G) / sigma2);
     }
@@ -144,7 +169,7 @@ Periodogram periodogram(const Run &run, const FitOut &f, int comp, const Explain
         }
         pg.trials = (double)gears.size();
     } else {
-        refine_peak(run, f, r, comp, sigma2, pg);
+        refine_peak(run, f, r, comp, sigma2, g_lo, pg);
         pg.trials = (double)pg.g.size();
     }
     pg.threshold = -2 * std::log(opt.alpha / pg.trials); // chi^2(2) tail at alpha / M
@@ -420,8 +445,8 @@ void score(const Run &run, const State &st, std::vector<Candidate> &cands, doubl
 
 // The first candidate (in order of evidence) that beats alpha and improves
 // the cross-validated RMS; -1 if none.
-int choose(const Run &run, const State &st, std::vector<Candidate> &cands,
-           const ExplainOptions &opt)
+int first_passing(const Run &run, const State &st, std::vector<Candidate> &cands,
+                  const ExplainOptions &opt)
 {
     for (size_t k = 0; k < cands.size(); k++) {
         Candidate &c = cands[k];
@@ -437,6 +462,45 @@ int choose(const Run &run, const State &st, std::vector<Candidate> &cands,
             return (int)k;
     }
     return -1;
+}
+
+// The physical reading before the generic one: when higher_order wins on
+// false-alarm probability but a significant single family of a few terms
+// has the lower BIC (noise fixed at higher_order's sigma) and improves the
+// cross-validated RMS too, take the family; higher_order stays a candidate
+// of the next step.  (The MMT's sag against an order-0 baseline: tube
+// flexure, one term, rather than the 16 terms of order 1.)
+int simpler_reading(const Run &run, const State &st, std::vector<Candidate> &cands, int k,
+                    const ExplainOptions &opt)
+{
+    const Candidate &h = cands[(size_t)k];
+    double s2 = h.fit.chi2 / (double)(2 * h.fit.N - h.fit.P), ln2n = std::log((double)(2 * h.fit.N));
+    double best = h.fit.chi2 / s2 + h.fit.P * ln2n;
+    int pick = k;
+    for (size_t j = 0; j < cands.size(); j++) {
+        Candidate &c = cands[j];
+        if ((int)j == k || c.effect == "outlier" || c.effect == "higher_order" || !c.fit.ok ||
+            c.fit.P <= st.cur.P || !(c.log_fap < std::log(opt.alpha)))
+            continue;
+        double bic = c.fit.chi2 / s2 + c.fit.P * ln2n;
+        if (!(bic < best))
+            continue;
+        c.cv = cv_rms(run, st.use, c.order, c.adds, opt.folds, opt.seed);
+        if (!(c.cv < st.cur_cv))
+            continue;
+        best = bic;
+        pick = (int)j;
+    }
+    return pick;
+}
+
+int choose(const Run &run, const State &st, std::vector<Candidate> &cands,
+           const ExplainOptions &opt)
+{
+    int k = first_passing(run, st, cands, opt);
+    if (k < 0 || cands[(size_t)k].effect != "higher_order")
+        return k;
+    return simpler_reading(run, st, cands, k, opt);
 }
 
 // Pairs of the single families (not higher_order, not outliers) where no

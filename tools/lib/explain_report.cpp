@@ -147,9 +147,12 @@ void print_findings(const Explanation &ex, double alpha)
                     f.where.c_str(), f.false_alarm_probability, f.log10_p, f.sigma_after_arcsec,
                     f.cv_rms_after_arcsec, f.n_params_after);
         for (const Alternative &a : f.alternatives)
-            std::printf("     as good a reading: %s (false-alarm 10^%.1f, Delta BIC %+.1f, "
+            std::printf("     as good a reading: %s (false-alarm 10^%.1f, Delta BIC %+.1f%s, "
                         "likelihood ratio 10^%.2f in favour of %s); to separate them: %s\n",
-                        a.effect.c_str(), a.log10_fap, a.delta_bic, a.log10_lr, f.effect.c_str(),
+                        a.effect.c_str(), a.log10_fap, a.delta_bic,
+                        a.delta_bic < 0 ? ": BIC, which does not count the periods or candidates "
+                                          "tried, prefers it" : "",
+                        std::fabs(a.log10_lr), a.log10_lr >= 0 ? f.effect.c_str() : a.effect.c_str(),
                         a.separate_by.c_str());
     }
 }
