@@ -139,10 +139,10 @@ double sampled_extent(const Run &run, const std::vector<int> &idx, int comp)
 }
 
 // The periodogram of one axis.  A period is identifiable as periodic only
-// if the run samples two of its cycles: G below 2 turns / extent is a
-// smooth function of the angle over the sampled range (flexure, higher
-// order), not a gear error -- an alt-az elevation axis sampled over 65 deg
-// starts at G = 12.
+// if the run samples one and a half of its cycles (a maximum, a minimum and
+// the way back): below that a sinusoid is one smooth bump over the sampled
+// range (flexure, higher order), not a gear error -- an alt-az elevation
+// axis sampled over 65 deg starts at G = 9, a full azimuth circle at 2.
 Periodogram periodogram(const Run &run, const FitOut &f, int comp, const ExplainOptions &opt,
                         double sigma2)
 {
@@ -152,7 +152,7 @@ Periodogram periodogram(const Run &run, const FitOut &f, int comp, const Explain
     frame_residuals(run, f, &r0, &r1);
     const std::vector<double> &r = comp == 0 ? r0 : r1;
     double extent = sampled_extent(run, f.idx, comp);
-    double g_lo = std::max(opt.g_min, extent > 0 ? 4 * PI / extent : opt.g_max);
+    double g_lo = std::max(opt.g_min, extent > 0 ? 3 * PI / extent : opt.g_max);
     for (double G = std::ceil(g_lo); G <= opt.g_max; G += 1) {
         pg.g.push_back(G);
         pg.power.push_back(period_power(run, f.idx, r, comp, G) / sigma2);
