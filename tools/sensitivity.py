@@ -23,6 +23,7 @@ import argparse
 import json
 import math
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -112,7 +113,9 @@ def applicable(path, spec, tmp, pmfit):
     try:
         p = run([pmfit, "simulate", "--inject", spec + "=1sigma", "--into", path, out])
     except RuntimeError as e:
-        return False, str(e).split(": ", 1)[-1][:120]
+        if "input it needs is missing" in str(e):
+            return False, "the run does not give the input it reads (time or temperature)"
+        return False, str(e).split(": ", 1)[-1][:160]
     rms = float(p.stderr.split("RMS displacement ")[1].split()[0])
     if rms <= 0:
         return False, "moves nothing on this run (the input it reads is constant)"
@@ -184,6 +187,10 @@ def main():
     n_trials = 4 if a.quick else 8
     result = {}
     with tempfile.TemporaryDirectory(prefix="pm_sens_") as tmp:
+        # a copy: a rebuild during the hour this takes must not pull the program away
+        exe = os.path.join(tmp, "pmfit")
+        shutil.copy(a.pmfit, exe)
+        a.pmfit = exe
         for name in a.runs:
             path = os.path.join(a.data, name)
             if not os.path.exists(path):

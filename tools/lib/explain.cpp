@@ -327,6 +327,34 @@ void add_candidate(std::vector<Candidate> &cands, const State &st, const std::st
     cands.push_back(c);
 }
 
+bool opt_is_scan(const ExplainOptions &opt, int comp)
+{
+    return (comp ? opt.gears_dec : opt.gears_ha).empty();
+}
+
+// The periodogram decides integer vs non-integer G on the baseline's
+// residuals; a term correlated with the model's own terms can tip it.  The
+// full fits decide: the integer (a worm has whole teeth) unless its chi^2
+// exceeds the non-integer's by more than 3.84 sigma^2.
+void prefer_integer(const Run &run, const State &st, const char *prefix, double &G)
+{
+    double gi = std::round(G);
+    if (G == gi || std::fabs(G - gi) >= 0.5 || gi < 1)
+        return;
+    char a[64], b[64];
+    std::snprintf(a, sizeof a, "%s%.6g", prefix, gi);
+    std::snprintf(b, sizeof b, "%s%.6g", prefix, G);
+    std::vector<std::string> ai = st.adds, bi = st.adds;
+    ai.push_back(a);
+    bi.push_back(b);
+    Fit fi = fit_spec(run, st.use, st.order, ai), fg = fit_spec(run, st.use, st.order, bi);
+    if (!fi.ok || !fg.ok)
+        return;
+    double s2 = fg.chi2 / (double)std::max(1L, 2 * fg.N - fg.P);
+    if ((fi.chi2 - fg.chi2) / s2 <= 3.84)
+        G = gi;
+}
+
 void periodic_candidates(const Run &run, const State &st, const ExplainOptions &opt,
                          std::vector<Candidate> &cands)
 {
@@ -339,6 +367,8 @@ void periodic_candidates(const Run &run, const State &st, const ExplainOptions &
         Periodogram pg = periodogram(run, st.cur.f, comp, opt, sg2);
         if (already || !(pg.peak_g > 0))
             continue;
+        if (opt_is_scan(opt, comp))
+            prefer_integer(run, st, prefix, pg.peak_g);
         char spec[64];
         std::snprintf(spec, sizeof spec, "%s%.6g", prefix, pg.peak_g);
         add_candidate(cands, st, comp ? "dec_periodic" : "ha_periodic", {spec});

@@ -1,0 +1,270 @@
+/*
+**  check_inject.c - pmfit simulate --inject EFFECT[=SIZE] --into RUN OUT:
+**  a known effect added to a recording, its noise and everything else kept.
+**
+**  - Nothing injected (size 0) gives the same run: positions to 1e-9",
+**    the same explanation (the bundled flip_gem run of an independent numpy
+**    gimbal, and the real runs of ../shared/data when present).
+**  - Injecting +s and then -s gives the recording back to 0.1% of the
+**    largest displacement (each injection works in the frame of its run's
+**    own baseline fit, which the first one moves by the effect's share the
+**    fit absorbs: a second-order difference).
+**  - Injected effects are found by explain with their size (flip_gem:
+**    refraction, hysteresis, an HA periodic error, an outlier at the line
+**    the tool reports).
+**  - Misuse is a clear error and writes nothing.
+*/
+#define _POSIX_C_SOURCE 200809L
+#include <check.h>
+#include "tu_check.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "pm.h"
+#include "explain.h"
+#include "runfile.h"
+#include "testutil.h"
+#include "tu_tool.h"
+
+static char tmpdir[256];
+static char out[1 << 16];
+
+static void setup(void)
+{
+    if (!tmpdir[0])
+        tu_tmpdir(tmpdir, "pm_inject_");
+}
+
+static void flip_path(char *buf, size_t len)
+{
+    const char *top = getenv("PM_TOP");
+    snprintf(buf, len, "%s/tests/data/flip_gem_pm180.dat", top ? top : ".");
+}
+
+static pmrun *read_run(const char *path)
+{
+    pmrun_options o;
+    pmrun *r = NULL;
+    char err[512];
+    pmrun_options_default(&o);
+    ck_assert_msg(pmrun_read(path, &o, &r, err, sizeof err) == 0, "%s", err);
+    return r;
+}
+
+/* Largest difference of the apparent positions on the sky (arcsec). */
+static double max_moved(const char *a, const char *b)
+{
+    pmrun *ra = read_run(a), *rb = read_run(b);
+    size_t i;
+    double worst = 0;
+    ck_assert_uint_eq(pmrun_count(ra), pmrun_count(rb));
+    for (i = 0; i < pmrun_count(ra); i++) {
+        const pmrun_obs *p = pmrun_get(ra, i), *q = pmrun_get(rb, i);
+        double d = tu_angle(p->app_ha, p->app_dec, q->app_ha, q->app_dec) / ARCSEC;
+        ck_assert(fabs(remainder(p->enc_ha - q->enc_ha, 2 * M_PI)) < 1e-13);
+        ck_assert(fabs(p->enc_dec - q->enc_dec) < 1e-13);
+        if (d > worst)
+            worst = d;
+    }
+    pmrun_free(ra);
+    pmrun_free(rb);
+    return worst;
+}
+
+static int inject(const char *into, const char *spec, const char *extra, const char *dst)
+{
+    char cmd[2048];
+    snprintf(cmd, sizeof cmd, "%s simulate --inject '%s' %s --into '%s' '%s'", tu_pmfit_path(),
+             spec, extra ? extra : "", into, dst);
+    return tu_capture(cmd, out, sizeof out);
+}
+
+static void same_explanation(const char *a, const char *b)
+{
+    pmx_result x, y;
+    char err[512];
+    int k;
+    ck_assert_msg(pmx_explain(a, 1, 0.01, &x, err, sizeof err) == 0, "%s", err);
+    ck_assert_msg(pmx_explain(b, 1, 0.01, &y, err, sizeof err) == 0, "%s", err);
+    ck_assert(fabs(x.base_sigma_arcsec - y.base_sigma_arcsec) < 1e-6 * x.base_sigma_arcsec);
+    ck_assert_int_eq(x.n_findings, y.n_findings);
+    for (k = 0; k < x.n_findings; k++) {
+        ck_assert_str_eq(x.findings[k].effect, y.findings[k].effect);
+        ck_assert(fabs(x.findings[k].amplitude_arcsec - y.findings[k].amplitude_arcsec) <
+                  1e-6 * (1 + x.findings[k].amplitude_arcsec));
+    }
+}
+
+START_TEST(test_inject_nothing_same_run)
+{
+    static const char *real[3] = {"mmt/k_and_e.dat", "celestial/gem-28.dat",
+                                  "celestial/cgx-l-data.dat"};
+    char src[512], dst[512];
+    const char *d = tu_data_dir();
+    int k;
+    setup();
+    flip_path(src, sizeof src);
+    snprintf(dst, sizeof dst, "%s/zero.dat", tmpdir);
+    ck_assert_msg(inject(src, "refraction=0", NULL, dst) == 0, "%s", out);
+    ck_assert(max_moved(src, dst) < 1e-9);
+    same_explanation(src, dst);
+    if (!d) {
+        printf("check_inject: ../shared/data absent: the real runs skipped\n");
+        return;
+    }
+    for (k = 0; k < 3; k++) {
+        snprintf(src, sizeof src, "%s/%s", d, real[k]);
+        if (access(src, R_OK) != 0)
+            continue;
+        ck_assert_msg(inject(src, "hysteresis=0sigma", NULL, dst) == 0, "%s", out);
+        /* TPOINT files are reduced (refraction, precession): the same
+        ** apparent places, written to 1e-12 deg */
+        ck_assert_msg(max_moved(src, dst) < 1e-6, "%s moved by %g\"", real[k], max_moved(src, dst));
+        same_explanation(src, dst);
+    }
+}
+END_TEST
+
+START_TEST(test_inject_and_back)
+{
+    static const char *specs[4][2] = {{"refraction=2.5", "refraction=-2.5"},
+                                      {"ha_periodic:120=3", "ha_periodic:120=-3"},
+                                      {"i@W=4", "i@W=-4"},
+                                      {"higher_order=2", "higher_order=-2"}};
+    char src[512], a[512], b[512];
+    int k;
+    setup();
+    flip_path(src, sizeof src);
+    snprintf(a, sizeof a, "%s/plus.dat", tmpdir);
+    snprintf(b, sizeof b, "%s/back.dat", tmpdir);
+    for (k = 0; k < 4; k++) {
+        ck_assert_msg(inject(src, specs[k][0], "--phase 30", a) == 0, "%s", out);
+        ck_assert_msg(max_moved(src, a) > 1, "%s moved nothing", specs[k][0]);
+        ck_assert_msg(inject(a, specs[k][1], "--phase 30", b) == 0, "%s", out);
+        printf("check_inject: %s then back: %.2g\" from the recording\n", specs[k][0],
+               max_moved(src, b));
+        ck_assert(max_moved(src, b) < 1e-3 * max_moved(src, a));
+    }
+}
+END_TEST
+
+/* explain names what was injected into the independent gimbal's run, with
+** its size (25%); an outlier at the line the tool reports */
+START_TEST(test_inject_found)
+{
+    static const struct {
+        const char *spec, *name;
+        double G;
+    } cases[] = {{"refraction:4sigma", "refraction", 0},
+                 {"hysteresis:3sigma", "hysteresis", 0},
+                 {"ha_periodic:150:4sigma", "ha_periodic", 150},
+                 {"dec_periodic:97:4sigma", "dec_periodic", 97}};
+    char src[512], dst[512], err[512];
+    size_t k;
+    int j, found;
+    pmx_result r;
+    setup();
+    flip_path(src, sizeof src);
+    snprintf(dst, sizeof dst, "%s/found.dat", tmpdir);
+    for (k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        double size;
+        const char *p;
+        ck_assert_msg(inject(src, cases[k].spec, "--phase 70", dst) == 0, "%s", out);
+        p = strstr(out, "of size ");
+        ck_assert_ptr_nonnull(p);
+        size = atof(p + 8);
+        ck_assert_msg(pmx_explain(dst, 1, 0.01, &r, err, sizeof err) == 0, "%s", err);
+        found = 0;
+        for (j = 0; j < r.n_findings; j++)
+            if (!strcmp(r.findings[j].effect, cases[k].name) &&
+                (cases[k].G == 0 || r.findings[j].cycles_per_rev == cases[k].G)) {
+                found = 1;
+                printf("check_inject: flip_gem + %s (%.2f\"): found %s, %.2f\" +- %.2f\"\n",
+                       cases[k].spec, size, r.findings[j].effect, r.findings[j].amplitude_arcsec,
+                       r.findings[j].amplitude_err_arcsec);
+                ck_assert(fabs(r.findings[j].amplitude_arcsec - size) <= 0.25 * size);
+            }
+        ck_assert_msg(found, "%s not found", cases[k].spec);
+    }
+    ck_assert_msg(inject(src, "outlier=12sigma", "--seed 5", dst) == 0, "%s", out);
+    {
+        const char *p = strstr(out, "; in ");
+        int line;
+        ck_assert_ptr_nonnull(p);
+        p = strchr(p + 5, ':');
+        line = atoi(p + 1);
+        ck_assert_msg(pmx_explain(dst, 1, 0.01, &r, err, sizeof err) == 0, "%s", err);
+        ck_assert_int_ge(r.n_findings, 1);
+        ck_assert_str_eq(r.findings[0].effect, "outlier");
+        ck_assert_int_eq(r.findings[0].n_lines, 1);
+        ck_assert_int_eq(r.findings[0].lines[0], line);
+    }
+}
+END_TEST
+
+START_TEST(test_inject_misuse)
+{
+    static const struct {
+        const char *args, *says;
+    } bad[] = {
+        {"--inject refraction OUT", "--inject needs --into"},
+        {"--into RUN OUT", "needs at least one --inject"},
+        {"--inject refraction --into RUN --n 50 OUT", "--n shapes a simulated run"},
+        {"--inject refraction --into RUN --order 2 OUT", "--order shapes a simulated run"},
+        {"--inject nonsense --into RUN OUT", "nonsense"},
+        {"--inject refraction=2furlongs --into RUN OUT", "2furlongs"},
+        {"--inject time_drift --into RUN OUT", "flip_gem_pm180.dat:"},
+        {"--inject temperature --into RUN OUT", "flip_gem_pm180.dat:"},
+        {"--inject outlier:1000 --into RUN OUT", "outlier:N"},
+        {"--inject refraction --into /nonexistent.dat OUT", "/nonexistent.dat"},
+    };
+    char src[512], dst[512], cmd[4096], args[1024];
+    size_t k;
+    setup();
+    flip_path(src, sizeof src);
+    snprintf(dst, sizeof dst, "%s/never.dat", tmpdir);
+    for (k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        /* RUN and OUT replaced by the paths */
+        const char *s = bad[k].args;
+        char *w = args;
+        while (*s) {
+            if (!strncmp(s, "RUN", 3)) {
+                w += sprintf(w, "'%s'", src);
+                s += 3;
+            } else if (!strncmp(s, "OUT", 3)) {
+                w += sprintf(w, "'%s'", dst);
+                s += 3;
+            } else {
+                *w++ = *s++;
+            }
+        }
+        *w = 0;
+        snprintf(cmd, sizeof cmd, "%s simulate %s", tu_pmfit_path(), args);
+        ck_assert_msg(tu_capture(cmd, out, sizeof out) != 0, "accepted: %s", args);
+        ck_assert_msg(strstr(out, bad[k].says) != NULL, "%s: says '%s', not '%s'", args, out,
+                      bad[k].says);
+        ck_assert_msg(access(dst, F_OK) != 0, "%s: wrote the output", args);
+    }
+}
+END_TEST
+
+static Suite *suite(void)
+{
+    Suite *s = suite_create("inject");
+    TCase *t = tcase_create("inject");
+    tcase_set_timeout(t, 300);
+    tcase_add_test(t, test_inject_nothing_same_run);
+    tcase_add_test(t, test_inject_and_back);
+    tcase_add_test(t, test_inject_found);
+    tcase_add_test(t, test_inject_misuse);
+    suite_add_tcase(s, t);
+    return s;
+}
+
+int main(void)
+{
+    return tu_run_suite(suite());
+}
