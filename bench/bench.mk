@@ -4,6 +4,7 @@
 #
 #   build/bench/pmbench          host per-call cost (TSC ticks; --callgrind)
 #   build/bench/pmbench_fit      fit scaling, ours vs LAPACK dgels
+#   build/bench/pmbench_explain  pmfit explain's time on 1,000-30,000 points
 #   build/bench/<t>/bench.elf    Cortex-M per-call instructions (t = m4f, m7),
 #                                with the core at PM_MAX_L=4
 #   build/bench/results.json     everything, merged by bench/report.py
@@ -34,6 +35,11 @@ $(BN)/pmbench_fit: bench/bench_fit.c include/pm.h $(B)/libpm.a
 	@mkdir -p $(@D)
 	$(CC) $(BENCH_CFLAGS) $< $(B)/libpm.a -llapacke -llapack -lblas -lm -o $@
 
+$(BN)/pmbench_explain: bench/bench_explain.c include/pm.h tools/lib/explain.h tools/lib/simulate.h \
+                       $(B)/libpmhost.a $(B)/libpm.a
+	@mkdir -p $(@D)
+	$(CC) $(BENCH_CFLAGS) -Itools/lib $< $(B)/libpmhost.a $(B)/libpm.a -lerfa -lstdc++ -lm -o $@
+
 # $(call bench_target,T): the Cortex-M bench of target T.
 define bench_target
 $(call fw_core,$(BN)/$(1),$$(ARM_CXX),$$(FW_ARM_CXXFLAGS) $$(FW_CPU_$(1)),4)
@@ -55,7 +61,7 @@ $(foreach t,$(BENCH_TARGETS),$(eval $(call bench_target,$(t))))
 
 BENCH_ELFS := $(foreach t,$(BENCH_TARGETS),$(BN)/$(t)/bench.elf)
 
-bench-run: fw-toolchain $(BN)/pmbench $(BN)/pmbench_fit $(BENCH_ELFS)
+bench-run: fw-toolchain $(BN)/pmbench $(BN)/pmbench_fit $(BN)/pmbench_explain $(BENCH_ELFS)
 	@command -v valgrind > /dev/null || { echo "bench: valgrind not found (tools/deps.sh)"; exit 1; }
 	@echo "== host: TSC ticks per call ($(BENCH_BATCHES) batches of 256 calls, median)"
 	$(BN)/pmbench --batches $(BENCH_BATCHES) --out $(BN)/host.jsonl
@@ -69,6 +75,8 @@ bench-run: fw-toolchain $(BN)/pmbench $(BN)/pmbench_fit $(BENCH_ELFS)
 	  > $(BN)/$(t).out 2>&1 || { cat $(BN)/$(t).out; exit 1; };)
 	@echo "== fit scaling (N up to $(BENCH_MAX_N)); ours vs LAPACK dgels"
 	$(BN)/pmbench_fit --max-n $(BENCH_MAX_N) --out $(BN)/fit.jsonl
+	@echo "== pmfit explain on large runs"
+	$(BN)/pmbench_explain --out $(BN)/explain.jsonl
 	@$(PYTHON) bench/report.py --dir $(BN) --targets "$(BENCH_TARGETS)"
 
 .PHONY: bench-run

@@ -131,6 +131,7 @@ def main():
                 loop = raw.get(re.sub(r"_(fwd|inv_near|inv|naive_fwd|naive_inv)_", "_empty_", name))
             insns[name] = v - loop if loop is not None else v
     fit = read_jsonl(os.path.join(D, "fit.jsonl"))
+    expl = read_jsonl(os.path.join(D, "explain.jsonl"))
 
     # per-call entries
     entries = []
@@ -151,7 +152,7 @@ def main():
                 e["ratio_vs"] = vs
                 e["ratio"] = round(e[key] / ref, 4)
         entries.append(e)
-    results = entries + fit
+    results = entries + fit + expl
     with open(os.path.join(D, "results.json"), "w") as f:
         json.dump(results, f, indent=1)
         f.write("\n")
@@ -272,6 +273,13 @@ def main():
         say("   ours' memory above the data, L=2, N=%s: %s KB  %s" % (
             "..".join(str(r["n_obs"]) for r in (p2[0], p2[-1])),
             ", ".join(str(x) for x in ex), verdict(max(ex) - min(ex) < 1024)))
+    for r in expl:
+        if r["n_obs"] == 10000:
+            say("   pmfit explain, 10,000 points, < 5 s: %.2f s  %s (found %s)" % (
+                r["seconds"], verdict(r["seconds"] < 5), ", ".join(r["findings"]) or "nothing"))
+    if expl:
+        say("   explain time by size: " + ", ".join("N=%d %.2f s" % (r["n_obs"], r["seconds"])
+                                                     for r in expl))
     with open(os.path.join(D, "results.txt"), "w") as f:
         f.write("\n".join(lines) + "\n")
     print("results: %s" % os.path.join(D, "results.json"))

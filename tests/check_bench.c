@@ -54,11 +54,36 @@ START_TEST(test_bench_smoke_json)
 }
 END_TEST
 
+/* the explain bench at its smallest size: a JSON line with the time and
+** the two hidden effects found (timing is judged in bench/, not here) */
+START_TEST(test_bench_explain_smoke)
+{
+    char cmd[4096];
+    const char *d = "build/bench/smoke_explain";
+    unsetenv("MAKEFLAGS");
+    unsetenv("MFLAGS");
+    unsetenv("MAKELEVEL");
+    snprintf(cmd, sizeof cmd, "cd '%s' && make -s build/bench/pmbench_explain > /dev/null 2>&1", top());
+    ck_assert_int_eq(sh(cmd), 0);
+    snprintf(cmd, sizeof cmd, "cd '%s' && rm -rf %s && mkdir -p %s && "
+             "build/bench/pmbench_explain --max-n 1000 --out %s/explain.jsonl 2> %s/log.txt && "
+             "/usr/bin/python3 -c '"
+             "import json\n"
+             "r = [json.loads(l) for l in open(\"%s/explain.jsonl\")]\n"
+             "assert [e[\"n_obs\"] for e in r] == [1000]\n"
+             "assert r[0][\"seconds\"] > 0\n"
+             "assert sorted(r[0][\"findings\"]) == [\"ha_periodic\", \"refraction\"], r\n"
+             "' > %s/check.txt 2>&1", top(), d, d, d, d, d, d);
+    ck_assert_msg(sh(cmd) == 0, "pmbench_explain: see %s/check.txt", d);
+}
+END_TEST
+
 static Suite *suite(void)
 {
     Suite *s = suite_create("bench");
     TCase *tc = tcase_create("smoke");
     tcase_add_test(tc, test_bench_smoke_json);
+    tcase_add_test(tc, test_bench_explain_smoke);
     tcase_set_timeout(tc, 120);
     suite_add_tcase(s, tc);
     return s;
