@@ -251,6 +251,57 @@ START_TEST(test_inject_misuse)
 }
 END_TEST
 
+static double sag_reading(const char *path)
+{
+    pmx_result r;
+    char err[512];
+    int k;
+    ck_assert_msg(pmx_explain(path, 1, 0.01, &r, err, sizeof err) == 0, "%s", err);
+    for (k = 0; k < r.n_readings; k++)
+        if (!strcmp(r.readings[k].what, "tube_flexure_in_order1"))
+            return r.readings[k].value;
+    ck_abort_msg("%s: no sag reading", path);
+    return 0;
+}
+
+/* A sag injected into a real recording is read back by the physical
+** reading of the order-1 baseline ("what the baseline holds"): the reading
+** moves by the injected size (1%), whatever sag the run holds itself. */
+START_TEST(test_inject_sag_read_back)
+{
+    static const char *real[3] = {"mmt/k_and_e.dat", "celestial/gem-28.dat",
+                                  "celestial/cgx-l-data.dat"};
+    static const double sizes[3] = {2.0, -1.5, 3.0};
+    char src[512], dst[512];
+    const char *d = tu_data_dir();
+    int k;
+    setup();
+    snprintf(dst, sizeof dst, "%s/sag.dat", tmpdir);
+    for (k = 0; k < 3; k++) {
+        double r0, r1, size;
+        const char *p;
+        char spec[64];
+        if (!d) {
+            printf("check_inject: ../shared/data absent: skipped\n");
+            return;
+        }
+        snprintf(src, sizeof src, "%s/%s", d, real[k]);
+        if (access(src, R_OK) != 0)
+            continue;
+        snprintf(spec, sizeof spec, "tube_flexure=%gsigma", sizes[k]);
+        ck_assert_msg(inject(src, spec, NULL, dst) == 0, "%s", out);
+        p = strstr(out, "of size ");
+        ck_assert_ptr_nonnull(p);
+        size = atof(p + 8);
+        r0 = sag_reading(src);
+        r1 = sag_reading(dst);
+        printf("check_inject: %s: its order-1 terms hold a sag of %.2f\"; with %.2f\" injected "
+               "%.2f\" (moved by %.2f\")\n", real[k], r0, size, r1, r1 - r0);
+        ck_assert(fabs((r1 - r0) - size) <= 0.01 * fabs(size));
+    }
+}
+END_TEST
+
 static Suite *suite(void)
 {
     Suite *s = suite_create("inject");
@@ -260,6 +311,7 @@ static Suite *suite(void)
     tcase_add_test(t, test_inject_and_back);
     tcase_add_test(t, test_inject_found);
     tcase_add_test(t, test_inject_misuse);
+    tcase_add_test(t, test_inject_sag_read_back);
     suite_add_tcase(s, t);
     return s;
 }
