@@ -260,16 +260,24 @@ void describe_pier(const Run &run, const State &st, const Candidate &c,
     fd.text = buf;
 }
 
-// What a one-family effect is, in the mount's vocabulary.
-const char *family_words(const Run &run, const std::string &e)
+// What a one-family effect is, in the mount's vocabulary; sign: of the
+// (single) coefficient of refraction and tube flexure, + toward the zenith.
+const char *family_words(const Run &run, const std::string &e, double sign)
 {
     bool az = run.mount == PM_MOUNT_ALTAZ;
     if (e == "refraction")
-        return "an elevation-dependent shift toward the zenith growing as cot(el): refraction "
-               "missing or wrong in the reduction";
+        return sign >= 0 ? "an elevation-dependent shift toward the zenith growing as cot(el): "
+                           "refraction missing from the reduction or under-corrected"
+                         : "an elevation-dependent shift toward the horizon growing as cot(el): "
+                           "refraction over-corrected (applied twice, or a wrong pressure)";
     if (e == "tube_flexure")
-        return az ? "elevation-dependent flexure: the tube sags toward the horizon as cos(el)"
-                  : "tube flexure: a sag toward the horizon growing as cos(el)";
+        return sign < 0 ? (az ? "elevation-dependent flexure: the tube sags toward the horizon as cos(el)"
+                              : "tube flexure: a sag toward the horizon growing as cos(el)")
+                        : (az ? "elevation-dependent flexure toward the zenith as cos(el) (the "
+                                "opposite sense of a tube sag: a flexure of the structure that "
+                                "lifts the optics)"
+                              : "flexure toward the zenith growing as cos(el) (the opposite sense "
+                                "of a tube sag: a flexure of the structure that lifts the optics)");
     if (e == "temperature")
         return az ? "the pointing follows temperature (arcsec per deg C): on the elevation and "
                     "azimuth index, as thermal expansion of the tube or the structure moves them"
@@ -295,7 +303,8 @@ void describe_family(const Run &run, const Candidate &c, const std::vector<int> 
     fd.amplitude_arcsec = big >= 0 ? arcsec(std::fabs(m.coef[big])) : 0;
     fd.amplitude_err_arcsec = big >= 0 ? arcsec(c.fit.f.res.err[big]) : 0;
     char buf[700];
-    std::snprintf(buf, sizeof buf, "%s; %s arcsec", family_words(run, effect),
+    std::snprintf(buf, sizeof buf, "%s; %s arcsec",
+                  family_words(run, effect, big >= 0 ? m.coef[big] : 0.0),
                   values_of(run, m, c.fit.f.res, newi).c_str());
     fd.text = buf;
 }
