@@ -118,7 +118,6 @@ static int rf_walk(const pmrun *run, const char *path, int skip_bad)
 
     for (i = 0; i < n; i++) {
         const pmrun_obs *o = pmrun_get(run, i);
-        int tpoint_eq = fmt == PMRUN_FORMAT_TPOINT && mount == PMRUN_MOUNT_EQUATORIAL;
         if (!o)
             return pmfz_fail("runfile: record %zu of %zu is NULL", i, n);
         if (!pmfz_finite(o->enc_ha) || !pmfz_finite(o->enc_dec) || !pmfz_finite(o->app_ha) ||

@@ -439,7 +439,51 @@ void physical_candidates(const Run &run, const State &st, std::vector<Candidate>
 }
 
 // Outliers: the points beyond the Bonferroni-corrected chi^2(2) tail.
-void outlier_candidate(const State &st, const ExplainOptions &opt, std::vector<Candidate> &cands)
+// The deleted residual of observation i: predicted by the model fitted
+// without it, chi^2 with the prediction's covariance (sigma^2 I + J C J^T,
+// J its two rows, C the coefficient covariance of that fit): the
+// externally studentized residual, which neither the point's own pull on
+// the fit (leverage) nor its share of sigma can shrink.  False if the fit
+// without it fails.
+bool deleted_residual(const Run &run, const State &st, int i, double &chi2, double &miss)
+{
+    std::vector<int> rest;
+    for (int k : st.use)
+        if (k != i)
+            rest.push_back(k);
+    Fit g = fit_spec(run, rest, st.order, st.adds);
+    if (!g.ok)
+        return false;
+    const Obs &o = run.obs[i];
+    int P = g.f.model.n_terms;
+    std::vector<double> a(PM_MAX_TERMS), b(PM_MAX_TERMS);
+    double r[2];
+    if (pm_fit_row(&g.f.model, &o.ctx, o.eh, o.ed, o.ah, o.ad, a.data(), b.data(), r) != PM_OK ||
+        g.f.cov.size() != (size_t)(P * P))
+        return false;
+    double s2 = g.f.res.sigma * g.f.res.sigma, v00 = s2, v01 = 0, v11 = s2;
+    for (int x = 0; x < P; x++)
+        for (int y = 0; y < P; y++) {
+            double c = g.f.cov[(size_t)(x * P + y)];
+            v00 += a[(size_t)x] * c * a[(size_t)y];
+            v01 += a[(size_t)x] * c * b[(size_t)y];
+            v11 += b[(size_t)x] * c * b[(size_t)y];
+        }
+    double det = v00 * v11 - v01 * v01;
+    if (!(det > 0))
+        return false;
+    chi2 = (v11 * r[0] * r[0] - 2 * v01 * r[0] * r[1] + v00 * r[1] * r[1]) / det;
+    miss = std::hypot(r[0], r[1]);
+    return true;
+}
+
+// Gross errors: the points whose deleted residual is beyond the
+// Bonferroni-corrected chi^2(2) tail (N tests).  The deleted residual is a
+// leave-one-out prediction, so the test is its own cross-validation.  Only
+// the five largest ordinary residuals beyond 2.5 sigma are examined (one
+// refit each).
+void outlier_candidate(const Run &run, const State &st, const ExplainOptions &opt,
+                       std::vector<Candidate> &cands)
 {
     Candidate c;
     c.effect = "outlier";
@@ -448,11 +492,24 @@ void outlier_candidate(const State &st, const ExplainOptions &opt, std::vector<C
     c.adds = st.adds;
     const FitOut &f = st.cur.f;
     double sg2 = f.res.sigma * f.res.sigma, worst = 0, ln_n = std::log((double)f.idx.size());
+    std::vector<std::pair<double, int>> big;
     for (size_t j = 0; j < f.idx.size(); j++) {
         double z2 = (f.r0[j] * f.r0[j] + f.r1[j] * f.r1[j]) / sg2;
-        if (-z2 / 2 + ln_n < std::log(opt.alpha))
-            c.drop.push_back(f.idx[j]);
-        worst = std::max(worst, z2);
+        if (z2 > 2.5 * 2.5)
+            big.push_back({z2, f.idx[j]});
+    }
+    std::sort(big.begin(), big.end(), [](const std::pair<double, int> &x, const std::pair<double, int> &y) {
+        return x.first > y.first;
+    });
+    for (size_t k = 0; k < big.size() && k < 5; k++) {
+        double chi2, miss;
+        if (!deleted_residual(run, st, big[k].second, chi2, miss))
+            continue;
+        if (-chi2 / 2 + ln_n < std::log(opt.alpha)) {
+            c.drop.push_back(big[k].second);
+            c.miss.push_back(miss);
+        }
+        worst = std::max(worst, chi2);
     }
     c.log_fap = -worst / 2 + ln_n;
     if (!c.drop.empty())
@@ -472,7 +529,7 @@ std::vector<Candidate> candidates(const Run &run, const State &st, const Explain
         cands.push_back(c);
     }
     physical_candidates(run, st, cands);
-    outlier_candidate(st, opt, cands);
+    outlier_candidate(run, st, opt, cands);
     return cands;
 }
 
@@ -522,10 +579,9 @@ int first_passing(const Run &run, const State &st, std::vector<Candidate> &cands
         bool out = c.effect == "outlier";
         std::vector<int> nuse = out ? without(st.use, c.drop) : st.use;
         c.cv = cv_rms(run, nuse, c.order, c.adds, opt.folds, opt.seed);
-        // outliers: the same points predicted by models trained with them
-        double cv_old = out ? cv_rms(run, nuse, st.order, st.adds, opt.folds, opt.seed, c.drop)
-                            : st.cur_cv;
-        if (c.cv < cv_old)
+        // outliers: their test, the deleted residual, is a leave-one-out
+        // prediction already (outlier_candidate)
+        if (out || c.cv < st.cur_cv)
             return (int)k;
     }
     return -1;

@@ -208,11 +208,12 @@ void describe_outlier(const Run &run, const State &st, const Candidate &c, Findi
 {
     const FitOut &cur = st.cur.f;
     double worst = 0;
-    for (size_t j = 0; j < cur.idx.size(); j++)
-        if (std::find(c.drop.begin(), c.drop.end(), cur.idx[j]) != c.drop.end()) {
-            worst = std::max(worst, std::hypot(cur.r0[j], cur.r1[j]));
-            fd.lines.push_back(run.obs[cur.idx[j]].line);
-        }
+    // the miss: each point's deleted residual (its own fit cannot pull it in)
+    for (size_t k = 0; k < c.drop.size(); k++) {
+        worst = std::max(worst, k < c.miss.size() ? c.miss[k] : 0.0);
+        fd.lines.push_back(run.obs[c.drop[k]].line);
+    }
+    std::sort(fd.lines.begin(), fd.lines.end());
     fd.amplitude_arcsec = arcsec(worst);
     std::string lines;
     for (int l : fd.lines)
@@ -222,7 +223,8 @@ void describe_outlier(const Run &run, const State &st, const Candidate &c, Findi
                   "%zu individual bad point%s (failed plate solve, wrong star?) at line%s %s; the "
                   "worst misses by %.1f\" (%.1f sigma)",
                   fd.lines.size(), fd.lines.size() > 1 ? "s" : "", fd.lines.size() > 1 ? "s" : "",
-                  lines.c_str(), fd.amplitude_arcsec, worst / cur.res.sigma);
+                  lines.c_str(), fd.amplitude_arcsec,
+                  worst / (c.fit.ok ? c.fit.f.res.sigma : cur.res.sigma));
     fd.text = buf;
 }
 

@@ -53,6 +53,7 @@ struct Candidate {
     double peak_g = 0;
     std::vector<double> member_g;      // per member of a pair: its G (periodic), else 0
     std::vector<int> drop;             // outliers: observations to drop
+    std::vector<double> miss;          // outliers: each one's deleted residual (rad)
     Fit fit;
     double log_fap = 0;                // natural log of the false-alarm probability
     double cv = 0;                     // cross-validated RMS once checked
