@@ -183,7 +183,19 @@ void print_explain_text(const Run &run, const Explanation &ex, int order, bool a
     std::printf("\n  pmfit fit %s --order %d", run.path.c_str(), ex.final_order);
     for (const std::string &a : ex.final_adds)
         std::printf(a.find('\'') == std::string::npos ? " --add '%s'" : " --add \"%s\"", a.c_str());
-    std::printf("   # fits the explained model\n");
+    std::vector<int> bad;
+    for (const Finding &f : ex.findings)
+        if (f.effect == "outlier")
+            bad.insert(bad.end(), f.lines.begin(), f.lines.end());
+    if (bad.empty()) {
+        std::printf("   # fits the explained model\n");
+    } else {
+        std::string l;
+        for (int x : bad)
+            l += (l.empty() ? "" : ", ") + std::to_string(x);
+        std::printf("   # fits the explained model once line%s %s %s left out (or add --robust)\n",
+                    bad.size() > 1 ? "s" : "", l.c_str(), bad.size() > 1 ? "are" : "is");
+    }
 }
 
 } // namespace pmhost
