@@ -53,6 +53,12 @@ extern "C" {
 #define PM_MAX_EXTRA 16
 #endif
 
+/* The model's definition (what a set of coefficients means): 2 since the
+** anisotropic tilt terms are evaluated at the index-shifted position
+** (docs/model.md, "The tilt terms"); model files say "pm-model 2" and the
+** headers of pmfit --emit-c refuse to compile against another. */
+#define PM_MODEL_DEFINITION 2
+
 /* Free parameters of the harmonic model of order L: 4L^2+12L+6
 ** (6, 22, 46, 78, 118 for L = 0..4; Pal et al. Sec. 3.1 and 5.1). */
 #define PM_SH_TERMS(L) (4 * (L) * (L) + 12 * (L) + 6)

@@ -119,6 +119,18 @@ V3<double> mt_and_derivs(const Chain &c, const V3<double> &x, V3<double> dq[6])
     return q;
 }
 
+/* The tilt fields A1 p1 + A2 p2, evaluated at the shifted position
+** (t' = t + c', d' = d - e'), move with c' and e': their part of the index
+** columns (exact Jacobian).  p1 = (-sd' ct', st'), p2 = (-sd' st', -ct'). */
+void tilt_index_rows(const Chain &c, double A1, double A2, double *row0, double *row1)
+{
+    if (A1 == 0 && A2 == 0)
+        return;
+    row0[2] += c.sdp * (A1 * c.stp - A2 * c.ctp); /* d/dc' */
+    row1[2] += A1 * c.ctp + A2 * c.stp;
+    row0[4] += c.cdp * (A1 * c.ctp + A2 * c.stp); /* d/de' */
+}
+
 /* Two design rows (model derivatives) and the residual of one observation
 ** at model m.  Residual: r = log(M^T t) - D(x), in the frame transported
 ** by the isotropic rotation M (docs/model.md). */
@@ -146,24 +158,44 @@ void rows(const pm_model *m, const pm_context *ctx, double enc_ha,
         row1[j] = -(D[1][0] * dq[j].x + D[1][1] * dq[j].y + D[1][2] * dq[j].z);
     }
 
-    /* harmonic terms: linear, row = Y_lm N_lm (u_k, v_k) */
-    double Y[PM_N_HARM(PM_MAX_L)];
+    /* harmonic terms: linear, row = Y_lm N_lm (u_k, v_k), the tilts'
+    ** (k = 1, 2) at the shifted position; A1, A2: the tilt fields' sums
+    ** sum coef Y N (their dependence on c' and e', below) */
+    Trig<double> gs = g;
+    gs.st = c.stp;
+    gs.ct = c.ctp;
+    gs.sd = c.sdp;
+    gs.cd = c.cdp;
+    double Y[PM_N_HARM(PM_MAX_L)], A1 = 0, A2 = 0;
     harmonics<double>(m->order, g, Y);
     for (int i = 6; i < m->n_base; i++) {
         const pm_term *tm = &m->term[i];
         int j = tm->l * tm->l + tm->l + tm->m;
         double y = Y[j] * norm_lm(tm->l, tm->m);
         double u, v;
-        base_uv<double>(tm->k, g, &u, &v);
+        base_uv_at<double>(tm->k, g, gs, &u, &v);
         row0[i] = y * u;
         row1[i] = y * v;
+        if (tm->k == 1)
+            A1 += m->coef[i] * y;
+        else if (tm->k == 2)
+            A2 += m->coef[i] * y;
     }
+    Site<double> st;
+    if (m->n_terms > m->n_base) {
+        /* added terms: linear, row = their displacement per unit coefficient */
+        st = site_of<double>(m, c.k, g, ctx);
+        for (int i = m->n_base; i < m->n_terms; i++) {
+            const pm_term &t = m->term[i];
+            term_uv<double>(t, g, st, ctx, &row0[i], &row1[i]);
+            double f;
+            if (t.k <= 2 && term_factor<double>(t, g, st, ctx, &f))
+                (t.k == 1 ? A1 : A2) += m->coef[i] * f;
+        }
+    }
+    tilt_index_rows(c, A1, A2, row0, row1);
     if (m->n_terms == m->n_base)
         return;
-    /* added terms: linear, row = their displacement per unit coefficient */
-    Site<double> st = site_of<double>(m, c.k, g, ctx);
-    for (int i = m->n_base; i < m->n_terms; i++)
-        term_uv<double>(m->term[i], g, st, ctx, &row0[i], &row1[i]);
     /* The zenith terms' direction, M^T Z, turns with the isotropic terms:
     ** their part of the isotropic columns (exact Jacobian). */
     if (!st.have_zenith)

@@ -25,6 +25,7 @@ Site<float> site_f(const pm_model_f *m, const Trig<float> &ge, int side,
                    float ia, float ib, float ic) /* omega' = (ia, ib, ic) */
 {
     Site<float> s;
+    s.gs = ge;
     s.side = side;
     s.have_zenith = false;
     s.zx = s.zy = s.zz = 0;
@@ -123,8 +124,9 @@ void correction_f(const pm_model_f *m, const pm_context *ctx, const FrameF &f, f
     /* anisotropic displacement (same templates as the double build) */
     float S[6];
     sh_sums<float, float>(m->order, g, m->dense, S);
-    float dt = -g.sd * (S[0] * g.ct + S[1] * g.st + S[3]) + g.cd * S[2] + S[5];
-    float dd = S[0] * g.st - S[1] * g.ct - S[4];
+    /* the tilts (S_0, S_1) at the shifted position ge (base_uv_at) */
+    float dt = -ge.sd * (S[0] * ge.ct + S[1] * ge.st) - g.sd * S[3] + g.cd * S[2] + S[5];
+    float dd = S[0] * ge.st - S[1] * ge.ct - S[4];
     if (m->n_terms > m->n_base) {
         int side = ctx && ctx->pier ? (ctx->pier > 0 ? 1 : -1) : (f.flip ? -1 : 1);
         Site<float> s = site_f(m, ge, side, om.x, om.y, om.z);

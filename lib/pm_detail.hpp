@@ -406,6 +406,17 @@ inline void base_uv(int k, const Trig<T> &g, T *u, T *v)
     }
 }
 
+/* The base vector k of a term evaluated at encoder trig g: the tilts
+** (k = 1, 2: rotations about the axes x and y, fixed on the sky) at the
+** index-shifted position gs = (t + c', d - e'), where the telescope points
+** in the mount's frame; the others, which move with the axes, at g
+** (docs/model.md, "The tilt terms"). */
+template <typename T>
+inline void base_uv_at(int k, const Trig<T> &g, const Trig<T> &gs, T *u, T *v)
+{
+    base_uv<T>(k, k <= 2 ? gs : g, u, v);
+}
+
 /* Unit vector displaced from (1,0,0) by the tangent offset (a, b) along y
 ** and z: the exponential map.  Series below 1e-2 (error < 1e-15). */
 template <typename T> inline V3<T> expmap(T a, T b)
@@ -614,6 +625,8 @@ template <typename T> struct Site {
     int side;        /* +1 normal side, -1 beyond the pole */
     bool have_zenith;
     T zx, zy, zz;    /* M^T Z: zx = sin(el), (zy, zz) toward the zenith */
+    Trig<T> gs;      /* the shifted position (t + c', d - e'): the tilt
+                        base vectors' (base_uv_tilt) */
 };
 
 template <typename T>
@@ -623,6 +636,12 @@ inline Site<T> site_of(const pm_model *m, const Iso<T> &k, const Trig<T> &g,
     Site<T> s;
     T stp, ctp, sdp, cdp;
     shifted<T>(k, g, &stp, &ctp, &sdp, &cdp);
+    s.gs.st = stp;
+    s.gs.ct = ctp;
+    s.gs.sd = sdp;
+    s.gs.cd = cdp;
+    s.gs.t = s.gs.d = 0;
+    s.gs.have_angles = false;
     s.side = ctx && ctx->pier ? (ctx->pier > 0 ? 1 : -1) : (cdp >= 0 ? 1 : -1);
     s.have_zenith = false;
     s.zx = s.zy = s.zz = 0;
@@ -682,15 +701,16 @@ inline pm_status eval_ready(const pm_model *m, const pm_context *ctx)
     return st != PM_OK ? st : context_ok(m, ctx);
 }
 
-/* Displacement per unit coefficient of an added term t at position g. */
+/* The factor f of an added term t at position g (its displacement is f
+** times its base vector), or false for the zenith terms (whose direction
+** is their own) and a term of the other pier side (f = 0). */
 template <typename T>
-inline void term_uv(const pm_term &t, const Trig<T> &g, const Site<T> &s,
-                    const pm_context *ctx, T *u, T *v)
+inline bool term_factor(const pm_term &t, const Trig<T> &g, const Site<T> &s,
+                        const pm_context *ctx, T *fo)
 {
-    *u = 0;
-    *v = 0;
-    if (t.side && t.side != s.side)
-        return;
+    *fo = 0;
+    if ((t.side && t.side != s.side) || t.kind == PM_TERM_ZENITH)
+        return false;
     T f = 0;
     switch (t.kind) {
     case PM_TERM_SH: {
@@ -710,7 +730,27 @@ inline void term_uv(const pm_term &t, const Trig<T> &g, const Site<T> &s,
         f = ipow<T>(g.cd, G) * (t.m ? m_sin(a) : m_cos(a));
         break;
     }
-    case PM_TERM_ZENITH: {
+    case PM_TERM_AUX:
+        f = (T)(aux_input(ctx, t.aux) - t.param);
+        break;
+    default:
+        return false;
+    }
+    *fo = f;
+    return true;
+}
+
+/* Displacement per unit coefficient of an added term t at position g; the
+** tilt base vectors (k = 1, 2) at the shifted position s.gs (base_uv_at). */
+template <typename T>
+inline void term_uv(const pm_term &t, const Trig<T> &g, const Site<T> &s,
+                    const pm_context *ctx, T *u, T *v)
+{
+    *u = 0;
+    *v = 0;
+    if (t.side && t.side != s.side)
+        return;
+    if (t.kind == PM_TERM_ZENITH) {
         if (t.l == 0) { /* cot(el) along the unit vector to the zenith */
             T sel = s.zx > (T)0.01 ? s.zx : (T)0.01;
             *u = s.zy / sel;
@@ -721,14 +761,10 @@ inline void term_uv(const pm_term &t, const Trig<T> &g, const Site<T> &s,
         }
         return;
     }
-    case PM_TERM_AUX:
-        f = (T)(aux_input(ctx, t.aux) - t.param);
-        break;
-    default:
+    T f, bu, bv;
+    if (!term_factor<T>(t, g, s, ctx, &f))
         return;
-    }
-    T bu, bv;
-    base_uv<T>(t.k, g, &bu, &bv);
+    base_uv_at<T>(t.k, g, s.gs, &bu, &bv);
     *u = f * bu;
     *v = f * bv;
 }
@@ -847,10 +883,13 @@ inline void aniso(const pm_model *m, const Iso<T> &k, const Trig<T> &g0,
     T S[6];
     sh_sums<T, double>(m->order, g0, m->dense, S);
     /* sum_k S_k (u_k, v_k), written out (the products of the position's
-    ** trig formed beside the sums: a short chain after them) */
-    const T sc = g0.sd * g0.ct, ss = g0.sd * g0.st;
+    ** trig formed beside the sums: a short chain after them); the tilts
+    ** (S_0, S_1) at the shifted position (base_uv_at) */
+    const T stp = g0.st * k.cc + g0.ct * k.sc, ctp = g0.ct * k.cc - g0.st * k.sc;
+    const T sdp = g0.sd * k.ce - g0.cd * k.se;
+    const T sc = sdp * ctp, ss = sdp * stp;
     *dt = ((g0.cd * S[2] + S[5]) - sc * S[0]) - (ss * S[1] + g0.sd * S[3]);
-    *dd = (S[0] * g0.st - S[4]) - S[1] * g0.ct;
+    *dd = (S[0] * stp - S[4]) - S[1] * ctp;
     if (m->n_terms > m->n_base) {
         Trig<T> g = g0;
         if (!g.have_angles) {

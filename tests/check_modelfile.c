@@ -101,7 +101,7 @@ START_TEST(test_pmmodel_load_errors_name_line)
     make_tmpdir();
     expect_load_error("", "1", "empty");
     expect_load_error("hello\n", "1", "pm-model");
-    expect_load_error("pm-model 2\n", "1", "version");
+    expect_load_error("pm-model 3\n", "1", "version");
     expect_load_error("pm-model 1\nmount dobsonian\n", "2", "mount");
     expect_load_error("pm-model 1\nmount altaz\norder x\n", "3", "order");
     snprintf(big, sizeof big, "pm-model 1\nmount altaz\norder %d\n", PM_MAX_L + 1);
@@ -122,6 +122,61 @@ START_TEST(test_pmmodel_load_errors_name_line)
                       "term a 1 0 0 0\nterm b 2 0 0 0\nterm c 3 0 0 0\nterm d 4 0 0 0\n"
                       "term e 5 0 0 0\nterm i 6 0 0 0\nend\nmore\n",
                       "12", "after 'end'");
+}
+END_TEST
+
+/* Version 1 files (before the tilt terms were evaluated at the
+** index-shifted position, docs/model.md): read where nothing evaluates
+** differently, refused at the first anisotropic tilt term otherwise; files
+** are written as version 2. */
+START_TEST(test_pmmodel_version_1)
+{
+    pm_model m;
+    char path[300], err[512], where[320];
+    FILE *f;
+    char head[32];
+    int i;
+    make_tmpdir();
+    path_in(path, sizeof path, "v1.pm");
+    /* order 1 with every tilt term zero but the isotropic a, b */
+    f = fopen(path, "w");
+    ck_assert_ptr_nonnull(f);
+    pm_model_init(&m, PM_MOUNT_EQUATORIAL, 1);
+    fprintf(f, "pm-model 1\nmount equatorial\norder 1\nterms %d\n", m.n_terms);
+    for (i = 0; i < m.n_terms; i++) {
+        char name[32];
+        pm_term_name(&m, i, name, sizeof name);
+        fprintf(f, "term %s %d %d %d %.17g\n", name, m.term[i].k, m.term[i].l, m.term[i].m,
+                m.term[i].k <= 2 && m.term[i].l >= 1 ? 0.0 : 1e-5 * (i + 1));
+    }
+    fprintf(f, "end\n");
+    fclose(f);
+    ck_assert_msg(pmmodel_load(path, &m, err, sizeof err) == 0, "%s", err);
+    ck_assert(m.coef[0] == 1e-5 * 1 && m.coef[2] == 1e-5 * 3);
+    /* an anisotropic tilt term with a value: refused at its line */
+    f = fopen(path, "w");
+    ck_assert_ptr_nonnull(f);
+    fprintf(f, "pm-model 1\nmount equatorial\norder 1\nterms %d\n", m.n_terms);
+    for (i = 0; i < m.n_terms; i++) {
+        char name[32];
+        pm_term_name(&m, i, name, sizeof name);
+        fprintf(f, "term %s %d %d %d %.17g\n", name, m.term[i].k, m.term[i].l, m.term[i].m,
+                1e-5 * (i + 1));
+    }
+    fprintf(f, "end\n");
+    fclose(f);
+    ck_assert_int_eq(pmmodel_load(path, &m, err, sizeof err), -1);
+    for (i = 0; i < m.n_terms && !(m.term[i].k <= 2 && m.term[i].l >= 1); i++) {
+    }
+    snprintf(where, sizeof where, "%s:%d:", path, 5 + i);
+    ck_assert_msg(strstr(err, where) && strstr(err, "refit"), "%s", err);
+    /* saved files are version 2 */
+    ck_assert_int_eq(pmmodel_save(path, &m, NULL, err, sizeof err), 0);
+    f = fopen(path, "r");
+    ck_assert_ptr_nonnull(f);
+    ck_assert_ptr_nonnull(fgets(head, sizeof head, f));
+    fclose(f);
+    ck_assert_str_eq(head, "pm-model 2\n");
 }
 END_TEST
 
@@ -207,6 +262,7 @@ static Suite *suite(void)
     suite_add_tcase(s, tc);
     tc = tcase_create("errors");
     tcase_add_test(tc, test_pmmodel_load_errors_name_line);
+    tcase_add_test(tc, test_pmmodel_version_1);
     tcase_add_test(tc, test_pmmodel_load_binary_and_missing);
     tcase_add_test(tc, test_pmmodel_save_unwritable);
     suite_add_tcase(s, tc);

@@ -115,7 +115,7 @@ extern "C" int pmmodel_save(const char *path, const pm_model *m, const char *com
     }
     std::string out;
     comment_lines(out, comment, "# ");
-    out += "pm-model 1\n";
+    out += "pm-model 2\n";
     out += std::string("mount ") + (m->mount == PM_MOUNT_ALTAZ ? "altaz" : "equatorial") + "\n";
     out += "order " + std::to_string(m->order) + "\n";
     if (m->latitude != 0)
@@ -163,8 +163,16 @@ extern "C" int pmmodel_load(const char *path, pm_model *out, char *err, size_t e
     double latitude = 0;
     pm_model m;
     std::memset(&m, 0, sizeof m);
-    int got = 0;
+    int got = 0, version = 2;
     std::vector<int> term_line; // line of each term, for the term-list check
+    // a version-1 file's anisotropic tilt term: it was evaluated at the
+    // encoder reading, this version at the index-shifted position
+    auto old_tilt = [](const std::string &name) {
+        return "term " + name + " of a 'pm-model 1' file: versions before 2 evaluated the "
+               "anisotropic tilt terms (k = 1, 2) at the encoder reading, this one at the "
+               "index-shifted position (docs/model.md, \"The tilt terms\"); the model would "
+               "point differently: refit the run and save it again";
+    };
     int end_line = 0;
     for (int r; (r = read_line(in, line, MAX_LINE)) != 0;) {
         lineno++;
@@ -184,9 +192,10 @@ extern "C" int pmmodel_load(const char *path, pm_model *out, char *err, size_t e
         switch (state) {
         case HEADER:
             if (tok.size() != 2 || tok[0] != "pm-model")
-                return fail("expected 'pm-model 1' (is this a pm model file?)");
-            if (tok[1] != "1")
-                return fail("model file version '" + tok[1] + "' not supported (expected 1)");
+                return fail("expected 'pm-model 2' (is this a pm model file?)");
+            if (tok[1] != "1" && tok[1] != "2")
+                return fail("model file version '" + tok[1] + "' not supported (expected 2, or 1)");
+            version = tok[1] == "1" ? 1 : 2;
             state = MOUNT;
             break;
         case MOUNT:
@@ -251,6 +260,8 @@ extern "C" int pmmodel_load(const char *path, pm_model *out, char *err, size_t e
                                 "side aux param value)");
                 if (!parse_double(tok[8], &param) || !parse_double(tok[9], &v))
                     return fail("bad parameter or value (expected finite numbers)");
+                if (version == 1 && (k == 1 || k == 2) && v != 0)
+                    return fail(old_tilt(tok[1]));
                 if (base < 0)
                     base = got;
                 pm_term &nt = m.term[got];
@@ -278,6 +289,8 @@ extern "C" int pmmodel_load(const char *path, pm_model *out, char *err, size_t e
                             "' (expected k in 1..6, l in 0..order, |m| <= l)");
             if (!parse_double(tok[5], &v))
                 return fail("bad value '" + tok[5] + "' (expected a finite number, radians)");
+            if (version == 1 && (k == 1 || k == 2) && l >= 1 && v != 0)
+                return fail(old_tilt(tok[1]));
             m.term[got].kind = PM_TERM_SH;
             m.term[got].k = (unsigned char)k;
             m.term[got].l = (signed char)l;
@@ -360,7 +373,10 @@ extern "C" int pmmodel_emit_c(const char *path, const pm_model *m, const char *p
     o += "**\n** Use:  pm_model m;  if (" + p + "_load(&m) != PM_OK) ...\n*/\n";
     o += "#ifndef " + guard + "\n#define " + guard + "\n\n#include \"pm.h\"\n\n";
     o += "#if PM_MAX_L < " + std::to_string(m->order) + "\n#error \"this model needs PM_MAX_L >= " +
-         std::to_string(m->order) + "\"\n#endif\n\n";
+         std::to_string(m->order) + "\"\n#endif\n";
+    o += "#if !defined(PM_MODEL_DEFINITION) || PM_MODEL_DEFINITION != 2\n#error \"this model was "
+         "fitted with the model definition 2 (docs/model.md, The tilt terms); rebuild it with this "
+         "pm.h's pmfit\"\n#endif\n\n";
     o += "#define " + guard.substr(0, guard.size() - 2) + "_MOUNT " +
          (m->mount == PM_MOUNT_ALTAZ ? "PM_MOUNT_ALTAZ" : "PM_MOUNT_EQUATORIAL") + "\n";
     o += "#define " + guard.substr(0, guard.size() - 2) + "_ORDER " + std::to_string(m->order) + "\n";

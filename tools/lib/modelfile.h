@@ -5,7 +5,7 @@
 **  The model file format (docs/formats.md, "Model files"):
 **
 **     # any comment
-**     pm-model 1
+**     pm-model 2                  (version 1 read as docs/formats.md says)
 **     mount equatorial            (or altaz)
 **     order 2
 **     terms 46

@@ -1,4 +1,4 @@
-pm-model 1
+pm-model 2
 mount equatorial
 order 0
 terms 6

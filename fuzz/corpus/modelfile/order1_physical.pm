@@ -1,6 +1,6 @@
 # fitted by pmfit from examples/sim_gem.dat (joint fit, both pier sides)
 # N = 300, sigma = 1.510478 arcsec
-pm-model 1
+pm-model 2
 mount equatorial
 order 1
 latitude 0.8360127117052838
