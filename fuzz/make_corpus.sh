@@ -39,7 +39,7 @@ $B/pmfit fit examples/sim_gem.dat --order 1 --add ha_periodic:144 --add refracti
     --add temperature --add hysteresis --add 'i@W' --add ha_periodic_paper:2 --save $C/modelfile/order1_physical.pm > /dev/null
 cat > $C/modelfile/altaz_latitude.pm <<'MODEL'
 # by hand: an alt-az model with a latitude, comments and blank lines
-pm-model 1
+pm-model 2
 mount altaz
 order 0
 latitude 0.55301
@@ -55,7 +55,7 @@ xterm cot(el) zenith 0 0 0 0 0 0 1e-5
 xterm c'*aux1 aux 3 0 0 1 4 0.5 -2e-6
 end
 MODEL
-printf 'pm-model 1\r\nmount equatorial\r\norder 0\r\nterms 6\r\nterm a 1 0 0 0\r\nterm b 2 0 0 0\r\nterm c 3 0 0 0\r\nterm d 4 0 0 0\r\nterm e 5 0 0 0\r\nterm i 6 0 0 0\r\nend\r\n' \
+printf 'pm-model 2\r\nmount equatorial\r\norder 0\r\nterms 6\r\nterm a 1 0 0 0\r\nterm b 2 0 0 0\r\nterm c 3 0 0 0\r\nterm d 4 0 0 0\r\nterm e 5 0 0 0\r\nterm i 6 0 0 0\r\nend\r\n' \
     > $C/modelfile/crlf_zero.pm
 
 # ---- the API targets: fixed pseudo-random bytes (the harnesses read any
