@@ -530,6 +530,9 @@ std::vector<Candidate> candidates(const Run &run, const State &st, const Explain
     }
     physical_candidates(run, st, cands);
     outlier_candidate(run, st, opt, cands);
+    cands.erase(std::remove_if(cands.begin(), cands.end(),
+                               [&](const Candidate &c) { return has(opt.exclude, c.effect); }),
+                cands.end());
     return cands;
 }
 
@@ -782,6 +785,8 @@ void record(const Run &run, State &st, const Candidate &c, const std::vector<Can
     std::vector<Alternative> alts = alternatives(run, st, c, cands, opt);
     for (Finding &fd : describe(run, st, c)) {
         fd.adds = c.new_adds;
+        fd.trials = c.trials;
+        fd.step = (int)(ex.findings.size() + ex.withdrawn.size()) + 1;
         fd.false_alarm_probability = std::exp(c.log_fap);
         fd.log10_p = c.log_fap / LN10;
         fd.sigma_after_arcsec = arcsec(c.fit.f.res.sigma);
@@ -796,6 +801,68 @@ void record(const Run &run, State &st, const Candidate &c, const std::vector<Can
     st.use = nuse;
     st.cur = c.fit;
     st.cur_cv = c.cv;
+}
+
+// ------------------------------------------------------------ stage: prune
+
+std::vector<std::string> minus(const std::vector<std::string> &all, const std::vector<std::string> &drop)
+{
+    std::vector<std::string> keep;
+    for (const std::string &a : all)
+        if (std::find(drop.begin(), drop.end(), a) == drop.end())
+            keep.push_back(a);
+    return keep;
+}
+
+// The backward pass of the step-wise search: a finding of a single family
+// that the final model no longer needs -- its terms' partial F-test given
+// every other finding, times its trials, not below alpha, and the model
+// without it predicting as well (cross-validated RMS within 1%) -- is withdrawn,
+// the least needed first.  (A drift through the night found first, then
+// the temperature it was following: the drift goes.)
+void prune(const Run &run, State &st, const ExplainOptions &opt, Explanation &ex)
+{
+    for (;;) {
+        int worst = -1;
+        double worst_lp = -1e300, worst_cv = 0;
+        Fit worst_fit;
+        for (size_t k = 0; k < ex.findings.size(); k++) {
+            const Finding &f = ex.findings[k];
+            if (f.effect == "outlier" || f.effect == "higher_order" || !f.with.empty() || f.adds.empty())
+                continue;
+            Fit g = fit_spec(run, st.use, st.order, minus(st.adds, f.adds));
+            double d1 = st.cur.P - g.P, d2 = (double)(2 * st.cur.N - st.cur.P);
+            if (!g.ok || !(d1 > 0) || !(d2 > 0))
+                continue;
+            double F = ((g.chi2 - st.cur.chi2) / d1) / (st.cur.chi2 / d2);
+            double lp = log_f_tail(F, d1, d2) + std::log(f.trials);
+            if (lp < std::log(opt.alpha) || lp <= worst_lp)
+                continue;
+            double cv = cv_rms(run, st.use, st.order, minus(st.adds, f.adds), opt.folds, opt.seed);
+            if (!(cv <= 1.01 * st.cur_cv)) // within the noise of a 5-fold CV
+                continue;
+            worst = (int)k;
+            worst_lp = lp;
+            worst_cv = cv;
+            worst_fit = g;
+        }
+        if (worst < 0)
+            return;
+        Finding f = ex.findings[(size_t)worst];
+        char why[300];
+        std::snprintf(why, sizeof why,
+                      "%s (finding %d) is not needed once the others are in: false-alarm "
+                      "probability %.2g of its terms given them; without it sigma %.3f\", CV RMS "
+                      "%.3f\"",
+                      f.effect.c_str(), worst + 1, std::min(1.0, std::exp(worst_lp)),
+                      arcsec(worst_fit.f.res.sigma), arcsec(worst_cv));
+        ex.withdrawn.push_back(f);
+        ex.withdrawn_why.push_back(why);
+        ex.findings.erase(ex.findings.begin() + worst);
+        st.adds = minus(st.adds, f.adds);
+        st.cur = worst_fit;
+        st.cur_cv = worst_cv;
+    }
 }
 
 // One step: the best single family, else (opt.pairs) the best pair.
@@ -885,7 +952,11 @@ double cv_rms(const Run &run, const std::vector<int> &use, int order,
     return n ? std::sqrt(ss / (double)(2 * n)) : NAN; /* per axis, like sigma */
 }
 
-Explanation explain(const Run &run, const ExplainOptions &opt)
+namespace {
+
+// One pass of the pipeline: baseline, locate, interpret, the forward
+// search, the backward pass (prune).
+Explanation explain_pass(const Run &run, const ExplainOptions &opt)
 {
     Explanation ex;
     State st = baseline(run, opt);
@@ -901,6 +972,7 @@ Explanation explain(const Run &run, const ExplainOptions &opt)
     ex.physical_reading = physical_reading(run, ex, opt);
     while ((int)ex.findings.size() < opt.max_findings && step(run, st, opt, ex)) {
     }
+    prune(run, st, opt, ex);
     ex.final = st.cur.f;
     ex.kept = st.use;
     ex.final_sigma_arcsec = arcsec(st.cur.f.res.sigma);
@@ -908,6 +980,30 @@ Explanation explain(const Run &run, const ExplainOptions &opt)
     ex.final_n_params = st.cur.P;
     ex.final_adds = st.adds;
     ex.final_order = st.order;
+    return ex;
+}
+
+} // namespace
+
+// The pipeline, and again without any family the backward pass withdrew
+// (so that every finding is described in a model without it), until
+// nothing more is withdrawn.
+Explanation explain(const Run &run, const ExplainOptions &opt)
+{
+    Explanation ex = explain_pass(run, opt);
+    ExplainOptions o = opt;
+    for (int round = 0; round < 4 && !ex.withdrawn.empty(); round++) {
+        for (const Finding &w : ex.withdrawn)
+            o.exclude.push_back(w.effect);
+        Explanation again = explain_pass(run, o);
+        again.withdrawn.insert(again.withdrawn.begin(), ex.withdrawn.begin(), ex.withdrawn.end());
+        again.withdrawn_why.insert(again.withdrawn_why.begin(), ex.withdrawn_why.begin(),
+                                   ex.withdrawn_why.end());
+        bool more = again.withdrawn.size() > ex.withdrawn.size();
+        ex = again;
+        if (!more)
+            break;
+    }
     return ex;
 }
 
@@ -1015,6 +1111,9 @@ extern "C" int pmx_explain_opts(const char *path, const pmx_options *opt, pmx_re
             b.error = it.error;
         }
         r.physical_reading = !ex.physical_reading.empty();
+        for (const Finding &w : ex.withdrawn)
+            if (r.n_withdrawn < PMX_MAX_FINDINGS)
+                std::snprintf(r.withdrawn[r.n_withdrawn++], sizeof r.withdrawn[0], "%s", w.effect.c_str());
         *out = r;
     } catch (const std::exception &x) {
         set_err(err, errlen, x.what());

@@ -55,6 +55,8 @@ typedef struct pmx_result {
     int n_readings;                  /* the physical reading of the baseline */
     pmx_reading readings[PMX_MAX_READINGS];
     int physical_reading;            /* 1: order 0 + one term predicts as well as order 1 */
+    int n_withdrawn;                 /* found, then not needed once later findings were in */
+    char withdrawn[PMX_MAX_FINDINGS][24];
 } pmx_result;
 
 /* Explain the run in file path from a baseline of the given order; alpha is

@@ -31,6 +31,7 @@ struct ExplainOptions {
     bool pairs = true;             // where no single family passes, try pairs
     double close_delta_bic = 6;    // alternatives: Delta BIC below this (for readings of
                                    // as many terms: a likelihood ratio below 20)
+    std::vector<std::string> exclude; // families not to try (the ones a backward pass withdrew)
 };
 
 // One located statistic: a part of the data whose residuals are too large.
@@ -79,6 +80,8 @@ struct Finding {
     double sigma_after_arcsec = 0, cv_rms_after_arcsec = 0;
     int n_params_after = 0;
     std::vector<int> lines;   // outliers: their file lines
+    double trials = 1;        // periods its search chose among (periodic), else 1
+    int step = 0;             // the step of the search that found it (1, 2, ...)
     std::string with;         // found together with this effect (a pair), else ""
     std::vector<Alternative> alternatives; // readings with close evidence
 };
@@ -92,6 +95,8 @@ struct Explanation {
     std::vector<Periodogram> periodograms; // of the baseline residuals
     std::vector<Finding> findings;
     std::vector<std::string> candidates_tried; // per step, for the report
+    std::vector<Finding> withdrawn;      // found, then not needed once later ones were in
+    std::vector<std::string> withdrawn_why;
     std::vector<Interpretation> interpretation; // the physical reading of the baseline
     std::string physical_reading;        // order 0 + one term predicts as well as order 1
     FitOut baseline, final;              // the two fits (residuals for plots)

@@ -3,6 +3,7 @@
 // text.
 #include "explain_internal.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -53,6 +54,7 @@ std::string finding_json(const Finding &f)
             j += std::string(k ? ", " : "") + std::to_string(f.lines[k]);
         j += "]";
     }
+    j += ", \"step\": " + std::to_string(f.step);
     if (!f.with.empty())
         j += ", \"with\": " + str(f.with);
     j += ", \"alternatives\": " + alternatives_json(f.alternatives);
@@ -96,6 +98,11 @@ std::string explain_json(const Run &run, const Explanation &ex, int order)
     j += "], \"findings\": [";
     for (size_t i = 0; i < ex.findings.size(); i++)
         j += std::string(i ? ", " : "") + finding_json(ex.findings[i]);
+    j += "], \"withdrawn\": [";
+    for (size_t i = 0; i < ex.withdrawn.size(); i++)
+        j += std::string(i ? ", " : "") + "{\"effect\": " + str(ex.withdrawn[i].effect) +
+             ", \"step\": " + std::to_string(ex.withdrawn[i].step) + ", \"why\": " +
+             str(ex.withdrawn_why[i]) + "}";
     return j + "], \"final\": {\"sigma_arcsec\": " + num(ex.final_sigma_arcsec) +
            ", \"cv_rms_arcsec\": " + num(ex.final_cv_rms_arcsec) +
            ", \"n_params\": " + std::to_string(ex.final_n_params) + "}";
@@ -155,6 +162,9 @@ void print_findings(const Explanation &ex, double alpha)
                         std::fabs(a.log10_lr), a.log10_lr >= 0 ? f.effect.c_str() : a.effect.c_str(),
                         a.separate_by.c_str());
     }
+    for (size_t i = 0; i < ex.withdrawn.size(); i++)
+        std::printf("  withdrawn: %s; the findings above are those of the search without it\n",
+                    ex.withdrawn_why[i].c_str());
 }
 
 } // namespace
