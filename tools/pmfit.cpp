@@ -585,6 +585,45 @@ int cmd_eval(const Options &o, const std::vector<Obs> &obs, int mount)
 }
 
 // The pictures of pmfit explain --plots DIR (SVG).
+// The variable a finding was located by, at observation o (the j-th of the
+// baseline fit), and its axis label: the x of its residual plot.
+double finding_variable(const Run &run, const Finding &f, const Obs &o, size_t j, std::string *xlab)
+{
+    bool altaz = run.mount == PM_MOUNT_ALTAZ;
+    if (f.effect == "ha_periodic" || f.effect == "dec_periodic") {
+        double th = f.effect == "ha_periodic" ? o.eh : o.ed;
+        *xlab = "phase of the period, G * raw " +
+                std::string(f.effect == "ha_periodic" ? (altaz ? "azimuth" : "HA")
+                                                      : (altaz ? "elevation" : "Dec")) + " (deg)";
+        return std::fmod(std::fmod(f.cycles_per_rev * th * 180 / PI, 360) + 360, 360);
+    }
+    if (f.effect == "refraction" || f.effect == "tube_flexure") {
+        double el = altaz ? o.ad
+                          : std::asin(std::sin(run.latitude) * std::sin(o.ad) +
+                                      std::cos(run.latitude) * std::cos(o.ad) * std::cos(o.ah));
+        *xlab = "elevation (deg)";
+        return el * 180 / PI;
+    }
+    if (f.effect == "temperature") {
+        *xlab = "temperature (deg C)";
+        return o.ctx.temp_c;
+    }
+    if (f.effect == "time_drift") {
+        *xlab = "time (h)";
+        return o.ctx.time_h;
+    }
+    if (f.effect == "hysteresis") {
+        *xlab = "direction of the last slew on axis 1 (-1, +1; jittered)";
+        return o.ctx.dir + 0.1 * ((double)(j % 7) - 3) / 3; // jitter to see the spread
+    }
+    if (f.effect == "pier_side") {
+        *xlab = "apparent hour angle (h); west pier = beyond the pole";
+        return std::remainder(o.ah, 2 * PI) * 12 / PI;
+    }
+    *xlab = "line in the run file";
+    return (double)o.line;
+}
+
 void write_explain_plots(const std::string &dir, const Run &run, const Explanation &ex)
 {
     std::error_code ec;
@@ -648,35 +687,7 @@ void write_explain_plots(const std::string &dir, const Run &run, const Explanati
         std::string xlab;
         for (size_t j = 0; j < b.idx.size(); j++) {
             const Obs &o = run.obs[b.idx[j]];
-            double x = NAN;
-            if (f.effect == "ha_periodic" || f.effect == "dec_periodic") {
-                double th = f.effect == "ha_periodic" ? o.eh : o.ed;
-                x = std::fmod(std::fmod(f.cycles_per_rev * th * 180 / PI, 360) + 360, 360);
-                xlab = "phase of the period, G * raw " +
-                       std::string(f.effect == "ha_periodic" ? "HA" : "Dec") + " (deg)";
-            } else if (f.effect == "refraction" || f.effect == "tube_flexure") {
-                double el = altaz ? o.ad
-                                  : std::asin(std::sin(run.latitude) * std::sin(o.ad) +
-                                              std::cos(run.latitude) * std::cos(o.ad) *
-                                                  std::cos(o.ah));
-                x = el * 180 / PI;
-                xlab = "elevation (deg)";
-            } else if (f.effect == "temperature") {
-                x = o.ctx.temp_c;
-                xlab = "temperature (deg C)";
-            } else if (f.effect == "time_drift") {
-                x = o.ctx.time_h;
-                xlab = "time (h)";
-            } else if (f.effect == "hysteresis") {
-                x = o.ctx.dir + 0.1 * ((double)(j % 7) - 3) / 3; // jitter to see the spread
-                xlab = "direction of the last slew on axis 1 (-1, +1; jittered)";
-            } else if (f.effect == "pier_side") {
-                x = std::remainder(o.ah, 2 * PI) * 12 / PI;
-                xlab = "apparent hour angle (h); west pier = beyond the pole";
-            } else {
-                x = (double)o.line;
-                xlab = "line in the run file";
-            }
+            double x = finding_variable(run, f, o, j, &xlab);
             double y0 = b.r0[j] * RAD2AS, y1 = b.r1[j] * RAD2AS;
             if (f.effect == "ha_periodic" && std::fabs(std::cos(o.ad)) > 0.2)
                 y0 /= std::fabs(std::cos(o.ad)); // along the axis, not on the sky
