@@ -727,6 +727,46 @@ pm_status pm_fit_covariance(const pm_fit *fit, const pm_fit_result *res,
                             int i, int j, double *cov, double *corr);
 
 /*
+**  pm_fit_pointing_sigma - how well the fitted model knows the pointing at
+**  one encoder position: the 1-sigma uncertainty of its correction there,
+**  from the coefficients' covariance (the model's own error, not the
+**  measurement noise).  Where the run sampled densely it is small; where
+**  the model extrapolates (below the lowest star, in a gap of the sky) it
+**  grows.  The predicted error map of docs/model.md ("How well the model
+**  knows the sky").
+**
+**  Given:
+**     fit      const pm_fit*           after a successful pm_fit_solve or
+**                                      pm_fit_run
+**     res      const pm_fit_result*    its result (for sigma)
+**     m        const pm_model*         the fitted model (its terms the fit's)
+**     ctx      const pm_context*       inputs of its physical terms (or NULL)
+**     enc_ha, enc_dec  double          the encoder position (rad)
+**  Returned:
+**     sigma    double*     per axis: sqrt((v11 + v22) / 2) (rad), on the
+**                          scale of res->sigma
+**     cov      double[3]   (may be NULL) v11, v12, v22 (rad^2): the
+**                          covariance of the correction along axis 1 (on
+**                          the sky) and axis 2
+**  Returned (function value):
+**              pm_status   PM_OK; PM_ERR_ARG (NULL, or m has another number
+**                          of terms than the fit); PM_ERR_STATE (no
+**                          successful solve); PM_ERR_NONFINITE; the model's
+**                          statuses of pm_fit_row
+**  Notes:
+**  1) J C J^T with J the position's two rows (pm_fit_row at the model's own
+**     prediction) and C = sigma^2 (J^T J)^-1 of the last solve: about P^2
+**     multiply-adds (2,100 at L = 2), allocation-free, for a controller
+**     choosing where to look next.
+**  2) The scatter of a corrected telescope at a new star is about
+**     sqrt(res->sigma^2 + sigma^2) per axis: the noise of one measurement
+**     plus this (tests/check_errormap.c compares it with held-out points).
+*/
+pm_status pm_fit_pointing_sigma(const pm_fit *fit, const pm_fit_result *res,
+                                const pm_model *m, const pm_context *ctx, double enc_ha,
+                                double enc_dec, double *sigma, double cov[3]);
+
+/*
 **  pm_fit_row - the two design-matrix rows of one observation.
 **
 **  Given:

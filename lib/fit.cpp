@@ -549,6 +549,55 @@ pm_status pm_fit_run(pm_fit *fit, pm_model *model, const pm_context *ctx,
     return PM_ERR_DIVERGED;
 }
 
+pm_status pm_fit_pointing_sigma(const pm_fit *fit, const pm_fit_result *res,
+                                const pm_model *m, const pm_context *ctx, double enc_ha,
+                                double enc_dec, double *sigma, double cov[3])
+{
+    if (!fit || !res || !m || !sigma)
+        return PM_ERR_ARG;
+    if (fit->state != FIT_READY || fit->iterations < 1 || !fit->cov_valid)
+        return PM_ERR_STATE;
+    if (m->n_terms != fit->n_par)
+        return PM_ERR_ARG;
+    if (!finite(enc_ha) || !finite(enc_dec))
+        return PM_ERR_NONFINITE;
+    double app_ha, app_dec, row0[PM_MAX_TERMS], row1[PM_MAX_TERMS], r[2];
+    pm_status st = pm_model_apply(m, ctx, enc_ha, enc_dec, &app_ha, &app_dec);
+    if (st != PM_OK)
+        return st;
+    st = pm_fit_row(m, ctx, enc_ha, enc_dec, app_ha, app_dec, row0, row1, r);
+    if (st != PM_OK)
+        return st;
+    /* J C J^T over the packed lower triangle: each off-diagonal element
+    ** twice */
+    const int P = fit->n_par;
+    double v00 = 0, v01 = 0, v11 = 0;
+    for (int i = 0; i < P; i++) {
+        for (int j = 0; j < i; j++) {
+            double c = fit->cov[pidx(i, j)];
+            v00 += 2 * row0[i] * c * row0[j];
+            v01 += c * (row0[i] * row1[j] + row1[i] * row0[j]);
+            v11 += 2 * row1[i] * c * row1[j];
+        }
+        double c = fit->cov[pidx(i, i)];
+        v00 += row0[i] * c * row0[i];
+        v01 += row0[i] * c * row1[i];
+        v11 += row1[i] * c * row1[i];
+    }
+    double s2 = res->sigma * res->sigma;
+    v00 *= s2;
+    v01 *= s2;
+    v11 *= s2;
+    double v = 0.5 * (v00 + v11);
+    *sigma = v > 0 ? m_sqrt(v) : 0.0;
+    if (cov) {
+        cov[0] = v00;
+        cov[1] = v01;
+        cov[2] = v11;
+    }
+    return PM_OK;
+}
+
 pm_status pm_fit_covariance(const pm_fit *fit, const pm_fit_result *res,
                             int i, int j, double *cov, double *corr)
 {

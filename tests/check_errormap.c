@@ -1,0 +1,176 @@
+/*
+**  check_errormap.c - the predicted error map (pm_fit_pointing_sigma):
+**  the 1-sigma uncertainty of the fitted model's correction at a sky
+**  position, from the fit's covariance, against the real error of fitted
+**  models at held-out positions.
+**
+**  40 runs of one mount (order 1 truth: arcminute isotropic terms, 15"
+**  anisotropic ones; 1" noise) observed on the EAST half of the sky only
+**  (hour angle < 0, 60 points above 10 deg), each fitted at L = 1; at 300
+**  held-out positions over the whole sky above 10 deg the error of the
+**  fitted correction (fitted model minus the truth, per axis) is compared
+**  with the predicted sigma: the ratio of the RMS of the one to the RMS of
+**  the other within 20% on the sampled half and on the unsampled half
+**  (where the model extrapolates and the predicted sigma is larger), and
+**  with the model noise-free, on each position's own (the 2x2 covariance).
+*/
+#define _POSIX_C_SOURCE 200809L
+#include <check.h>
+#include "tu_check.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pm.h"
+#include "testutil.h"
+
+#define RUNS 40
+#define NTRAIN 60
+#define NHELD 300
+#define LAT (47 * DEG)
+
+static pm_fit fit; /* large: static */
+
+static void truth_model(pm_model *m)
+{
+    tu_rng r;
+    int i;
+    static const double iso[6] = {60, -40, 600, 30, -300, 20};
+    ck_assert_int_eq(pm_model_init(m, PM_MOUNT_EQUATORIAL, 1), PM_OK);
+    for (i = 0; i < 6; i++)
+        m->coef[i] = iso[i] * ARCSEC;
+    tu_seed(&r, 4242);
+    for (i = 6; i < m->n_terms; i++)
+        m->coef[i] = (2 * tu_uniform(&r) - 1) * 15 * ARCSEC;
+    ck_assert_int_eq(pm_model_prepare(m), PM_OK);
+}
+
+/* A position above 10 deg elevation; east: hour angle < 0. */
+static void position(tu_rng *r, int east_only, double *t, double *d)
+{
+    double alt;
+    do {
+        *t = (2.0 * tu_uniform(r) - 1.0) * M_PI;
+        *d = asin(2.0 * tu_uniform(r) - 1.0);
+        alt = asin(sin(LAT) * sin(*d) + cos(LAT) * cos(*d) * cos(*t));
+    } while (alt < 10 * DEG || (east_only && *t >= 0));
+}
+
+/* Tangent-plane error of model a against b at encoder (t, d), per axis
+** (along the hour angle on the sky, along the declination). */
+static void error_of(const pm_model *a, const pm_model *b, double t, double d, double e[2])
+{
+    double ta, da, tb, db;
+    ck_assert_int_eq(pm_model_apply(a, NULL, t, d, &ta, &da), PM_OK);
+    ck_assert_int_eq(pm_model_apply(b, NULL, t, d, &tb, &db), PM_OK);
+    e[0] = remainder(ta - tb, 2 * M_PI) * cos(db);
+    e[1] = da - db;
+}
+
+START_TEST(test_errormap_matches_heldout)
+{
+    static double eh[NTRAIN], ed[NTRAIN], ah[NTRAIN], ad[NTRAIN];
+    pm_model truth, m;
+    tu_rng r, h;
+    int run, i, side;
+    /* [side] sums: squared real error, predicted variance; chi^2 of the
+    ** 2x2 form */
+    double err2[2] = {0, 0}, pred2[2] = {0, 0}, chi2 = 0;
+    long n[2] = {0, 0}, nchi = 0;
+    truth_model(&truth);
+    tu_seed(&r, 777);
+    for (run = 0; run < RUNS; run++) {
+        pm_fit_result res;
+        for (i = 0; i < NTRAIN; i++) {
+            position(&r, 1, &eh[i], &ed[i]);
+            ck_assert_int_eq(pm_model_apply(&truth, NULL, eh[i], ed[i], &ah[i], &ad[i]), PM_OK);
+            ad[i] += 1.0 * ARCSEC * tu_gauss(&r);
+            ah[i] += 1.0 * ARCSEC * tu_gauss(&r) / cos(ad[i]);
+        }
+        ck_assert_int_eq(pm_model_init(&m, PM_MOUNT_EQUATORIAL, 1), PM_OK);
+        ck_assert_int_eq(pm_fit_run(&fit, &m, NULL, NTRAIN, eh, ed, ah, ad, 50, &res), PM_OK);
+        tu_seed(&h, 991 + (unsigned long long)run);
+        for (i = 0; i < NHELD; i++) {
+            double t, d, e[2], s, c[3], det;
+            position(&h, 0, &t, &d);
+            side = t < 0 ? 0 : 1;
+            ck_assert_int_eq(pm_fit_pointing_sigma(&fit, &res, &m, NULL, t, d, &s, c), PM_OK);
+            error_of(&m, &truth, t, d, e);
+            err2[side] += 0.5 * (e[0] * e[0] + e[1] * e[1]);
+            pred2[side] += s * s;
+            n[side]++;
+            det = c[0] * c[2] - c[1] * c[1];
+            if (det > 0) {
+                chi2 += (c[2] * e[0] * e[0] - 2 * c[1] * e[0] * e[1] + c[0] * e[1] * e[1]) / det;
+                nchi++;
+            }
+        }
+    }
+    for (side = 0; side < 2; side++) {
+        double real = sqrt(err2[side] / (double)n[side]), pred = sqrt(pred2[side] / (double)n[side]);
+        printf("check_errormap: %s half: predicted %.3f\", real %.3f\" (ratio %.3f, %ld positions)\n",
+               side ? "unsampled (west)" : "sampled (east)", pred / ARCSEC, real / ARCSEC,
+               real / pred, n[side]);
+        ck_assert_msg(fabs(real / pred - 1) <= 0.2, "%s half: real/predicted %.3f",
+                      side ? "west" : "east", real / pred);
+    }
+    printf("check_errormap: chi^2 per position with the 2x2 covariance %.3f (2 expected)\n",
+           chi2 / (double)nchi);
+    ck_assert(fabs(chi2 / (double)nchi / 2 - 1) <= 0.2);
+    ck_assert(pred2[1] / (double)n[1] > 2 * pred2[0] / (double)n[0]); /* extrapolation shows */
+}
+END_TEST
+
+START_TEST(test_errormap_errors)
+{
+    static double eh[30], ed[30], ah[30], ad[30];
+    pm_model truth, m, other;
+    pm_fit_result res;
+    tu_run run;
+    double s, c[3];
+    int i;
+    truth_model(&truth);
+    ck_assert_int_eq(tu_simulate(&run, &truth, 30, LAT, 0, 1 * ARCSEC, 5), 0);
+    for (i = 0; i < 30; i++) {
+        eh[i] = run.eh[i];
+        ed[i] = run.ed[i];
+        ah[i] = run.ah[i];
+        ad[i] = run.ad[i];
+    }
+    tu_run_free(&run);
+    ck_assert_int_eq(pm_model_init(&m, PM_MOUNT_EQUATORIAL, 0), PM_OK);
+    ck_assert_int_eq(pm_fit_init(&fit, &m), PM_OK);
+    memset(&res, 0, sizeof res);
+    ck_assert_int_eq(pm_fit_pointing_sigma(&fit, &res, &m, NULL, 0.1, 0.2, &s, c), PM_ERR_STATE);
+    ck_assert_int_eq(pm_fit_run(&fit, &m, NULL, 30, eh, ed, ah, ad, 50, &res), PM_OK);
+    ck_assert_int_eq(pm_fit_pointing_sigma(&fit, &res, &m, NULL, 0.1, 0.2, &s, NULL), PM_OK);
+    ck_assert(s > 0 && s < res.sigma); /* 30 points know an order-0 model better than one point */
+    ck_assert_int_eq(pm_fit_pointing_sigma(NULL, &res, &m, NULL, 0.1, 0.2, &s, c), PM_ERR_ARG);
+    ck_assert_int_eq(pm_fit_pointing_sigma(&fit, NULL, &m, NULL, 0.1, 0.2, &s, c), PM_ERR_ARG);
+    ck_assert_int_eq(pm_fit_pointing_sigma(&fit, &res, NULL, NULL, 0.1, 0.2, &s, c), PM_ERR_ARG);
+    ck_assert_int_eq(pm_fit_pointing_sigma(&fit, &res, &m, NULL, 0.1, 0.2, NULL, c), PM_ERR_ARG);
+    ck_assert_int_eq(pm_model_init(&other, PM_MOUNT_EQUATORIAL, 1), PM_OK);
+    ck_assert_int_eq(pm_model_prepare(&other), PM_OK);
+    ck_assert_int_eq(pm_fit_pointing_sigma(&fit, &res, &other, NULL, 0.1, 0.2, &s, c), PM_ERR_ARG);
+    ck_assert_int_eq(pm_fit_pointing_sigma(&fit, &res, &m, NULL, NAN, 0.2, &s, c), PM_ERR_NONFINITE);
+    ck_assert_int_eq(pm_fit_pointing_sigma(&fit, &res, &m, NULL, 0.1, INFINITY, &s, c),
+                     PM_ERR_NONFINITE);
+}
+END_TEST
+
+static Suite *suite(void)
+{
+    Suite *s = suite_create("errormap");
+    TCase *t = tcase_create("errormap");
+    tcase_set_timeout(t, 300);
+    tcase_add_test(t, test_errormap_matches_heldout);
+    tcase_add_test(t, test_errormap_errors);
+    suite_add_tcase(s, t);
+    return s;
+}
+
+int main(void)
+{
+    return tu_run_suite(suite());
+}
