@@ -13,6 +13,8 @@
 **  the other within 20% on the sampled half and on the unsampled half
 **  (where the model extrapolates and the predicted sigma is larger), and
 **  with the model noise-free, on each position's own (the 2x2 covariance).
+**  pmfit fit's map (--json "error_map", --error-map FILE.svg) agrees with
+**  the C API at the run's own points.
 */
 #define _POSIX_C_SOURCE 200809L
 #include <check.h>
@@ -23,7 +25,9 @@
 #include <string.h>
 
 #include "pm.h"
+#include "runfile.h"
 #include "testutil.h"
+#include "tu_tool.h"
 
 #define RUNS 40
 #define NTRAIN 60
@@ -159,6 +163,78 @@ START_TEST(test_errormap_errors)
 }
 END_TEST
 
+/* pmfit fit reports the map (its value at the stars is the C API's), and
+** draws it. */
+START_TEST(test_errormap_pmfit)
+{
+    static double eh[400], ed[400], ah[400], ad[400];
+    static char out[1 << 16];
+    const char *top = getenv("PM_TOP");
+    char path[512], cmd[2048], err[512], dir[64], svg[128];
+    pmrun_options ro;
+    pmrun *run = NULL;
+    pm_model m;
+    pm_fit_result res;
+    size_t i, n;
+    double ss = 0, at;
+    snprintf(path, sizeof path, "%s/tests/data/flip_gem_pm180.dat", top ? top : ".");
+    pmrun_options_default(&ro);
+    ck_assert_msg(pmrun_read(path, &ro, &run, err, sizeof err) == 0, "%s", err);
+    n = pmrun_count(run);
+    ck_assert(n <= 400);
+    for (i = 0; i < n; i++) {
+        const pmrun_obs *o = pmrun_get(run, i);
+        eh[i] = o->enc_ha;
+        ed[i] = o->enc_dec;
+        ah[i] = o->app_ha;
+        ad[i] = o->app_dec;
+    }
+    pmrun_free(run);
+    ck_assert_int_eq(pm_model_init(&m, PM_MOUNT_EQUATORIAL, 1), PM_OK);
+    ck_assert_int_eq(pm_fit_run(&fit, &m, NULL, (long)n, eh, ed, ah, ad, 50, &res), PM_OK);
+    for (i = 0; i < n; i++) {
+        double s;
+        ck_assert_int_eq(pm_fit_pointing_sigma(&fit, &res, &m, NULL, eh[i], ed[i], &s, NULL), PM_OK);
+        ss += s * s;
+    }
+    tu_tmpdir(dir, "pm_errormap_");
+    snprintf(svg, sizeof svg, "%s/map.svg", dir);
+    snprintf(cmd, sizeof cmd, "%s fit '%s' --json --error-map %s", tu_pmfit_path(), path, svg);
+    ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
+    {
+        const char *em = strstr(out, "\"error_map\"");
+        ck_assert_ptr_nonnull(em);
+        at = tu_json_num(em, "at_points_arcsec");
+        printf("check_errormap: flip_gem at the stars: pmfit %.6f\", C API %.6f\"; over the sky "
+               "%.3f\", max %.3f\"\n", at, sqrt(ss / (double)n) / ARCSEC,
+               tu_json_num(em, "rms_arcsec"), tu_json_num(em, "max_arcsec"));
+        ck_assert(fabs(at - sqrt(ss / (double)n) / ARCSEC) <= 1e-4 * at);
+        ck_assert(tu_json_num(em, "max_arcsec") > tu_json_num(em, "rms_arcsec"));
+        ck_assert(tu_json_num(em, "rms_arcsec") >= at);
+    }
+    {
+        FILE *f = fopen(svg, "r");
+        size_t k = 0;
+        int c, rects = 0;
+        char win[6] = {0};
+        ck_assert_ptr_nonnull(f);
+        while ((c = fgetc(f)) != EOF) {
+            memmove(win, win + 1, 4);
+            win[4] = (char)c;
+            rects += !strncmp(win, "<rect", 5);
+            k++;
+        }
+        fclose(f);
+        ck_assert_int_gt(rects, 500); /* the cells of the map */
+    }
+    /* an unwritable map: an error, nothing computed is lost (the report is
+    ** printed first) */
+    snprintf(cmd, sizeof cmd, "%s fit '%s' --error-map /nonexistent/dir/map.svg", tu_pmfit_path(), path);
+    ck_assert(tu_capture(cmd, out, sizeof out) != 0);
+    ck_assert_ptr_nonnull(strstr(out, "/nonexistent/dir"));
+}
+END_TEST
+
 static Suite *suite(void)
 {
     Suite *s = suite_create("errormap");
@@ -166,6 +242,7 @@ static Suite *suite(void)
     tcase_set_timeout(t, 300);
     tcase_add_test(t, test_errormap_matches_heldout);
     tcase_add_test(t, test_errormap_errors);
+    tcase_add_test(t, test_errormap_pmfit);
     suite_add_tcase(s, t);
     return s;
 }

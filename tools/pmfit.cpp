@@ -17,6 +17,7 @@
 #include "modelfile.h"
 #include "simulate.h"
 #include "inject.hpp"
+#include "errormap.hpp"
 #include "hostutil.hpp"
 #include "fitrun.hpp"
 #include "explain.hpp"
@@ -69,6 +70,7 @@ struct Options {
     std::vector<std::pair<std::string, double>> terms;
     std::vector<std::pair<std::string, double>> effects; // simulate --effect SPEC=ARCSEC
     double phase_deg = 0;
+    std::string error_map;           // fit --error-map FILE.svg
     std::vector<std::string> inject; // simulate --inject EFFECT[=SIZE] --into RUN
     std::string into;
     std::string shape_opt;           // a simulate option that shapes a simulated run
@@ -104,6 +106,9 @@ void usage(FILE *f)
         "  --save MODEL     write the fitted model as a text model file (docs/formats.md);\n"
         "                   with --pier split: MODEL-east and MODEL-west\n"
         "  --emit-c HEADER  write the model as C constant data with a loader, for firmware\n"
+        "  --error-map F    write the predicted pointing error of the model over the sky\n"
+        "                   (1 sigma, from the fit's covariance) as an SVG map; with\n"
+        "                   --pier split: F-east and F-west (docs/model.md)\n"
         "  --no-refraction  leave refraction out of the TPOINT reduction\n"
         "  --skip-bad       skip malformed records (each is reported) instead of failing\n"
         "  --robust         ignore gross outliers (failed plate solves): clip points whose\n"
@@ -252,6 +257,8 @@ Options parse_args(int argc, char **argv)
             o.adds.push_back(need("an effect (see pmfit --help)"));
         } else if (!sim && !eval && !expl && a == "--save") {
             o.save = need("a file name");
+        } else if (!sim && !eval && !expl && a == "--error-map") {
+            o.error_map = need("a file name (SVG)");
         } else if (!sim && !eval && !expl && a == "--emit-c") {
             o.emit_c = need("a file name");
         } else if (sim && a == "--inject") {
@@ -906,6 +913,7 @@ int run_main(int argc, char **argv)
             continue;
         check_output("--save", o.save.empty() ? o.save : o.save + sfx);
         check_output("--emit-c", o.emit_c.empty() ? o.emit_c : o.emit_c + sfx);
+        check_output("--error-map", o.error_map.empty() ? o.error_map : o.error_map + sfx);
     }
     check_output("--residuals", o.residuals);
     if (o.cmd == "simulate")
@@ -1025,6 +1033,23 @@ int run_main(int argc, char **argv)
         }
     }
 
+    // the predicted error map of each fit (pier side of a split fit: its own)
+    std::vector<ErrorMap> maps;
+    for (size_t k = 0; k < fits.size(); k++) {
+        int side = fits.size() == 1 ? 0 : (k == 0 ? 1 : -1);
+        maps.push_back(error_map(run, fits[k], side));
+        std::string suffix = fits.size() == 1 ? "" : (k == 0 ? "-east" : "-west");
+        if (!o.error_map.empty()) {
+            try {
+                error_map_plot(o.error_map + suffix, run, maps[k],
+                               "Predicted pointing error of the model (1 sigma per axis), " +
+                                   titles[k]);
+            } catch (const std::exception &x) {
+                write_errors.push_back(x.what());
+            }
+        }
+    }
+
     std::string fjson;
     if (ftest.done) {
         char b[256];
@@ -1037,14 +1062,19 @@ int run_main(int argc, char **argv)
     if (o.json) {
         auto rj = [&](size_t k) { return o.robust ? robust_json(robs[k], obs) : std::string(); };
         if (fits.size() == 1) {
-            std::string r = rj(0);
-            print_json_fit(fits[0], fjson + (fjson.empty() || r.empty() ? "" : ", ") + r);
+            std::string r = rj(0), em = error_map_json(maps[0]);
+            r = r.empty() ? em : r + ", " + em;
+            print_json_fit(fits[0], fjson + (fjson.empty() ? "" : ", ") + r);
         } else {
             std::printf("{\"pier\": \"split\", %s%s\"sides\": {\"east\": ", fjson.c_str(),
                         fjson.empty() ? "" : ", ");
-            print_json_fit(fits[0], rj(0));
+            auto with_map = [&](size_t k) {
+                std::string r = rj(k);
+                return (r.empty() ? "" : r + ", ") + error_map_json(maps[k]);
+            };
+            print_json_fit(fits[0], with_map(0));
             std::printf(", \"west\": ");
-            print_json_fit(fits[1], rj(1));
+            print_json_fit(fits[1], with_map(1));
             std::printf("}}");
         }
         std::printf("\n");
@@ -1053,6 +1083,7 @@ int run_main(int argc, char **argv)
                     mount == PM_MOUNT_ALTAZ ? "alt-az" : "equatorial", obs.size());
         for (size_t k = 0; k < fits.size(); k++) {
             print_table(titles[k].c_str(), fits[k], obs, o.run);
+            std::printf("\n%s\n", error_map_text(run, maps[k]).c_str());
             if (o.robust)
                 print_robust(robs[k], obs, o.run);
             else

@@ -395,6 +395,87 @@ int sky_vectors_pair(const std::string &path, const std::string &title, const st
                    group_names, err);
 }
 
+namespace {
+
+// A sequential colour scale (dark blue - teal - yellow), f in [0, 1].
+std::string ramp(double f)
+{
+    static const double c[5][3] = {{38, 24, 110}, {42, 92, 160}, {33, 145, 140}, {94, 201, 98},
+                                   {253, 231, 37}};
+    f = std::min(1.0, std::max(0.0, fin(f) ? f : 0.0)) * 4;
+    int i = std::min(3, (int)f);
+    double t = f - i;
+    return fmt("#%02x%02x%02x", (int)std::lround(c[i][0] + t * (c[i + 1][0] - c[i][0])),
+               (int)std::lround(c[i][1] + t * (c[i + 1][1] - c[i][1])),
+               (int)std::lround(c[i][2] + t * (c[i + 1][2] - c[i][2])));
+}
+
+} // namespace
+
+int sky_scalar(const std::string &path, const std::string &title, const std::string &xlabel,
+               const std::string &ylabel, const std::vector<Cell> &cells, const std::string &unit,
+               const std::vector<std::pair<double, double>> &marks, const std::string &marks_name,
+               std::string *err)
+{
+    double mnx = INFINITY, mxx = -INFINITY, mny = INFINITY, mxy = -INFINITY, vmax = 0;
+    size_t n = 0;
+    for (const Cell &c : cells)
+        if (fin(c.x) && fin(c.y) && fin(c.w) && fin(c.h) && fin(c.v)) {
+            mnx = std::min(mnx, c.x - c.w / 2), mxx = std::max(mxx, c.x + c.w / 2);
+            mny = std::min(mny, c.y - c.h / 2), mxy = std::max(mxy, c.y + c.h / 2);
+            vmax = std::max(vmax, c.v);
+            n++;
+        }
+    const int W = 900, H = 560;
+    Svg g(W, H, title);
+    std::vector<Item> items;
+    if (!marks.empty())
+        items.push_back({'o', INK, marks_name + fmt(" (%zu)", marks.size()), 0});
+    double top = 50 + legend(g, items, 40, W - 140, 46) + 20;
+    Panel p(g, 90, top, W - 150, H - 62);
+    p.ax.angular = p.ay.angular = true;
+    p.zero_line = false;
+    if (!n)
+        mnx = 0, mxx = 1, mny = 0, mxy = 1;
+    set_range(p.ax, mnx, mxx, 0.0);
+    set_range(p.ay, mny, mxy, 0.0);
+    p.under(g);
+    double vtop = vmax > 0 ? vmax : 1;
+    for (const Cell &c : cells) {
+        if (!(fin(c.x) && fin(c.y) && fin(c.w) && fin(c.h) && fin(c.v)))
+            continue;
+        double x0 = p.ax.map(c.x - c.w / 2), x1 = p.ax.map(c.x + c.w / 2);
+        double y0 = p.ay.map(c.y + c.h / 2), y1 = p.ay.map(c.y - c.h / 2);
+        g.rect(std::min(x0, x1), std::min(y0, y1), std::fabs(x1 - x0) + 0.6, std::fabs(y1 - y0) + 0.6,
+               ramp(c.v / vtop).c_str());
+    }
+    for (const auto &m : marks)
+        if (fin(m.first) && fin(m.second))
+            g.s += fmt("<circle cx=\"%.1f\" cy=\"%.1f\" r=\"2.6\" fill=\"none\" stroke=\"%s\" "
+                       "stroke-width=\"1.2\"/>\n", p.ax.map(m.first), p.ay.map(m.second), INK);
+    p.over(g, xlabel, ylabel, n == 0);
+    // the colour bar, 0 .. vmax
+    double bx = W - 120, by0 = top, by1 = H - 62, steps = 40;
+    for (int k = 0; k < steps; k++) {
+        double f0 = k / steps, f1 = (k + 1) / steps;
+        g.rect(bx, by1 - f1 * (by1 - by0), 18, (f1 - f0) * (by1 - by0) + 0.6, ramp((f0 + f1) / 2).c_str());
+    }
+    g.rect(bx, by0, 18, by1 - by0, "none", fmt(" stroke=\"%s\" stroke-width=\"1\"", FRAME));
+    Axis a;
+    a.p0 = by1;
+    a.p1 = by0;
+    set_range(a, 0, vtop, 0.0);
+    a.lo = 0;
+    a.hi = vtop;
+    for (const Tick &t : ticks(a, 55)) {
+        double y = a.map(t.v);
+        g.line(bx + 18, y, bx + 23, y, FRAME, 1);
+        if (!t.label.empty()) g.text(bx + 26, y + 4, t.label, 12, "start");
+    }
+    g.text(bx + 9, by0 - 8, unit, 13);
+    return finish(path, g, err);
+}
+
 int xy(const std::string &path, const std::string &title, const std::string &xlabel,
        const std::string &ylabel, const std::vector<Series> &s, std::string *err)
 {

@@ -44,6 +44,22 @@ int sky_vectors_pair(const std::string &path, const std::string &title, const st
                      const std::string &after_title, double scale_arcsec,
                      const std::vector<std::string> &group_names, std::string *err);
 
+// A value on the sky (a cell of a map), degrees and the value's unit.
+struct Cell {
+    double x, y;        // cell centre, degrees
+    double w, h;        // cell size, degrees
+    double v;           // the value (non-finite: not drawn)
+};
+
+// A map of a scalar over the sky: each cell filled by its value on a sequential colour
+// scale from 0 to the largest value (a colour bar with ticks and `unit` beside the frame),
+// and the points `marks` (x, y in degrees, e.g. the observed stars) drawn as small black
+// rings on top, named `marks_name` in the legend.
+int sky_scalar(const std::string &path, const std::string &title, const std::string &xlabel,
+               const std::string &ylabel, const std::vector<Cell> &cells, const std::string &unit,
+               const std::vector<std::pair<double, double>> &marks, const std::string &marks_name,
+               std::string *err);
+
 // A series of an xy plot.  line = true: a polyline in the given order (a non-finite point
 // breaks it), e.g. a model curve; line = false: scatter points.  x and y must have the
 // same length.  An empty name leaves the series out of the legend.

@@ -1,0 +1,172 @@
+// errormap.cpp - the predicted error map of a fitted model (errormap.hpp).
+#include "errormap.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+namespace pmhost {
+
+namespace {
+
+const double DEG = PI / 180;
+
+// Per-axis 1-sigma of the correction at encoder (t, d) with inputs ctx:
+// sqrt((J0 C J0 + J1 C J1) / 2), C the fit's covariance (rad^2).
+double sigma_at(const FitOut &f, const pm_context &ctx, double t, double d)
+{
+    const pm_model &m = f.model;
+    int P = m.n_terms;
+    double T, D, r[2];
+    std::vector<double> a(PM_MAX_TERMS), b(PM_MAX_TERMS);
+    if (pm_model_apply(&m, &ctx, t, d, &T, &D) != PM_OK ||
+        pm_fit_row(&m, &ctx, t, d, T, D, a.data(), b.data(), r) != PM_OK)
+        return NAN;
+    double v = 0;
+    for (int i = 0; i < P; i++)
+        for (int j = 0; j < P; j++)
+            v += f.cov[(size_t)(i * P + j)] * (a[(size_t)i] * a[(size_t)j] + b[(size_t)i] * b[(size_t)j]);
+    return v > 0 ? std::sqrt(v / 2) : 0.0;
+}
+
+// Inputs for the map: the run's mean temperature and time, no slew
+// direction, the mean of every auxiliary column; the pier side given.
+pm_context mean_context(const Run &run, int side)
+{
+    pm_context c = pm_context();
+    double s[3 + PM_MAX_AUX] = {0};
+    long n[3 + PM_MAX_AUX] = {0};
+    for (const Obs &o : run.obs) {
+        double x[3 + PM_MAX_AUX] = {o.ctx.temp_c, o.ctx.time_h, 0};
+        for (int k = 0; k < PM_MAX_AUX; k++)
+            x[3 + k] = o.ctx.aux[k];
+        for (int k = 0; k < 3 + PM_MAX_AUX; k++)
+            if (std::isfinite(x[k]))
+                s[k] += x[k], n[k]++;
+    }
+    c.temp_c = n[0] ? s[0] / (double)n[0] : 0;
+    c.time_h = n[1] ? s[1] / (double)n[1] : 0;
+    c.dir = 0;
+    c.pier = side;
+    for (int k = 0; k < PM_MAX_AUX; k++)
+        c.aux[k] = n[3 + k] ? s[3 + k] / (double)n[3 + k] : 0;
+    return c;
+}
+
+// The pier side of the run's star nearest to (ha, dec) on the sky (+1 when
+// it gives none).
+int nearest_side(const Run &run, const FitOut &f, double ha, double dec)
+{
+    double best = -2;
+    int side = 1;
+    for (int i : f.idx) {
+        const Obs &o = run.obs[i];
+        double c = std::sin(dec) * std::sin(o.ad) + std::cos(dec) * std::cos(o.ad) * std::cos(ha - o.ah);
+        if (c > best)
+            best = c, side = o.pier < 0 ? -1 : 1;
+    }
+    return side;
+}
+
+double elevation(const Run &run, double ha, double dec)
+{
+    return std::asin(std::sin(run.latitude) * std::sin(dec) +
+                     std::cos(run.latitude) * std::cos(dec) * std::cos(ha));
+}
+
+} // namespace
+
+ErrorMap error_map(const Run &run, const FitOut &f, int side)
+{
+    ErrorMap e;
+    int P = f.model.n_terms;
+    if (f.cov.size() != (size_t)(P * P))
+        throw std::runtime_error("error map: the fit has no covariance");
+    bool altaz = run.mount == PM_MOUNT_ALTAZ;
+    e.elevation = altaz || std::isfinite(run.latitude);
+    // the usable sky: above the run's lowest star (whole degrees, >= 0 in elevation)
+    double lo = 90, ss = 0;
+    long np = 0;
+    for (int i : f.idx) {
+        const Obs &o = run.obs[i];
+        double y = altaz ? o.ad : e.elevation ? elevation(run, o.ah, o.ad) : o.ad;
+        lo = std::min(lo, y / DEG);
+        double x = std::remainder(o.ah, 2 * PI) / DEG;
+        e.marks.push_back({altaz && x < 0 ? x + 360 : x, o.ad / DEG});
+        double s = sigma_at(f, o.ctx, o.eh, o.ed);
+        if (std::isfinite(s))
+            ss += s * s, np++;
+    }
+    e.limit_deg = e.elevation ? std::max(0.0, std::floor(lo)) : std::floor(lo);
+    e.at_points_arcsec = np ? std::sqrt(ss / (double)np) * RAD2AS : NAN;
+    pm_context ctx = mean_context(run, side);
+    double sum = 0, area = 0;
+    const double step = 3;
+    for (double y = -90 + step / 2; y < 90; y += step) {
+        int nx = std::max(1, (int)std::lround(360 / step * std::cos(y * DEG)));
+        double w = 360.0 / nx;
+        for (int k = 0; k < nx; k++) {
+            double x = (altaz ? 0 : -180) + w * (k + 0.5);
+            double above = altaz ? y : e.elevation ? elevation(run, x * DEG, y * DEG) / DEG : y;
+            if (above < e.limit_deg)
+                continue;
+            // the encoder position of that place on this pier side (side 0
+            // of an equatorial mount: the side of the run's nearest star)
+            double t = x * DEG, d = y * DEG;
+            int sd = altaz ? 0 : side ? side : nearest_side(run, f, t, d);
+            ctx.pier = sd;
+            if (sd < 0)
+                t += PI, d = PI - d;
+            double s = sigma_at(f, ctx, t, d) * RAD2AS;
+            if (!std::isfinite(s))
+                continue;
+            e.cells.push_back({x, y, w, step, s});
+            double a = std::cos(y * DEG);
+            sum += s * s * a;
+            area += a;
+            if (s > e.max_arcsec)
+                e.max_arcsec = s, e.max_x_deg = x, e.max_y_deg = y;
+        }
+    }
+    e.mean_arcsec = area > 0 ? std::sqrt(sum / area) : NAN;
+    return e;
+}
+
+std::string error_map_text(const Run &run, const ErrorMap &e)
+{
+    bool altaz = run.mount == PM_MOUNT_ALTAZ;
+    char b[600];
+    std::snprintf(b, sizeof b,
+                  "  predicted pointing error of this model (1 sigma per axis, from the fit's "
+                  "covariance):\n    over the sky above %s %.0f deg (the lowest star): RMS %.3g\", "
+                  "max %.3g\" at %s %.0f deg, %s %.0f deg; at the stars %.3g\"",
+                  e.elevation ? "elevation" : "declination", e.limit_deg, e.mean_arcsec,
+                  e.max_arcsec, altaz ? "azimuth" : "HA", e.max_x_deg,
+                  altaz ? "elevation" : "Dec", e.max_y_deg, e.at_points_arcsec);
+    return b;
+}
+
+std::string error_map_json(const ErrorMap &e)
+{
+    char b[400];
+    std::snprintf(b, sizeof b,
+                  "\"error_map\": {\"limit\": \"%s\", \"limit_deg\": %.6g, \"rms_arcsec\": %.6g, "
+                  "\"max_arcsec\": %.6g, \"max_at_deg\": [%.6g, %.6g], \"at_points_arcsec\": %.6g}",
+                  e.elevation ? "elevation" : "declination", e.limit_deg, e.mean_arcsec,
+                  e.max_arcsec, e.max_x_deg, e.max_y_deg, e.at_points_arcsec);
+    return b;
+}
+
+void error_map_plot(const std::string &path, const Run &run, const ErrorMap &e,
+                    const std::string &title)
+{
+    bool altaz = run.mount == PM_MOUNT_ALTAZ;
+    std::string err;
+    if (pmplot::sky_scalar(path, title, altaz ? "azimuth (deg)" : "hour angle (deg)",
+                           altaz ? "elevation (deg)" : "declination (deg)", e.cells,
+                           "1 sigma (arcsec)", e.marks, "observed stars", &err) != 0)
+        throw std::runtime_error(err);
+}
+
+} // namespace pmhost

@@ -1,0 +1,45 @@
+// errormap.hpp - the predicted error map of a fitted model (host side):
+// the 1-sigma uncertainty of its correction over the usable sky, from the
+// fit's covariance (the same J C J^T as pm_fit_pointing_sigma), its mean and
+// maximum, and the cells of a sky plot.  docs/model.md, "How well the model
+// knows the sky".
+#ifndef PM_ERRORMAP_HPP
+#define PM_ERRORMAP_HPP
+
+#include "fitrun.hpp"
+#include "plots.hpp"
+
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace pmhost {
+
+struct ErrorMap {
+    bool elevation = true;        // the sky's lower limit is an elevation (else a declination)
+    double limit_deg = 0;         // the usable sky: above the run's lowest star (deg)
+    double mean_arcsec = 0, max_arcsec = 0; // over the usable sky, per axis
+    double max_x_deg = 0, max_y_deg = 0;    // where the maximum is (HA, Dec or az, el)
+    double at_points_arcsec = 0;  // RMS at the run's own points
+    std::vector<pmplot::Cell> cells;             // the map (x, y in degrees)
+    std::vector<std::pair<double, double>> marks; // the run's points, same axes
+};
+
+// The map of fit f of run over the usable sky, for the pier side `side`
+// (+1 normal, -1 beyond the pole; 0: alt-az, or an equatorial mount used
+// as the run used it -- each place on the side of the run's nearest star):
+// cells of about 3 deg.
+// Throws std::runtime_error if the fit has no covariance.
+ErrorMap error_map(const Run &run, const FitOut &f, int side);
+
+// A line for the text report and a JSON object (keys in docs/formats.md).
+std::string error_map_text(const Run &run, const ErrorMap &e);
+std::string error_map_json(const ErrorMap &e);
+
+// The sky plot (an SVG file); throws with the reason on failure.
+void error_map_plot(const std::string &path, const Run &run, const ErrorMap &e,
+                    const std::string &title);
+
+} // namespace pmhost
+
+#endif
