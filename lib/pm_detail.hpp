@@ -877,16 +877,18 @@ inline void sh_sums(int L, const Trig<T> &g, const W (*dense)[6], T S[6])
 ** table, then the added terms. */
 template <typename T>
 inline void aniso(const pm_model *m, const Iso<T> &k, const Trig<T> &g0,
-                  const pm_context *ctx, T *dt, T *dd)
+                  const pm_context *ctx, T *dt, T *dd, const T *sh = 0)
 {
     PM_EVAL_PROBE();
     T S[6];
     sh_sums<T, double>(m->order, g0, m->dense, S);
     /* sum_k S_k (u_k, v_k), written out (the products of the position's
     ** trig formed beside the sums: a short chain after them); the tilts
-    ** (S_0, S_1) at the shifted position (base_uv_at) */
-    const T stp = g0.st * k.cc + g0.ct * k.sc, ctp = g0.ct * k.cc - g0.st * k.sc;
-    const T sdp = g0.sd * k.ce - g0.cd * k.se;
+    ** (S_0, S_1) at the shifted position (base_uv_at; sh: its trig when
+    ** the caller has it, as forward_vec does) */
+    const T stp = sh ? sh[0] : g0.st * k.cc + g0.ct * k.sc;
+    const T ctp = sh ? sh[1] : g0.ct * k.cc - g0.st * k.sc;
+    const T sdp = sh ? sh[2] : g0.sd * k.ce - g0.cd * k.se;
     const T sc = sdp * ctp, ss = sdp * stp;
     *dt = ((g0.cd * S[2] + S[5]) - sc * S[0]) - (ss * S[1] + g0.sd * S[3]);
     *dd = (S[0] * stp - S[4]) - S[1] * ctp;
@@ -915,8 +917,9 @@ inline V3<T> forward_vec(const pm_model *m, const Iso<T> &k, const Trig<T> &g,
                          const pm_context *ctx, T *sh = 0)
 {
     T dt, dd, stp, ctp, sdp, cdp;
-    aniso<T>(m, k, g, ctx, &dt, &dd);
     shifted<T>(k, g, &stp, &ctp, &sdp, &cdp);
+    const T sg[4] = {stp, ctp, sdp, cdp};
+    aniso<T>(m, k, g, ctx, &dt, &dd, sg);
     if (sh) {
         sh[0] = stp;
         sh[1] = ctp;
