@@ -1038,6 +1038,66 @@ extern "C" void pmx_options_default(pmx_options *o)
     o->folds = d.folds;
 }
 
+namespace {
+
+void finding_to_c(const pmhost::Finding &f, pmx_finding &g)
+{
+    using namespace pmhost;
+    std::snprintf(g.effect, sizeof g.effect, "%s", f.effect.c_str());
+    g.cycles_per_rev = f.cycles_per_rev;
+    g.amplitude_arcsec = f.amplitude_arcsec;
+    g.amplitude_err_arcsec = f.amplitude_err_arcsec;
+    g.phase_deg = f.phase_deg;
+    g.false_alarm_probability = f.false_alarm_probability;
+    g.sigma_after_arcsec = f.sigma_after_arcsec;
+    g.cv_rms_after_arcsec = f.cv_rms_after_arcsec;
+    g.n_params_after = f.n_params_after;
+    g.n_lines = (int)f.lines.size();
+    for (size_t k = 0; k < f.lines.size() && k < 16; k++)
+        g.lines[k] = f.lines[k];
+    std::snprintf(g.with, sizeof g.with, "%s", f.with.c_str());
+    for (const Alternative &a : f.alternatives) {
+        if (g.n_alternatives >= PMX_MAX_ALTERNATIVES)
+            break;
+        pmx_alternative &b = g.alternatives[g.n_alternatives++];
+        std::snprintf(b.effect, sizeof b.effect, "%s", a.effect.c_str());
+        std::snprintf(b.separate_by, sizeof b.separate_by, "%s", a.separate_by.c_str());
+        b.delta_bic = a.delta_bic;
+        b.log10_lr = a.log10_lr;
+        b.log10_fap = a.log10_fap;
+    }
+}
+
+// The explanation as the plain structs of explain.h (r zeroed by the caller).
+void explanation_to_c(const pmhost::Explanation &ex, pmx_result &r)
+{
+    using namespace pmhost;
+    r.base_sigma_arcsec = ex.base_sigma_arcsec;
+    r.base_cv_rms_arcsec = ex.base_cv_rms_arcsec;
+    r.base_n_params = ex.base_n_params;
+    r.final_sigma_arcsec = ex.final_sigma_arcsec;
+    r.final_cv_rms_arcsec = ex.final_cv_rms_arcsec;
+    r.final_n_params = ex.final_n_params;
+    for (const Finding &f : ex.findings)
+        if (r.n_findings < PMX_MAX_FINDINGS)
+            finding_to_c(f, r.findings[r.n_findings++]);
+    for (const Interpretation &it : ex.interpretation) {
+        if (r.n_readings >= PMX_MAX_READINGS)
+            break;
+        pmx_reading &b = r.readings[r.n_readings++];
+        std::snprintf(b.what, sizeof b.what, "%s", it.what.c_str());
+        std::snprintf(b.unit, sizeof b.unit, "%s", it.unit.c_str());
+        b.value = it.value;
+        b.error = it.error;
+    }
+    r.physical_reading = !ex.physical_reading.empty();
+    for (const Finding &w : ex.withdrawn)
+        if (r.n_withdrawn < PMX_MAX_FINDINGS)
+            std::snprintf(r.withdrawn[r.n_withdrawn++], sizeof r.withdrawn[0], "%s", w.effect.c_str());
+}
+
+} // namespace
+
 extern "C" int pmx_explain_opts(const char *path, const pmx_options *opt, pmx_result *out,
                                 char *err, size_t errlen)
 {
@@ -1067,53 +1127,7 @@ extern "C" int pmx_explain_opts(const char *path, const pmx_options *opt, pmx_re
         Explanation ex = explain(run, o);
         pmx_result r;
         std::memset(&r, 0, sizeof r);
-        r.base_sigma_arcsec = ex.base_sigma_arcsec;
-        r.base_cv_rms_arcsec = ex.base_cv_rms_arcsec;
-        r.base_n_params = ex.base_n_params;
-        r.final_sigma_arcsec = ex.final_sigma_arcsec;
-        r.final_cv_rms_arcsec = ex.final_cv_rms_arcsec;
-        r.final_n_params = ex.final_n_params;
-        for (const Finding &f : ex.findings) {
-            if (r.n_findings >= PMX_MAX_FINDINGS)
-                break;
-            pmx_finding &g = r.findings[r.n_findings++];
-            std::snprintf(g.effect, sizeof g.effect, "%s", f.effect.c_str());
-            g.cycles_per_rev = f.cycles_per_rev;
-            g.amplitude_arcsec = f.amplitude_arcsec;
-            g.amplitude_err_arcsec = f.amplitude_err_arcsec;
-            g.phase_deg = f.phase_deg;
-            g.false_alarm_probability = f.false_alarm_probability;
-            g.sigma_after_arcsec = f.sigma_after_arcsec;
-            g.cv_rms_after_arcsec = f.cv_rms_after_arcsec;
-            g.n_params_after = f.n_params_after;
-            g.n_lines = (int)f.lines.size();
-            for (size_t k = 0; k < f.lines.size() && k < 16; k++)
-                g.lines[k] = f.lines[k];
-            std::snprintf(g.with, sizeof g.with, "%s", f.with.c_str());
-            for (const Alternative &a : f.alternatives) {
-                if (g.n_alternatives >= PMX_MAX_ALTERNATIVES)
-                    break;
-                pmx_alternative &b = g.alternatives[g.n_alternatives++];
-                std::snprintf(b.effect, sizeof b.effect, "%s", a.effect.c_str());
-                std::snprintf(b.separate_by, sizeof b.separate_by, "%s", a.separate_by.c_str());
-                b.delta_bic = a.delta_bic;
-                b.log10_lr = a.log10_lr;
-                b.log10_fap = a.log10_fap;
-            }
-        }
-        for (const Interpretation &it : ex.interpretation) {
-            if (r.n_readings >= PMX_MAX_READINGS)
-                break;
-            pmx_reading &b = r.readings[r.n_readings++];
-            std::snprintf(b.what, sizeof b.what, "%s", it.what.c_str());
-            std::snprintf(b.unit, sizeof b.unit, "%s", it.unit.c_str());
-            b.value = it.value;
-            b.error = it.error;
-        }
-        r.physical_reading = !ex.physical_reading.empty();
-        for (const Finding &w : ex.withdrawn)
-            if (r.n_withdrawn < PMX_MAX_FINDINGS)
-                std::snprintf(r.withdrawn[r.n_withdrawn++], sizeof r.withdrawn[0], "%s", w.effect.c_str());
+        explanation_to_c(ex, r);
         *out = r;
     } catch (const std::exception &x) {
         set_err(err, errlen, x.what());
