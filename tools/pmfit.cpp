@@ -18,6 +18,7 @@
 #include "simulate.h"
 #include "inject.hpp"
 #include "errormap.hpp"
+#include "compare.hpp"
 #include "hostutil.hpp"
 #include "fitrun.hpp"
 #include "explain.hpp"
@@ -138,6 +139,14 @@ void usage(FILE *f)
         "  applies a saved model (pmfit fit --save) to a run without refitting: how well\n"
         "  does last night's model point tonight?\n"
         "\n"
+        "usage: pmfit compare OLD RUN [--order L] [--add EFFECT ...] [--json] [--no-refraction]\n"
+        "                     [--skip-bad]\n"
+        "\n"
+        "  has the model changed since last night? OLD is a saved model, or a run (fitted at\n"
+        "  --order with --add); RUN is refitted with the same terms: the pointing error the\n"
+        "  old model leaves, the terms that moved beyond 3 sigma, and whether re-zeroing the\n"
+        "  index terms (c', e') suffices or a full refit is needed (cross-validated)\n"
+        "\n"
         "usage: pmfit simulate OUT [--n N] [--seed S] [--lat DEG] [--mount equatorial|altaz]\n"
         "                      [--fork] [--el-limit DEG] [--noise ARCSEC] [--order L]\n"
         "                      [--term NAME=ARCSEC ...] [--random-aniso ARCSEC]\n"
@@ -196,10 +205,12 @@ Options parse_args(int argc, char **argv)
         usage(stdout);
         std::exit(0);
     }
-    if (o.cmd != "fit" && o.cmd != "simulate" && o.cmd != "eval" && o.cmd != "explain")
+    if (o.cmd != "fit" && o.cmd != "simulate" && o.cmd != "eval" && o.cmd != "explain" &&
+        o.cmd != "compare")
         die("unknown command '" + o.cmd +
-            "' (expected: fit, explain, eval or simulate); see pmfit --help");
+            "' (expected: fit, explain, eval, compare or simulate); see pmfit --help");
     bool sim = o.cmd == "simulate", eval = o.cmd == "eval", expl = o.cmd == "explain";
+    bool cmp = o.cmd == "compare";
     auto number = [&](const std::string &opt, const char *v, double lo, double hi) {
         char *end = nullptr;
         double x = std::strtod(v, &end);
@@ -309,7 +320,7 @@ Options parse_args(int argc, char **argv)
             o.clip_given = true;
         } else if (!a.empty() && a[0] == '-') {
             die("unknown option '" + a + "'; see pmfit --help");
-        } else if (eval && o.model.empty()) {
+        } else if ((eval || cmp) && o.model.empty()) {
             o.model = a;
         } else if (o.run.empty()) {
             o.run = a;
@@ -331,6 +342,12 @@ Options parse_args(int argc, char **argv)
         die("--clip K sets the threshold of --robust; add --robust");
     if (eval && o.model.empty())
         die("no model file given; see pmfit --help");
+    if (cmp && (o.model.empty() || o.run.empty()))
+        die("compare needs OLD (a model file, or a run) and RUN; see pmfit --help");
+    if (cmp && (o.split || !o.save.empty() || !o.emit_c.empty() || !o.error_map.empty() ||
+                o.robust || !o.residuals.empty()))
+        die("compare takes OLD RUN [--order L] [--add EFFECT ...] [--json] [--no-refraction] "
+            "[--skip-bad]; see pmfit --help");
     if (o.run.empty())
         die(sim ? "no output file given; see pmfit --help" : "no run file given; see pmfit --help");
     return o;
@@ -588,6 +605,62 @@ int cmd_eval(const Options &o, const std::vector<Obs> &obs, int mount)
                     o.model.c_str(), o.run.c_str(), obs.size(), f.model.order, f.model.n_terms);
         std::printf("  sky RMS of the residuals, no refit: %.3f\"\n", f.rms * RAD2AS);
     }
+    return 0;
+}
+
+// pmfit compare OLD RUN: OLD a model file (its first line 'pm-model N') or
+// a run (fitted at --order with --add, and its errors count).
+int cmd_compare(const Options &o, const Run &run)
+{
+    std::FILE *f = std::fopen(o.model.c_str(), "rb");
+    if (!f)
+        die(o.model + ": cannot open: " + std::strerror(errno), 1);
+    char line[256] = "";
+    bool is_model = false;
+    while (std::fgets(line, sizeof line, f)) {
+        const char *p = line + std::strspn(line, " \t\r\n");
+        if (!*p || *p == '#')
+            continue;
+        is_model = std::strncmp(p, "pm-model", 8) == 0;
+        break;
+    }
+    std::fclose(f);
+    pm_model old_model;
+    std::vector<double> old_err;
+    FitOut old_fit;
+    Run old_run_copy;
+    bool have_fit = false;
+    if (is_model) {
+        char err[1024];
+        if (pmmodel_load(o.model.c_str(), &old_model, err, sizeof err) != 0)
+            die(err, 1);
+    } else {
+        Run old_run = load_run(o.model, o.refraction, o.skip_bad);
+        std::vector<int> all(old_run.obs.size());
+        for (size_t i = 0; i < all.size(); i++)
+            all[i] = (int)i;
+        FitOut fo = do_fit(old_run.obs, all,
+                           build_model(o.order, o.adds, old_run.obs, old_run.mount,
+                                       old_run.latitude, old_run.aux_names));
+        if (fo.status != PM_OK)
+            fail_fit(fo, o.model + " (the old run)");
+        old_model = fo.model;
+        old_err.assign(fo.res.err, fo.res.err + fo.model.n_terms);
+        old_fit = fo;
+        old_run_copy = old_run;
+        have_fit = true;
+    }
+    Comparison c;
+    try {
+        c = compare_models(old_model, old_err, run, have_fit ? &old_fit : nullptr,
+                           have_fit ? &old_run_copy : nullptr);
+    } catch (const std::exception &x) {
+        die(o.model + " vs " + o.run + ": " + x.what(), 1);
+    }
+    if (o.json)
+        std::printf("%s\n", comparison_json(c).c_str());
+    else
+        print_comparison(c, o.model, o.run);
     return 0;
 }
 
@@ -931,6 +1004,8 @@ int run_main(int argc, char **argv)
     int mount = run.mount;
     if (o.cmd == "eval")
         return cmd_eval(o, obs, mount);
+    if (o.cmd == "compare")
+        return cmd_compare(o, run);
     if (o.cmd == "explain")
         return cmd_explain(o, run);
 

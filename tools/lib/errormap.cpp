@@ -12,9 +12,11 @@ namespace {
 
 const double DEG = PI / 180;
 
+} // namespace
+
 // Per-axis 1-sigma of the correction at encoder (t, d) with inputs ctx:
 // sqrt((J0 C J0 + J1 C J1) / 2), C the fit's covariance (rad^2).
-double sigma_at(const FitOut &f, const pm_context &ctx, double t, double d)
+double predicted_sigma(const FitOut &f, const pm_context &ctx, double t, double d)
 {
     const pm_model &m = f.model;
     int P = m.n_terms;
@@ -29,6 +31,8 @@ double sigma_at(const FitOut &f, const pm_context &ctx, double t, double d)
             v += f.cov[(size_t)(i * P + j)] * (a[(size_t)i] * a[(size_t)j] + b[(size_t)i] * b[(size_t)j]);
     return v > 0 ? std::sqrt(v / 2) : 0.0;
 }
+
+namespace {
 
 // Inputs for the map: the run's mean temperature and time, no slew
 // direction, the mean of every auxiliary column; the pier side given.
@@ -94,7 +98,7 @@ ErrorMap error_map(const Run &run, const FitOut &f, int side)
         lo = std::min(lo, y / DEG);
         double x = std::remainder(o.ah, 2 * PI) / DEG;
         e.marks.push_back({altaz && x < 0 ? x + 360 : x, o.ad / DEG});
-        double s = sigma_at(f, o.ctx, o.eh, o.ed);
+        double s = predicted_sigma(f, o.ctx, o.eh, o.ed);
         if (std::isfinite(s))
             ss += s * s, np++;
     }
@@ -118,7 +122,7 @@ ErrorMap error_map(const Run &run, const FitOut &f, int side)
             ctx.pier = sd;
             if (sd < 0)
                 t += PI, d = PI - d;
-            double s = sigma_at(f, ctx, t, d) * RAD2AS;
+            double s = predicted_sigma(f, ctx, t, d) * RAD2AS;
             if (!std::isfinite(s))
                 continue;
             e.cells.push_back({x, y, w, step, s});

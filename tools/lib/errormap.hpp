@@ -25,6 +25,10 @@ struct ErrorMap {
     std::vector<std::pair<double, double>> marks; // the run's points, same axes
 };
 
+// The predicted per-axis 1-sigma of fit f's correction at encoder (t, d)
+// with inputs ctx (radians; NaN where the model cannot be evaluated).
+double predicted_sigma(const FitOut &f, const pm_context &ctx, double t, double d);
+
 // The map of fit f of run over the usable sky, for the pier side `side`
 // (+1 normal, -1 beyond the pole; 0: alt-az, or an equatorial mount used
 // as the run used it -- each place on the side of the run's nearest star):

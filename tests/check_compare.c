@@ -1,0 +1,221 @@
+/*
+**  check_compare.c - night-to-night drift (pmfit compare OLD RUN, issue 17
+**  item 3).  Simulated nights of one mount (pmsim: the library's simulator,
+**  150 points, 1" noise, fixed true terms):
+**  - the same mount on another night: nothing moved, "the model still holds";
+**  - the hour-angle index moved by 12": only c' moved (beyond 3 sigma), the
+**    re-zero recovers 12" (within 3 sigma of it and of the old fit's own c')
+**    and is advised;
+**  - an order-1 term moved by 15": that term moved, a re-zero does not
+**    help, a refit is advised;
+**  with OLD given as a saved model and as a run (then both fits' errors
+**  count).  The real runs of ../shared/data: first half against second
+**  half (printed for docs/model.md; skipped without the data).
+*/
+#define _POSIX_C_SOURCE 200809L
+#include <check.h>
+#include "tu_check.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "pm.h"
+#include "simulate.h"
+#include "testutil.h"
+#include "tu_tool.h"
+
+static char dir[64];
+static char out[1 << 16];
+
+static void night(const char *name, unsigned long long seed, double c_index, double dY10)
+{
+    pmsim_spec s;
+    char path[256], err[512];
+    static const double iso[6] = {60, -40, 0, 30, -300, 20};
+    int i, idx;
+    pmsim_default(&s);
+    s.n = 150;
+    s.seed = seed;
+    ck_assert_int_eq(pm_model_init(&s.truth, PM_MOUNT_EQUATORIAL, 1), PM_OK);
+    s.truth.latitude = s.latitude_deg * DEG;
+    for (i = 0; i < 6; i++)
+        s.truth.coef[i] = iso[i] * ARCSEC;
+    s.truth.coef[2] = c_index * ARCSEC;
+    ck_assert_int_eq(pm_model_find(&s.truth, 4, 1, 0, &idx), PM_OK); /* d*Y(1,0) */
+    s.truth.coef[idx] = dY10 * ARCSEC;
+    ck_assert_int_eq(pm_model_find(&s.truth, 2, 1, 1, &idx), PM_OK); /* b*Y(1,1) */
+    s.truth.coef[idx] = 8 * ARCSEC;
+    ck_assert_int_eq(pm_model_prepare(&s.truth), PM_OK);
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    ck_assert_msg(pmsim_write(&s, path, NULL, err, sizeof err) == 0, "%s", err);
+}
+
+static void compare(const char *old, const char *run)
+{
+    char cmd[1024];
+    snprintf(cmd, sizeof cmd, "cd %s && %s compare %s %s --json", dir, tu_pmfit_path(), old, run);
+    ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
+}
+
+static int moved_count(void)
+{
+    const char *p = strstr(out, "\"moved\": [");
+    int n = 0;
+    ck_assert_ptr_nonnull(p);
+    for (p += 10; *p && *p != ']'; p++)
+        n += *p == '{';
+    return n;
+}
+
+START_TEST(test_compare_simulated_nights)
+{
+    static const char *olds[2] = {"n1.pm", "n1.dat"};
+    char cmd[1024];
+    int k;
+    double old_c_err = 0;
+    tu_tmpdir(dir, "pm_compare_");
+    night("n1.dat", 11, 600, 10);
+    night("n2.dat", 12, 600, 10);  /* the same mount */
+    night("n3.dat", 13, 612, 10);  /* IH moved by 12" */
+    night("n4.dat", 14, 600, 25);  /* an order-1 flexure term moved by 15" */
+    snprintf(cmd, sizeof cmd, "cd %s && %s fit n1.dat --save n1.pm --json", dir, tu_pmfit_path());
+    ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
+    {
+        /* the old fit's own c' error: the re-zero measures the new c' against
+        ** the old fitted one, not against the truth */
+        const char *c = strstr(out, "\"name\": \"c'\"");
+        ck_assert_ptr_nonnull(c);
+        old_c_err = tu_json_num(c, "error_arcsec");
+    }
+    for (k = 0; k < 2; k++) {
+        compare(olds[k], "n2.dat");
+        printf("check_compare: %s vs the same mount: %d moved; %s\n", olds[k], moved_count(),
+               strstr(out, "\"advice\""));
+        ck_assert_int_eq(moved_count(), 0);
+        ck_assert_ptr_nonnull(strstr(out, "still holds"));
+
+        compare(olds[k], "n3.dat");
+        printf("check_compare: %s vs IH + 12\": re-zero c' %.3f\" +- %.3f\"; %s\n", olds[k],
+               tu_json_num(out, "c_arcsec"), tu_json_num(out, "c_error_arcsec"),
+               strstr(out, "\"advice\""));
+        ck_assert_int_eq(moved_count(), 1);
+        ck_assert_ptr_nonnull(strstr(out, "\"term\": \"c'\""));
+        ck_assert(fabs(tu_json_num(out, "c_arcsec") - 12) <=
+                  3 * hypot(tu_json_num(out, "c_error_arcsec"), old_c_err));
+        ck_assert_ptr_nonnull(strstr(out, "re-zero the index terms"));
+
+        compare(olds[k], "n4.dat");
+        printf("check_compare: %s vs d*Y(1,0) + 15\": %s\n", olds[k], strstr(out, "\"advice\""));
+        ck_assert_int_ge(moved_count(), 1);
+        ck_assert_ptr_nonnull(strstr(out, "\"term\": \"d*Y(1,0)\""));
+        ck_assert_ptr_nonnull(strstr(out, "\"advice\": \"refit"));
+    }
+}
+END_TEST
+
+/* A run's first half against its second half. */
+static void halves(const char *data, const char *name)
+{
+    char src[512], cmd[2048], a[600], b[600];
+    FILE *in, *fa, *fb;
+    static char line[4096];
+    long n = 0, k = 0;
+    snprintf(src, sizeof src, "%s/%s", data, name);
+    if (access(src, R_OK) != 0)
+        return;
+    /* the run as a named-column file (nothing injected), then split */
+    snprintf(cmd, sizeof cmd, "%s simulate --inject refraction=0 --into '%s' %s/whole.dat",
+             tu_pmfit_path(), src, dir);
+    ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
+    snprintf(a, sizeof a, "%s/first.dat", dir);
+    snprintf(b, sizeof b, "%s/second.dat", dir);
+    snprintf(cmd, sizeof cmd, "%s/whole.dat", dir);
+    in = fopen(cmd, "r");
+    ck_assert_ptr_nonnull(in);
+    while (fgets(line, sizeof line, in))
+        n += line[0] != '#';
+    rewind(in);
+    fa = fopen(a, "w");
+    fb = fopen(b, "w");
+    ck_assert(fa && fb);
+    while (fgets(line, sizeof line, in)) {
+        if (line[0] == '#') {
+            fputs(line, fa);
+            fputs(line, fb);
+        } else {
+            fputs(line, k++ < n / 2 ? fa : fb);
+        }
+    }
+    fclose(in);
+    fclose(fa);
+    fclose(fb);
+    compare("first.dat", "second.dat");
+    {
+        const char *cv = strstr(out, "\"cv_rms_arcsec\"");
+        ck_assert_ptr_nonnull(cv);
+        printf("check_compare: %s, first half vs second half: as is %.3f\", re-zero %.3f\", "
+               "refit %.3f\" (cross-validated); the old fit's predicted error at the second "
+               "half %.3f\", at the first %.3f\"; %d terms moved; %s\n", name,
+               tu_json_num(cv, "as_is"), tu_json_num(cv, "rezero"), tu_json_num(cv, "refit"),
+               tu_json_num(out, "at_new_points"), tu_json_num(out, "at_old_points"), moved_count(),
+               strstr(out, "\"advice\""));
+        ck_assert(tu_json_num(cv, "refit") > 0);
+    }
+}
+
+START_TEST(test_compare_real_halves)
+{
+    const char *d = tu_data_dir();
+    if (!d) {
+        printf("check_compare: ../shared/data absent: the real runs skipped\n");
+        return;
+    }
+    if (!dir[0])
+        tu_tmpdir(dir, "pm_compare_");
+    halves(d, "mmt/k_and_e.dat");
+    halves(d, "celestial/gem-28.dat");
+    halves(d, "celestial/cgx-l-data.dat");
+}
+END_TEST
+
+START_TEST(test_compare_misuse)
+{
+    static const char *bad[][2] = {
+        {"compare", "compare needs OLD"},
+        {"compare only_one.dat", "compare needs OLD"},
+        {"compare /nonexistent.pm RUN", "/nonexistent"},
+        {"compare a.dat b.dat --save m.pm", "compare takes OLD RUN"},
+    };
+    char cmd[1024];
+    size_t k;
+    for (k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        const char *top = getenv("PM_TOP"), *r = strstr(bad[k][0], "RUN");
+        if (r)
+            snprintf(cmd, sizeof cmd, "%s %.*s%s/tests/data/flip_gem_pm180.dat", tu_pmfit_path(),
+                     (int)(r - bad[k][0]), bad[k][0], top ? top : ".");
+        else
+            snprintf(cmd, sizeof cmd, "%s %s", tu_pmfit_path(), bad[k][0]);
+        ck_assert_int_ne(tu_capture(cmd, out, sizeof out), 0);
+        ck_assert_msg(strstr(out, bad[k][1]) != NULL, "%s: %s", bad[k][0], out);
+    }
+}
+END_TEST
+
+static Suite *suite(void)
+{
+    Suite *s = suite_create("compare");
+    TCase *t = tcase_create("compare");
+    tcase_set_timeout(t, 300);
+    tcase_add_test(t, test_compare_simulated_nights);
+    tcase_add_test(t, test_compare_real_halves);
+    tcase_add_test(t, test_compare_misuse);
+    suite_add_tcase(s, t);
+    return s;
+}
+
+int main(void)
+{
+    return tu_run_suite(suite());
+}

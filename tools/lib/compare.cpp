@@ -1,0 +1,262 @@
+// compare.cpp - night-to-night drift (compare.hpp).
+#include "compare.hpp"
+#include "errormap.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <stdexcept>
+
+namespace pmhost {
+
+namespace {
+
+// Per-axis RMS of a model's residuals on observations `use` (no fit).
+double rms_of(const pm_model &m, const Run &run, const std::vector<int> &use)
+{
+    double ss = 0;
+    long n = 0;
+    for (int i : use) {
+        const Obs &o = run.obs[i];
+        double r[2];
+        if (pm_model_residual(&m, &o.ctx, o.eh, o.ed, o.ah, o.ad, r) != PM_OK)
+            continue;
+        ss += r[0] * r[0] + r[1] * r[1];
+        n++;
+    }
+    return n ? std::sqrt(ss / (double)(2 * n)) : NAN;
+}
+
+// Re-zero: the model m with only its two index terms (c', e': terms 2 and
+// 4) refitted to `use` (Gauss-Newton on the 2x2 normal equations; the
+// other terms held).  err: their 1-sigma errors.  False if singular.
+bool rezero(pm_model &m, const Run &run, const std::vector<int> &use, double err[2])
+{
+    std::vector<double> a(PM_MAX_TERMS), b(PM_MAX_TERMS);
+    for (int pass = 0; pass < 8; pass++) {
+        double n00 = 0, n01 = 0, n11 = 0, g0 = 0, g1 = 0, chi2 = 0;
+        long n = 0;
+        for (int i : use) {
+            const Obs &o = run.obs[i];
+            double r[2];
+            if (pm_fit_row(&m, &o.ctx, o.eh, o.ed, o.ah, o.ad, a.data(), b.data(), r) != PM_OK)
+                continue;
+            n00 += a[2] * a[2] + b[2] * b[2];
+            n01 += a[2] * a[4] + b[2] * b[4];
+            n11 += a[4] * a[4] + b[4] * b[4];
+            g0 += a[2] * r[0] + b[2] * r[1];
+            g1 += a[4] * r[0] + b[4] * r[1];
+            chi2 += r[0] * r[0] + r[1] * r[1];
+            n++;
+        }
+        double det = n00 * n11 - n01 * n01;
+        if (!(det > 0) || n < 2)
+            return false;
+        double d0 = (n11 * g0 - n01 * g1) / det, d1 = (n00 * g1 - n01 * g0) / det;
+        m.coef[2] += d0;
+        m.coef[4] += d1;
+        if (pm_model_prepare(&m) != PM_OK)
+            return false;
+        double s2 = chi2 / (double)std::max(1L, 2 * n - 2);
+        err[0] = std::sqrt(s2 * n11 / det);
+        err[1] = std::sqrt(s2 * n00 / det);
+        if (std::fabs(d0) < 1e-15 && std::fabs(d1) < 1e-15)
+            break;
+    }
+    return true;
+}
+
+// 5-fold cross-validated per-axis RMS of: 0 the old model as is, 1 its
+// re-zero, 2 a full refit (from the old model's terms and values).
+void cross_validate(const pm_model &old_model, const Run &run, double cv[3])
+{
+    std::vector<int> perm(run.obs.size());
+    for (size_t i = 0; i < perm.size(); i++)
+        perm[i] = (int)i;
+    std::mt19937 rng(1);
+    std::shuffle(perm.begin(), perm.end(), rng);
+    double ss[3] = {0, 0, 0};
+    long n[3] = {0, 0, 0};
+    const int folds = 5;
+    for (int k = 0; k < folds; k++) {
+        std::vector<int> train, test;
+        for (size_t j = 0; j < perm.size(); j++)
+            ((int)(j % folds) == k ? test : train).push_back(perm[j]);
+        pm_model m[3] = {old_model, old_model, old_model};
+        double e[2];
+        bool ok[3] = {true, rezero(m[1], run, train, e), false};
+        FitOut f = do_fit(run.obs, train, old_model);
+        if (f.status == PM_OK)
+            m[2] = f.model, ok[2] = true;
+        for (int w = 0; w < 3; w++) {
+            if (!ok[w])
+                continue;
+            double r = rms_of(m[w], run, test);
+            ss[w] += r * r * (double)test.size();
+            n[w] += (long)test.size();
+        }
+    }
+    for (int w = 0; w < 3; w++)
+        cv[w] = n[w] ? std::sqrt(ss[w] / (double)n[w]) : NAN;
+}
+
+std::string advice_of(const Comparison &c)
+{
+    char b[400];
+    if (c.moved.empty() && c.cv_as_is <= 1.05 * c.cv_refit) {
+        std::snprintf(b, sizeof b, "the model still holds: no term moved beyond 3 sigma and it "
+                                   "predicts this night as well as a refit would (%.3g\" vs %.3g\")",
+                      c.cv_as_is, c.cv_refit);
+    } else if (c.cv_rezero <= 1.05 * c.cv_refit) {
+        std::snprintf(b, sizeof b, "re-zero the index terms (c' %+.2f\", e' %+.2f\"): that predicts "
+                                   "as well as a full refit (cross-validated %.3g\" vs %.3g\"; as "
+                                   "is %.3g\")",
+                      c.rezero_c, c.rezero_e, c.cv_rezero, c.cv_refit, c.cv_as_is);
+    } else {
+        std::snprintf(b, sizeof b, "refit: a re-zero of the index terms leaves %.3g\" where a full "
+                                   "refit predicts %.3g\" (cross-validated; as is %.3g\")",
+                      c.cv_rezero, c.cv_refit, c.cv_as_is);
+    }
+    return b;
+}
+
+} // namespace
+
+// RMS of the old fit's predicted sigma over a run's points (arcsec).
+double predicted_over(const FitOut &f, const Run &run)
+{
+    double ss = 0;
+    long n = 0;
+    for (const Obs &o : run.obs) {
+        double s = predicted_sigma(f, o.ctx, o.eh, o.ed);
+        if (std::isfinite(s))
+            ss += s * s, n++;
+    }
+    return n ? std::sqrt(ss / (double)n) * RAD2AS : NAN;
+}
+
+Comparison compare_models(const pm_model &old_model, const std::vector<double> &old_err,
+                          const Run &run, const FitOut *old_fit, const Run *old_run)
+{
+    if (old_model.mount != run.mount)
+        throw std::runtime_error("the model is of an " +
+                                 std::string(old_model.mount == PM_MOUNT_ALTAZ ? "alt-az" : "equatorial") +
+                                 " mount, the run of an " +
+                                 (run.mount == PM_MOUNT_ALTAZ ? "alt-az" : "equatorial") + " one");
+    Comparison c;
+    std::vector<int> all(run.obs.size());
+    for (size_t i = 0; i < all.size(); i++)
+        all[i] = (int)i;
+    c.n_obs = (long)all.size();
+    c.n_terms = old_model.n_terms;
+    c.old_has_errors = !old_err.empty();
+    c.rms_as_is = rms_of(old_model, run, all) * RAD2AS;
+    FitOut f = do_fit(run.obs, all, old_model);
+    if (f.status != PM_OK)
+        throw std::runtime_error("the new run cannot be refitted with the model's terms (" +
+                                 std::to_string((int)f.status) +
+                                 "): too few points or too little sky for them");
+    c.refit = f.model;
+    c.sigma_refit = f.res.sigma * RAD2AS;
+    for (int i = 0; i < old_model.n_terms; i++) {
+        TermChange t;
+        t.name = term_name(old_model, i);
+        t.meaning = meaning(old_model, i);
+        t.old_arcsec = old_model.coef[i] * RAD2AS;
+        t.new_arcsec = f.model.coef[i] * RAD2AS;
+        double e0 = c.old_has_errors && (size_t)i < old_err.size() ? old_err[(size_t)i] : 0;
+        t.err_arcsec = std::sqrt(f.res.err[i] * f.res.err[i] + e0 * e0) * RAD2AS;
+        t.z = t.err_arcsec > 0 ? (t.new_arcsec - t.old_arcsec) / t.err_arcsec : 0;
+        if (std::fabs(t.z) >= 3)
+            c.moved.push_back(t);
+        else
+            c.n_stable++;
+    }
+    std::sort(c.moved.begin(), c.moved.end(),
+              [](const TermChange &a, const TermChange &b) { return std::fabs(a.z) > std::fabs(b.z); });
+    c.rezeroed = old_model;
+    double e[2] = {0, 0};
+    if (rezero(c.rezeroed, run, all, e)) {
+        c.rezero_c = (c.rezeroed.coef[2] - old_model.coef[2]) * RAD2AS;
+        c.rezero_e = (c.rezeroed.coef[4] - old_model.coef[4]) * RAD2AS;
+        c.rezero_c_err = e[0] * RAD2AS;
+        c.rezero_e_err = e[1] * RAD2AS;
+    }
+    double cv[3];
+    cross_validate(old_model, run, cv);
+    c.cv_as_is = cv[0] * RAD2AS;
+    c.cv_rezero = cv[1] * RAD2AS;
+    c.cv_refit = cv[2] * RAD2AS;
+    if (old_fit && old_run && old_fit->cov.size() == (size_t)(old_model.n_terms * old_model.n_terms)) {
+        c.old_pred_new = predicted_over(*old_fit, run);
+        c.old_pred_old = predicted_over(*old_fit, *old_run);
+    }
+    c.advice = advice_of(c);
+    if (std::isfinite(c.old_pred_new) && c.old_pred_new > 2 * c.old_pred_old &&
+        c.old_pred_new > c.sigma_refit) {
+        char b[300];
+        std::snprintf(b, sizeof b, "; but the new run is largely where the old model extrapolates "
+                                   "(its predicted 1 sigma there %.3g\", at its own stars %.3g\"): "
+                                   "much of the difference is the old model's ignorance, not drift",
+                      c.old_pred_new, c.old_pred_old);
+        c.advice += b;
+    }
+    return c;
+}
+
+std::string comparison_json(const Comparison &c)
+{
+    auto num = [](double v) {
+        char b[40];
+        std::snprintf(b, sizeof b, std::isfinite(v) ? "%.6g" : "null", v);
+        return std::string(b);
+    };
+    std::string j = "{\"n_obs\": " + std::to_string(c.n_obs) + ", \"n_terms\": " +
+                    std::to_string(c.n_terms) + ", \"old_errors_counted\": " +
+                    (c.old_has_errors ? "true" : "false") + ", \"rms_as_is_arcsec\": " +
+                    num(c.rms_as_is) + ", \"sigma_refit_arcsec\": " + num(c.sigma_refit) +
+                    ", \"moved\": [";
+    for (size_t k = 0; k < c.moved.size(); k++) {
+        const TermChange &t = c.moved[k];
+        j += std::string(k ? ", " : "") + "{\"term\": \"" + json_escape(t.name) +
+             "\", \"old_arcsec\": " + num(t.old_arcsec) + ", \"new_arcsec\": " + num(t.new_arcsec) +
+             ", \"error_arcsec\": " + num(t.err_arcsec) + ", \"z\": " + num(t.z) + "}";
+    }
+    j += "], \"n_stable\": " + std::to_string(c.n_stable) + ", \"rezero\": {\"c_arcsec\": " +
+         num(c.rezero_c) + ", \"c_error_arcsec\": " + num(c.rezero_c_err) + ", \"e_arcsec\": " +
+         num(c.rezero_e) + ", \"e_error_arcsec\": " + num(c.rezero_e_err) +
+         "}, \"cv_rms_arcsec\": {\"as_is\": " + num(c.cv_as_is) + ", \"rezero\": " +
+         num(c.cv_rezero) + ", \"refit\": " + num(c.cv_refit) +
+         "}, \"old_predicted_sigma_arcsec\": {\"at_new_points\": " + num(c.old_pred_new) +
+         ", \"at_old_points\": " + num(c.old_pred_old) + "}, \"advice\": \"" +
+         json_escape(c.advice) + "\"}";
+    return j;
+}
+
+void print_comparison(const Comparison &c, const std::string &old_name, const std::string &run_name)
+{
+    std::printf("pmfit compare %s %s: %ld observations, %d terms\n\n", old_name.c_str(),
+                run_name.c_str(), c.n_obs, c.n_terms);
+    std::printf("  the old model on the new run, no refit: RMS %.3f\" per axis (a refit: sigma "
+                "%.3f\")\n", c.rms_as_is, c.sigma_refit);
+    std::printf("\n  terms that moved (beyond 3 sigma of the %s):\n",
+                c.old_has_errors ? "two fits' errors" : "refit's errors; the model file has none");
+    if (c.moved.empty())
+        std::printf("    none\n");
+    for (const TermChange &t : c.moved)
+        std::printf("    %-14s %-36s %+10.2f\" -> %+10.2f\": moved %+8.2f\" +- %.2f\" (%.1f sigma)\n",
+                    t.name.c_str(), t.meaning.c_str(), t.old_arcsec, t.new_arcsec,
+                    t.new_arcsec - t.old_arcsec, t.err_arcsec, std::fabs(t.z));
+    std::printf("    everything else stable (%d terms)\n", c.n_stable);
+    std::printf("\n  re-zero (only c' and e' refitted): c' %+.2f\" +- %.2f\", e' %+.2f\" +- %.2f\"\n",
+                c.rezero_c, c.rezero_c_err, c.rezero_e, c.rezero_e_err);
+    std::printf("  cross-validated RMS per axis (5-fold): as is %.3f\", re-zero %.3f\", full refit "
+                "%.3f\"\n", c.cv_as_is, c.cv_rezero, c.cv_refit);
+    if (std::isfinite(c.old_pred_new))
+        std::printf("  the old fit's predicted error (1 sigma per axis): %.3f\" at the new run's "
+                    "points, %.3f\" at its own\n", c.old_pred_new, c.old_pred_old);
+    std::printf("\n  %s\n", c.advice.c_str());
+}
+
+} // namespace pmhost

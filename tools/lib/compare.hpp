@@ -1,0 +1,53 @@
+// compare.hpp - night-to-night drift (pmfit compare OLD RUN): apply an
+// earlier model to a new run, say what it leaves, which terms moved
+// significantly, and whether re-zeroing the two index terms suffices or the
+// model must be refitted (cross-validated).  docs/model.md, "Has the model
+// changed since last night?".
+#ifndef PM_COMPARE_HPP
+#define PM_COMPARE_HPP
+
+#include "fitrun.hpp"
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace pmhost {
+
+struct TermChange {
+    std::string name, meaning;
+    double old_arcsec = 0, new_arcsec = 0, err_arcsec = 0; // err: of the difference
+    double z = 0;                                          // difference / err
+};
+
+struct Comparison {
+    long n_obs = 0;
+    int n_terms = 0;
+    bool old_has_errors = false;   // OLD was a run (its errors count), not a model file
+    double rms_as_is = 0;          // per axis, the new run under the old model, no refit
+    double sigma_refit = 0;        // unbiased sigma of the refit
+    std::vector<TermChange> moved; // |z| >= 3, largest first
+    int n_stable = 0;              // terms that did not move (|z| < 3)
+    double rezero_c = 0, rezero_c_err = 0, rezero_e = 0, rezero_e_err = 0; // arcsec
+    double cv_as_is = 0, cv_rezero = 0, cv_refit = 0; // per axis, 5-fold
+    // OLD a run: the old fit's predicted error (pm_fit_pointing_sigma) at
+    // the new run's points and at its own; NaN for a model file
+    double old_pred_new = NAN, old_pred_old = NAN;
+    std::string advice;
+    pm_model refit, rezeroed;
+};
+
+// old_model: the earlier model; old_err: its coefficients' 1-sigma errors
+// (empty when it came from a model file); run: the new night.  Throws
+// std::runtime_error with the reason (mount mismatch, the refit failing).
+// old_fit, old_run: the fit OLD came from (a run), or null (a model file).
+Comparison compare_models(const pm_model &old_model, const std::vector<double> &old_err,
+                          const Run &run, const FitOut *old_fit = nullptr,
+                          const Run *old_run = nullptr);
+
+std::string comparison_json(const Comparison &c);
+void print_comparison(const Comparison &c, const std::string &old_name, const std::string &run_name);
+
+} // namespace pmhost
+
+#endif
