@@ -19,6 +19,7 @@
 #include "inject.hpp"
 #include "errormap.hpp"
 #include "compare.hpp"
+#include "plan.hpp"
 #include "hostutil.hpp"
 #include "fitrun.hpp"
 #include "explain.hpp"
@@ -72,6 +73,9 @@ struct Options {
     std::vector<std::pair<std::string, double>> effects; // simulate --effect SPEC=ARCSEC
     double phase_deg = 0;
     std::string error_map;           // fit --error-map FILE.svg
+    int next = 5;                    // plan --next K
+    double min_el = 15, grid = 6;    // plan --min-el, --grid
+    bool min_el_given = false, lat_given = false, noise_given = false, mount_given = false;
     std::vector<std::string> inject; // simulate --inject EFFECT[=SIZE] --into RUN
     std::string into;
     std::string shape_opt;           // a simulate option that shapes a simulated run
@@ -138,6 +142,15 @@ void usage(FILE *f)
         "\n"
         "  applies a saved model (pmfit fit --save) to a run without refitting: how well\n"
         "  does last night's model point tonight?\n"
+        "\n"
+        "usage: pmfit plan [RUN] [--next K] [--order L] [--add EFFECT ...] [--lat DEG]\n"
+        "                  [--mount equatorial|altaz] [--fork] [--min-el DEG] [--grid DEG]\n"
+        "                  [--noise ARCSEC] [--json]\n"
+        "\n"
+        "  which star next: the K targets (default 5) that most reduce the model's predicted\n"
+        "  pointing error averaged over the sky above --min-el (default 15 deg), given the\n"
+        "  points of RUN taken so far (none: the first points of a run); candidates on a grid\n"
+        "  of --grid deg (6); a German mount takes each on the side the run used nearby\n"
         "\n"
         "usage: pmfit compare OLD RUN [--order L] [--add EFFECT ...] [--json] [--no-refraction]\n"
         "                     [--skip-bad]\n"
@@ -206,11 +219,11 @@ Options parse_args(int argc, char **argv)
         std::exit(0);
     }
     if (o.cmd != "fit" && o.cmd != "simulate" && o.cmd != "eval" && o.cmd != "explain" &&
-        o.cmd != "compare")
+        o.cmd != "compare" && o.cmd != "plan")
         die("unknown command '" + o.cmd +
-            "' (expected: fit, explain, eval, compare or simulate); see pmfit --help");
+            "' (expected: fit, explain, eval, compare, plan or simulate); see pmfit --help");
     bool sim = o.cmd == "simulate", eval = o.cmd == "eval", expl = o.cmd == "explain";
-    bool cmp = o.cmd == "compare";
+    bool cmp = o.cmd == "compare", pln = o.cmd == "plan";
     auto number = [&](const std::string &opt, const char *v, double lo, double hi) {
         char *end = nullptr;
         double x = std::strtod(v, &end);
@@ -272,6 +285,13 @@ Options parse_args(int argc, char **argv)
             o.error_map = need("a file name (SVG)");
         } else if (!sim && !eval && !expl && a == "--emit-c") {
             o.emit_c = need("a file name");
+        } else if (pln && a == "--next") {
+            o.next = (int)number(a, need("a count"), 1, 1000);
+        } else if (pln && a == "--min-el") {
+            o.min_el = number(a, need("degrees"), -10, 80);
+            o.min_el_given = true;
+        } else if (pln && a == "--grid") {
+            o.grid = number(a, need("degrees"), 1, 30);
         } else if (sim && a == "--inject") {
             o.inject.push_back(need("EFFECT[=SIZE]"));
         } else if (sim && a == "--into") {
@@ -280,17 +300,17 @@ Options parse_args(int argc, char **argv)
             o.n = (long)number(a, need("a count"), 1, 1e7);
         } else if (sim && a == "--seed") {
             o.seed = (unsigned long long)number(a, need("a seed"), 0, 1e15);
-        } else if (sim && a == "--lat" && (o.shape_opt = a, true)) {
+        } else if ((sim || pln) && a == "--lat" && (o.shape_opt = a, true)) {
             o.lat = number(a, need("degrees"), -90, 90);
         } else if (sim && a == "--el-limit" && (o.shape_opt = a, true)) {
             o.el_limit = number(a, need("degrees"), -10, 80);
-        } else if (sim && a == "--noise" && (o.shape_opt = a, true)) {
+        } else if ((sim || pln) && a == "--noise" && (o.shape_opt = a, true)) {
             o.noise = number(a, need("arcseconds"), 0, 1e5);
         } else if (sim && a == "--random-aniso" && (o.shape_opt = a, true)) {
             o.random_aniso = number(a, need("arcseconds"), 0, 1e5);
-        } else if (sim && a == "--fork" && (o.shape_opt = a, true)) {
+        } else if ((sim || pln) && a == "--fork" && (o.shape_opt = a, true)) {
             o.fork = true;
-        } else if (sim && a == "--mount" && (o.shape_opt = a, true)) {
+        } else if ((sim || pln) && a == "--mount" && (o.shape_opt = a, true)) {
             std::string v = need("equatorial or altaz");
             if (v != "equatorial" && v != "altaz")
                 die("--mount: expected equatorial or altaz, got '" + v + "'");
@@ -348,8 +368,18 @@ Options parse_args(int argc, char **argv)
                 o.robust || !o.residuals.empty()))
         die("compare takes OLD RUN [--order L] [--add EFFECT ...] [--json] [--no-refraction] "
             "[--skip-bad]; see pmfit --help");
-    if (o.run.empty())
+    if (o.run.empty() && !pln)
         die(sim ? "no output file given; see pmfit --help" : "no run file given; see pmfit --help");
+    if (pln && (o.split || !o.save.empty() || !o.emit_c.empty() || !o.error_map.empty() ||
+                o.robust || !o.residuals.empty()))
+        die("plan takes [RUN] [--next K] [--order L] [--add EFFECT ...] [--lat DEG] [--mount M] "
+            "[--fork] [--min-el DEG] [--grid DEG] [--noise ARCSEC] [--json]; see pmfit --help");
+    for (int i = 2; i < argc; i++) {
+        std::string a = argv[i];
+        o.lat_given = o.lat_given || a == "--lat";
+        o.noise_given = o.noise_given || a == "--noise";
+        o.mount_given = o.mount_given || a == "--mount";
+    }
     return o;
 }
 
@@ -604,6 +634,85 @@ int cmd_eval(const Options &o, const std::vector<Obs> &obs, int mount)
         std::printf("pmfit eval %s on %s: %zu observations, model of order %d (%d terms)\n",
                     o.model.c_str(), o.run.c_str(), obs.size(), f.model.order, f.model.n_terms);
         std::printf("  sky RMS of the residuals, no refit: %.3f\"\n", f.rms * RAD2AS);
+    }
+    return 0;
+}
+
+// pmfit plan [RUN]: the next targets that most reduce the predicted error
+// over the sky (plan.hpp).
+int cmd_plan(const Options &o)
+{
+    Run run;
+    PlanOptions po;
+    if (!o.run.empty()) {
+        run = load_run(o.run, o.refraction, o.skip_bad);
+        po.mount = run.mount;
+        po.latitude = run.latitude;
+    }
+    if (o.mount_given || o.run.empty())
+        po.mount = o.altaz ? PM_MOUNT_ALTAZ : PM_MOUNT_EQUATORIAL;
+    if (o.lat_given || (o.run.empty() && po.mount != PM_MOUNT_ALTAZ))
+        po.latitude = o.lat * PI / 180;
+    po.order = o.order;
+    po.adds = o.adds;
+    po.next = o.next;
+    po.min_el_deg = o.min_el;
+    po.grid_deg = o.grid;
+    po.gem = !o.fork;
+    po.noise_arcsec = o.noise;
+    if (!o.noise_given && !run.obs.empty()) { // the run's own sigma, when it can be fitted
+        std::vector<int> all(run.obs.size());
+        for (size_t i = 0; i < all.size(); i++)
+            all[i] = (int)i;
+        pm_model m = build_model(o.order, o.adds, run.obs, run.mount, run.latitude, run.aux_names);
+        if (2 * (long)run.obs.size() > (long)m.n_terms + 2) {
+            FitOut f = do_fit(run.obs, all, m);
+            if (f.status == PM_OK)
+                po.noise_arcsec = f.res.sigma * RAD2AS;
+        }
+    }
+    Plan p;
+    try {
+        p = plan_targets(run, po);
+    } catch (const std::exception &x) {
+        die(x.what(), 1);
+    }
+    bool az = po.mount == PM_MOUNT_ALTAZ;
+    if (o.json) {
+        std::printf("{\"taken\": %zu, \"order\": %d, \"noise_arcsec\": %.6g, \"before_arcsec\": %s, "
+                    "\"targets\": [", run.obs.size(), o.order, po.noise_arcsec,
+                    std::isfinite(p.before_arcsec) ? std::to_string(p.before_arcsec).c_str() : "null");
+        for (size_t k = 0; k < p.targets.size(); k++) {
+            const Target &t = p.targets[k];
+            std::printf("%s{\"%s\": %.4f, \"%s\": %.4f, \"elevation_deg\": %.4f, \"side\": %d, "
+                        "\"after_arcsec\": %s}", k ? ", " : "", az ? "azimuth_deg" : "ha_deg",
+                        t.x_deg, az ? "el_deg" : "dec_deg", t.y_deg, t.el_deg, t.side,
+                        std::isfinite(t.after_arcsec) ? std::to_string(t.after_arcsec).c_str() : "null");
+        }
+        std::printf("]}\n");
+        return 0;
+    }
+    std::printf("pmfit plan: %zu points taken, order %d%s, noise %.3g\" per axis; %d candidates "
+                "above %.0f deg elevation\n", run.obs.size(), o.order, o.adds.empty() ? "" : " + terms",
+                po.noise_arcsec, p.n_candidates, po.min_el_deg);
+    if (std::isfinite(p.before_arcsec))
+        std::printf("  predicted error over the sky now: %.3f\" (1 sigma per axis, mean)\n",
+                    p.before_arcsec);
+    else
+        std::printf("  the model is not determined yet (fewer points than half its terms)\n");
+    std::printf("  next targets (in this order):\n");
+    for (size_t k = 0; k < p.targets.size(); k++) {
+        const Target &t = p.targets[k];
+        char after[64] = "not yet determined";
+        if (std::isfinite(t.after_arcsec))
+            std::snprintf(after, sizeof after, "%.3f\"", t.after_arcsec);
+        if (az)
+            std::printf("    %2zu. az %7.2f deg  el %6.2f deg  -> predicted %s\n", k + 1, t.x_deg,
+                        t.y_deg, after);
+        else
+            std::printf("    %2zu. HA %+6.2f h  Dec %+7.2f deg  (el %5.1f, %s)  -> predicted %s\n",
+                        k + 1, t.x_deg / 15, t.y_deg, t.el_deg,
+                        t.side < 0 ? "beyond the pole" : "normal side", after);
     }
     return 0;
 }
@@ -995,6 +1104,8 @@ int run_main(int argc, char **argv)
         die("library and program were built with different PM_MAX_L/PM_MAX_EXTRA", 1);
     if (o.cmd == "simulate")
         return cmd_simulate(o, argc, argv);
+    if (o.cmd == "plan")
+        return cmd_plan(o);
 
     Run run = load_run(o.run, o.refraction, o.skip_bad);
     for (const std::string &n : run.notes)
