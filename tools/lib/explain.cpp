@@ -820,17 +820,46 @@ std::vector<std::string> minus(const std::vector<std::string> &all, const std::v
 // without it predicting as well (cross-validated RMS within 1%) -- is withdrawn,
 // the least needed first.  (A drift through the night found first, then
 // the temperature it was following: the drift goes.)
+// The model without finding f: its terms dropped; for higher_order (the
+// last order it raised) the order back down, with tube flexure in its place
+// at order 0, where the order-1 terms held a sag exactly.  False when f
+// cannot be withdrawn (outliers, pairs, an order below the baseline's).
+bool without_finding(const Run &run, const State &st, const ExplainOptions &opt, const Finding &f,
+                     int *order, std::vector<std::string> *adds)
+{
+    if (f.effect == "outlier" || !f.with.empty())
+        return false;
+    if (f.effect == "higher_order") {
+        if (st.order <= opt.order)
+            return false;
+        *order = st.order - 1;
+        *adds = st.adds;
+        if (*order == 0 && (run.mount == PM_MOUNT_ALTAZ || !std::isnan(run.latitude)) &&
+            !has(*adds, "tube_flexure"))
+            adds->push_back("tube_flexure");
+        return true;
+    }
+    if (f.adds.empty())
+        return false;
+    *order = st.order;
+    *adds = minus(st.adds, f.adds);
+    return true;
+}
+
 void prune(const Run &run, State &st, const ExplainOptions &opt, Explanation &ex)
 {
     for (;;) {
-        int worst = -1;
+        int worst = -1, worst_order = st.order;
         double worst_lp = -1e300, worst_cv = 0;
         Fit worst_fit;
+        std::vector<std::string> worst_adds;
         for (size_t k = 0; k < ex.findings.size(); k++) {
             const Finding &f = ex.findings[k];
-            if (f.effect == "outlier" || f.effect == "higher_order" || !f.with.empty() || f.adds.empty())
+            int order;
+            std::vector<std::string> adds;
+            if (!without_finding(run, st, opt, f, &order, &adds))
                 continue;
-            Fit g = fit_spec(run, st.use, st.order, minus(st.adds, f.adds));
+            Fit g = fit_spec(run, st.use, order, adds);
             double d1 = st.cur.P - g.P, d2 = (double)(2 * st.cur.N - st.cur.P);
             if (!g.ok || !(d1 > 0) || !(d2 > 0))
                 continue;
@@ -838,13 +867,15 @@ void prune(const Run &run, State &st, const ExplainOptions &opt, Explanation &ex
             double lp = log_f_tail(F, d1, d2) + std::log(f.trials);
             if (lp < std::log(opt.alpha) || lp <= worst_lp)
                 continue;
-            double cv = cv_rms(run, st.use, st.order, minus(st.adds, f.adds), opt.folds, opt.seed);
+            double cv = cv_rms(run, st.use, order, adds, opt.folds, opt.seed);
             if (!(cv <= 1.01 * st.cur_cv)) // within the noise of a 5-fold CV
                 continue;
             worst = (int)k;
             worst_lp = lp;
             worst_cv = cv;
             worst_fit = g;
+            worst_order = order;
+            worst_adds = adds;
         }
         if (worst < 0)
             return;
@@ -859,7 +890,8 @@ void prune(const Run &run, State &st, const ExplainOptions &opt, Explanation &ex
         ex.withdrawn.push_back(f);
         ex.withdrawn_why.push_back(why);
         ex.findings.erase(ex.findings.begin() + worst);
-        st.adds = minus(st.adds, f.adds);
+        st.order = worst_order;
+        st.adds = worst_adds;
         st.cur = worst_fit;
         st.cur_cv = worst_cv;
     }
