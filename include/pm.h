@@ -767,6 +767,45 @@ pm_status pm_fit_pointing_sigma(const pm_fit *fit, const pm_fit_result *res,
                                 double enc_dec, double *sigma, double cov[3]);
 
 /*
+**  pm_fit_point_gain - how much one more star at an encoder position would
+**  lower the fitted model's predicted error, averaged over given places of
+**  the sky (the I-optimal criterion of pmfit plan): allocation-free, so a
+**  mount controller can choose its own next star by calling it for each
+**  candidate and taking the largest.
+**
+**  Given:
+**     fit      const pm_fit*           after a successful pm_fit_solve or
+**                                      pm_fit_run
+**     res      const pm_fit_result*    its result (sigma: the noise of the
+**                                      new star too)
+**     m        const pm_model*         the fitted model
+**     ctx      const pm_context*       inputs of its physical terms (or NULL),
+**                                      for the candidate and the places alike
+**     enc_ha, enc_dec  double          the candidate's encoder position (rad)
+**     sky      const double*           n_sky encoder positions (ha, dec pairs,
+**                                      rad): the places the error is averaged
+**                                      over (e.g. a grid of the usable sky)
+**     n_sky    int                     >= 1
+**  Returned:
+**     gain     double*     the mean over the places of the fall of the
+**                          predicted variance per axis (rad^2): the mean of
+**                          sigma^2 before minus after (pm_fit_pointing_sigma)
+**  Returned (function value):
+**              pm_status   PM_OK; PM_ERR_ARG; PM_ERR_STATE (no successful
+**                          solve); PM_ERR_NONFINITE; the model's statuses
+**  Notes:
+**  1) With C the covariance, J the candidate's two rows and J_g a place's:
+**     C' = C - C J^T S^-1 J C, S = sigma^2 I + J C J^T (one more star of
+**     noise sigma), so the fall at g is tr(U_g S^-1 U_g^T) / 2 with
+**     U_g = J_g C J^T.  Cost: P^2 + n_sky (one evaluation + 4P).
+**  2) The sum over the places is the caller's choice of "the sky": above
+**     its horizon, on the pier side it will use there.
+*/
+pm_status pm_fit_point_gain(const pm_fit *fit, const pm_fit_result *res, const pm_model *m,
+                            const pm_context *ctx, double enc_ha, double enc_dec,
+                            const double *sky, int n_sky, double *gain);
+
+/*
 **  pm_fit_row - the two design-matrix rows of one observation.
 **
 **  Given:

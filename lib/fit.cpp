@@ -598,6 +598,75 @@ pm_status pm_fit_pointing_sigma(const pm_fit *fit, const pm_fit_result *res,
     return PM_OK;
 }
 
+pm_status pm_fit_point_gain(const pm_fit *fit, const pm_fit_result *res, const pm_model *m,
+                            const pm_context *ctx, double enc_ha, double enc_dec,
+                            const double *sky, int n_sky, double *gain)
+{
+    if (!fit || !res || !m || !sky || n_sky < 1 || !gain)
+        return PM_ERR_ARG;
+    if (fit->state != FIT_READY || fit->iterations < 1 || !fit->cov_valid)
+        return PM_ERR_STATE;
+    if (m->n_terms != fit->n_par)
+        return PM_ERR_ARG;
+    if (!finite(enc_ha) || !finite(enc_dec))
+        return PM_ERR_NONFINITE;
+    const int P = fit->n_par;
+    const double s2 = res->sigma * res->sigma;
+    double app_ha, app_dec, j0[PM_MAX_TERMS], j1[PM_MAX_TERMS], r[2];
+    pm_status st = pm_model_apply(m, ctx, enc_ha, enc_dec, &app_ha, &app_dec);
+    if (st == PM_OK)
+        st = pm_fit_row(m, ctx, enc_ha, enc_dec, app_ha, app_dec, j0, j1, r);
+    if (st != PM_OK)
+        return st;
+    /* M = C J^T (P x 2), C = sigma^2 (J^T J)^-1 from the packed triangle */
+    double m0[PM_MAX_TERMS], m1[PM_MAX_TERMS];
+    for (int i = 0; i < P; i++) {
+        double a = 0, b = 0;
+        for (int j = 0; j < P; j++) {
+            double c = fit->cov[i >= j ? pidx(i, j) : pidx(j, i)] * s2;
+            a += c * j0[j];
+            b += c * j1[j];
+        }
+        m0[i] = a;
+        m1[i] = b;
+    }
+    /* S = sigma^2 I + J M, and its inverse */
+    double s00 = s2, s01 = 0, s10 = 0, s11 = s2;
+    for (int i = 0; i < P; i++) {
+        s00 += j0[i] * m0[i];
+        s01 += j0[i] * m1[i];
+        s10 += j1[i] * m0[i];
+        s11 += j1[i] * m1[i];
+    }
+    double det = s00 * s11 - s01 * s10;
+    if (!(det > 0))
+        return PM_ERR_SINGULAR;
+    double i00 = s11 / det, i01 = -s01 / det, i10 = -s10 / det, i11 = s00 / det;
+    double sum = 0;
+    for (int g = 0; g < n_sky; g++) {
+        double th = sky[2 * g], dh = sky[2 * g + 1], ta, da, g0[PM_MAX_TERMS], g1[PM_MAX_TERMS];
+        if (!finite(th) || !finite(dh))
+            return PM_ERR_NONFINITE;
+        st = pm_model_apply(m, ctx, th, dh, &ta, &da);
+        if (st == PM_OK)
+            st = pm_fit_row(m, ctx, th, dh, ta, da, g0, g1, r);
+        if (st != PM_OK)
+            return st;
+        /* U = J_g M (2 x 2); the fall tr(U S^-1 U^T) / 2 */
+        double u00 = 0, u01 = 0, u10 = 0, u11 = 0;
+        for (int i = 0; i < P; i++) {
+            u00 += g0[i] * m0[i];
+            u01 += g0[i] * m1[i];
+            u10 += g1[i] * m0[i];
+            u11 += g1[i] * m1[i];
+        }
+        sum += 0.5 * (u00 * (i00 * u00 + i01 * u01) + u01 * (i10 * u00 + i11 * u01) +
+                      u10 * (i00 * u10 + i01 * u11) + u11 * (i10 * u10 + i11 * u11));
+    }
+    *gain = sum / n_sky;
+    return PM_OK;
+}
+
 pm_status pm_fit_covariance(const pm_fit *fit, const pm_fit_result *res,
                             int i, int j, double *cov, double *corr)
 {

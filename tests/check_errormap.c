@@ -14,7 +14,9 @@
 **  (where the model extrapolates and the predicted sigma is larger), and
 **  with the model noise-free, on each position's own (the 2x2 covariance).
 **  pmfit fit's map (--json "error_map", --error-map FILE.svg) agrees with
-**  the C API at the run's own points.
+**  the C API at the run's own points.  pm_fit_point_gain (the allocation-
+**  free I-optimal score of one more star) equals the fall of the mean
+**  predicted variance of the refit with that star taken (1e-6).
 */
 #define _POSIX_C_SOURCE 200809L
 #include <check.h>
@@ -160,6 +162,18 @@ START_TEST(test_errormap_errors)
     ck_assert_int_eq(pm_fit_pointing_sigma(&fit, &res, &m, NULL, NAN, 0.2, &s, c), PM_ERR_NONFINITE);
     ck_assert_int_eq(pm_fit_pointing_sigma(&fit, &res, &m, NULL, 0.1, INFINITY, &s, c),
                      PM_ERR_NONFINITE);
+    {
+        double sky[4] = {0.1, 0.2, -0.3, 0.5}, g;
+        ck_assert_int_eq(pm_fit_point_gain(&fit, &res, &m, NULL, 0.1, 0.2, sky, 2, &g), PM_OK);
+        ck_assert(g > 0);
+        ck_assert_int_eq(pm_fit_point_gain(&fit, &res, &m, NULL, 0.1, 0.2, sky, 0, &g), PM_ERR_ARG);
+        ck_assert_int_eq(pm_fit_point_gain(&fit, &res, &m, NULL, 0.1, 0.2, NULL, 2, &g), PM_ERR_ARG);
+        ck_assert_int_eq(pm_fit_point_gain(&fit, &res, &m, NULL, 0.1, 0.2, sky, 2, NULL), PM_ERR_ARG);
+        ck_assert_int_eq(pm_fit_point_gain(&fit, &res, &other, NULL, 0.1, 0.2, sky, 2, &g), PM_ERR_ARG);
+        ck_assert_int_eq(pm_fit_point_gain(&fit, &res, &m, NULL, NAN, 0.2, sky, 2, &g), PM_ERR_NONFINITE);
+        sky[3] = NAN;
+        ck_assert_int_eq(pm_fit_point_gain(&fit, &res, &m, NULL, 0.1, 0.2, sky, 2, &g), PM_ERR_NONFINITE);
+    }
 }
 END_TEST
 
@@ -235,6 +249,61 @@ START_TEST(test_errormap_pmfit)
 }
 END_TEST
 
+/* pm_fit_point_gain against the refit with the star taken: the fall of the
+** mean predicted variance over the places (each fit's variance scaled by
+** its own sigma^2, since one more star changes sigma a little). */
+START_TEST(test_point_gain_matches_refit)
+{
+    static double eh[NTRAIN + 1], ed[NTRAIN + 1], ah[NTRAIN + 1], ad[NTRAIN + 1];
+    static double sky[2 * 200];
+    pm_model truth, m;
+    pm_fit_result res, res2;
+    tu_rng r;
+    int i, c;
+    truth_model(&truth);
+    tu_seed(&r, 31);
+    for (i = 0; i < NTRAIN; i++) {
+        position(&r, 1, &eh[i], &ed[i]);
+        ck_assert_int_eq(pm_model_apply(&truth, NULL, eh[i], ed[i], &ah[i], &ad[i]), PM_OK);
+        ad[i] += 1.0 * ARCSEC * tu_gauss(&r);
+        ah[i] += 1.0 * ARCSEC * tu_gauss(&r) / cos(ad[i]);
+    }
+    for (i = 0; i < 200; i++)
+        position(&r, 0, &sky[2 * i], &sky[2 * i + 1]);
+    for (c = 0; c < 3; c++) {
+        double t, d, gain, before = 0, after = 0, s;
+        ck_assert_int_eq(pm_model_init(&m, PM_MOUNT_EQUATORIAL, 1), PM_OK);
+        ck_assert_int_eq(pm_fit_run(&fit, &m, NULL, NTRAIN, eh, ed, ah, ad, 50, &res), PM_OK);
+        position(&r, c != 1, &t, &d); /* sampled half, unsampled half, sampled half */
+        ck_assert_int_eq(pm_fit_point_gain(&fit, &res, &m, NULL, t, d, sky, 200, &gain), PM_OK);
+        for (i = 0; i < 200; i++) {
+            ck_assert_int_eq(pm_fit_pointing_sigma(&fit, &res, &m, NULL, sky[2 * i], sky[2 * i + 1],
+                                                   &s, NULL), PM_OK);
+            before += s * s / 200;
+        }
+        /* the star taken where the model predicts it (no residual): the
+        ** refit's covariance is the update's */
+        eh[NTRAIN] = t;
+        ed[NTRAIN] = d;
+        ck_assert_int_eq(pm_model_apply(&m, NULL, t, d, &ah[NTRAIN], &ad[NTRAIN]), PM_OK);
+        ck_assert_int_eq(pm_fit_run(&fit, &m, NULL, NTRAIN + 1, eh, ed, ah, ad, 50, &res2), PM_OK);
+        for (i = 0; i < 200; i++) {
+            ck_assert_int_eq(pm_fit_pointing_sigma(&fit, &res2, &m, NULL, sky[2 * i], sky[2 * i + 1],
+                                                   &s, NULL), PM_OK);
+            after += s * s / 200;
+        }
+        {
+            double s1 = res.sigma * res.sigma, s2 = res2.sigma * res2.sigma;
+            double brute = before / s1 - after / s2;
+            printf("check_errormap: point gain at (%.2f, %.2f): %.6g sigma^2, refit %.6g "
+                   "sigma^2 (mean predicted %.3f\" -> %.3f\")\n", t, d, gain / s1, brute,
+                   sqrt(before) / ARCSEC, sqrt(after * s1 / s2) / ARCSEC);
+            ck_assert(fabs(gain / s1 - brute) <= 1e-6 * brute);
+        }
+    }
+}
+END_TEST
+
 static Suite *suite(void)
 {
     Suite *s = suite_create("errormap");
@@ -243,6 +312,7 @@ static Suite *suite(void)
     tcase_add_test(t, test_errormap_matches_heldout);
     tcase_add_test(t, test_errormap_errors);
     tcase_add_test(t, test_errormap_pmfit);
+    tcase_add_test(t, test_point_gain_matches_refit);
     suite_add_tcase(s, t);
     return s;
 }
