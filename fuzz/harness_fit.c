@@ -1,7 +1,7 @@
 /*
 **  harness_fit.c - fuzz target body: random observation streams into the
 **  fit (pm_fit_init, pm_fit_add, pm_fit_solve, pm_fit_run,
-**  pm_fit_covariance, pm_fit_row).
+**  pm_fit_covariance, pm_fit_row, pm_fit_pointing_sigma, pm_fit_point_gain).
 **
 **  A model of random mount, order (0..2) and added terms is the truth;
 **  observations are either made from it (apply plus noise, so that fits
@@ -228,6 +228,35 @@ static int ft_cov(pmfz_in *in, int solved)
     return 0;
 }
 
+/* The predicted error and the point gain at fuzzed positions: documented
+** statuses; after PM_OK finite and non-negative (the gain to rounding);
+** never PM_OK without a successful solve. */
+static const int ft_pred_st[] = {PM_OK, PM_ERR_ARG, PM_ERR_STATE, PM_ERR_NONFINITE,
+                                 PM_ERR_SINGULAR, PM_ERR_CAPACITY, 99};
+
+static int ft_predict(pmfz_in *in, int solved)
+{
+    double t = pmfz_angle(in), d = pmfz_angle(in), sky[4], s = 777, c[3], g = 777;
+    pm_status st;
+    sky[0] = pmfz_angle(in);
+    sky[1] = pmfz_angle(in);
+    sky[2] = pmfz_double(in);
+    sky[3] = pmfz_angle(in);
+    st = pm_fit_pointing_sigma(&ft.fit, &ft.res, &ft.fit.lin, NULL, t, d, &s, c);
+    if (!pmfz_status_in(st, ft_pred_st))
+        return pmfz_fail("pointing_sigma: status %d", st);
+    if (st == PM_OK && (solved == 0 || !pmfz_finite(s) || s < 0 || !pmfz_finite(c[0]) ||
+                        !pmfz_finite(c[1]) || !pmfz_finite(c[2])))
+        return pmfz_fail("pointing_sigma: PM_OK with sigma %g (solved %d)", s, solved);
+    st = pm_fit_point_gain(&ft.fit, &ft.res, &ft.fit.lin, NULL, t, d, sky,
+                           1 + (int)(pmfz_u8(in) & 1u), &g);
+    if (!pmfz_status_in(st, ft_pred_st))
+        return pmfz_fail("point_gain: status %d", st);
+    if (st == PM_OK && (solved == 0 || !pmfz_finite(g)))
+        return pmfz_fail("point_gain: PM_OK with gain %g (solved %d)", g, solved);
+    return 0;
+}
+
 static int ft_run(pmfz_in *in, int nobs)
 {
     int n = pmfz_range(in, 0, nobs), it = pmfz_range(in, 0, 12), k, use_ctx = 0;
@@ -329,6 +358,8 @@ int pmfz_fit(const unsigned char *data, size_t size)
             break;
         case 5:
             r = ft_cov(&in, solved);
+            if (!r)
+                r = ft_predict(&in, solved);
             break;
         case 6: /* a whole run from the current model */
             r = ft_run(&in, nobs);
