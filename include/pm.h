@@ -751,8 +751,10 @@ pm_status pm_fit_covariance(const pm_fit *fit, const pm_fit_result *res,
 **  Returned (function value):
 **              pm_status   PM_OK; PM_ERR_ARG (NULL, or m has another number
 **                          of terms than the fit); PM_ERR_STATE (no
-**                          successful solve); PM_ERR_NONFINITE; the model's
-**                          statuses of pm_fit_row
+**                          successful solve); PM_ERR_NONFINITE (a
+**                          non-finite angle, or a variance beyond the
+**                          double range); the model's statuses of
+**                          pm_fit_row.  Nothing is written on error.
 **  Notes:
 **  1) J C J^T with J the position's two rows (pm_fit_row at the model's own
 **     prediction) and C = sigma^2 (J^T J)^-1 of the last solve: about P^2
@@ -792,7 +794,9 @@ pm_status pm_fit_pointing_sigma(const pm_fit *fit, const pm_fit_result *res,
 **                          sigma^2 before minus after (pm_fit_pointing_sigma)
 **  Returned (function value):
 **              pm_status   PM_OK; PM_ERR_ARG; PM_ERR_STATE (no successful
-**                          solve); PM_ERR_NONFINITE; the model's statuses
+**                          solve); PM_ERR_NONFINITE (a non-finite angle, or
+**                          products beyond the double range); the model's
+**                          statuses.  Nothing is written on error.
 **  Notes:
 **  1) With C the covariance, J the candidate's two rows and J_g a place's:
 **     C' = C - C J^T S^-1 J C, S = sigma^2 I + J C J^T (one more star of

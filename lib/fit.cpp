@@ -588,6 +588,9 @@ pm_status pm_fit_pointing_sigma(const pm_fit *fit, const pm_fit_result *res,
     v00 *= s2;
     v01 *= s2;
     v11 *= s2;
+    /* rows or a covariance of 1e150 and more overflow the product */
+    if (!finite(v00) || !finite(v01) || !finite(v11))
+        return PM_ERR_NONFINITE;
     double v = 0.5 * (v00 + v11);
     *sigma = v > 0 ? m_sqrt(v) : 0.0;
     if (cov) {
@@ -639,6 +642,8 @@ pm_status pm_fit_point_gain(const pm_fit *fit, const pm_fit_result *res, const p
         s11 += j1[i] * m1[i];
     }
     double det = s00 * s11 - s01 * s10;
+    if (!finite(det))
+        return PM_ERR_NONFINITE;
     if (!(det > 0))
         return PM_ERR_SINGULAR;
     double i00 = s11 / det, i01 = -s01 / det, i10 = -s10 / det, i11 = s00 / det;
@@ -663,6 +668,8 @@ pm_status pm_fit_point_gain(const pm_fit *fit, const pm_fit_result *res, const p
         sum += 0.5 * (u00 * (i00 * u00 + i01 * u01) + u01 * (i10 * u00 + i11 * u01) +
                       u10 * (i00 * u10 + i01 * u11) + u11 * (i10 * u10 + i11 * u11));
     }
+    if (!finite(sum))
+        return PM_ERR_NONFINITE; /* an overflow of the products (huge rows or covariance) */
     *gain = sum / n_sky;
     return PM_OK;
 }
