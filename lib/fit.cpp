@@ -549,23 +549,39 @@ pm_status pm_fit_run(pm_fit *fit, pm_model *model, const pm_context *ctx,
     return PM_ERR_DIVERGED;
 }
 
-pm_status pm_fit_pointing_sigma(const pm_fit *fit, const pm_fit_result *res,
-                                const pm_model *m, const pm_context *ctx, double enc_ha,
-                                double enc_dec, double *sigma, double cov[3])
+/* The checks of pm_fit_pointing_sigma and pm_fit_point_gain: a solved fit
+** of m's terms, a finite position. */
+static pm_status prediction_ready(const pm_fit *fit, const pm_model *m, double enc_ha,
+                                  double enc_dec)
 {
-    if (!fit || !res || !m || !sigma)
-        return PM_ERR_ARG;
     if (fit->state != FIT_READY || fit->iterations < 1 || !fit->cov_valid)
         return PM_ERR_STATE;
     if (m->n_terms != fit->n_par)
         return PM_ERR_ARG;
     if (!finite(enc_ha) || !finite(enc_dec))
         return PM_ERR_NONFINITE;
-    double app_ha, app_dec, row0[PM_MAX_TERMS], row1[PM_MAX_TERMS], r[2];
+    return PM_OK;
+}
+
+/* The two rows of m at an encoder position, at the model's own prediction. */
+static pm_status rows_at(const pm_model *m, const pm_context *ctx, double enc_ha, double enc_dec,
+                         double *row0, double *row1)
+{
+    double app_ha, app_dec, r[2];
     pm_status st = pm_model_apply(m, ctx, enc_ha, enc_dec, &app_ha, &app_dec);
-    if (st != PM_OK)
-        return st;
-    st = pm_fit_row(m, ctx, enc_ha, enc_dec, app_ha, app_dec, row0, row1, r);
+    return st != PM_OK ? st : pm_fit_row(m, ctx, enc_ha, enc_dec, app_ha, app_dec, row0, row1, r);
+}
+
+pm_status pm_fit_pointing_sigma(const pm_fit *fit, const pm_fit_result *res,
+                                const pm_model *m, const pm_context *ctx, double enc_ha,
+                                double enc_dec, double *sigma, double cov[3])
+{
+    if (!fit || !res || !m || !sigma)
+        return PM_ERR_ARG;
+    double row0[PM_MAX_TERMS], row1[PM_MAX_TERMS];
+    pm_status st = prediction_ready(fit, m, enc_ha, enc_dec);
+    if (st == PM_OK)
+        st = rows_at(m, ctx, enc_ha, enc_dec, row0, row1);
     if (st != PM_OK)
         return st;
     /* J C J^T over the packed lower triangle: each off-diagonal element
@@ -607,20 +623,14 @@ pm_status pm_fit_point_gain(const pm_fit *fit, const pm_fit_result *res, const p
 {
     if (!fit || !res || !m || !sky || n_sky < 1 || !gain)
         return PM_ERR_ARG;
-    if (fit->state != FIT_READY || fit->iterations < 1 || !fit->cov_valid)
-        return PM_ERR_STATE;
-    if (m->n_terms != fit->n_par)
-        return PM_ERR_ARG;
-    if (!finite(enc_ha) || !finite(enc_dec))
-        return PM_ERR_NONFINITE;
-    const int P = fit->n_par;
-    const double s2 = res->sigma * res->sigma;
-    double app_ha, app_dec, j0[PM_MAX_TERMS], j1[PM_MAX_TERMS], r[2];
-    pm_status st = pm_model_apply(m, ctx, enc_ha, enc_dec, &app_ha, &app_dec);
+    double j0[PM_MAX_TERMS], j1[PM_MAX_TERMS];
+    pm_status st = prediction_ready(fit, m, enc_ha, enc_dec);
     if (st == PM_OK)
-        st = pm_fit_row(m, ctx, enc_ha, enc_dec, app_ha, app_dec, j0, j1, r);
+        st = rows_at(m, ctx, enc_ha, enc_dec, j0, j1);
     if (st != PM_OK)
         return st;
+    const int P = fit->n_par;
+    const double s2 = res->sigma * res->sigma;
     /* M = C J^T (P x 2), C = sigma^2 (J^T J)^-1 from the packed triangle */
     double m0[PM_MAX_TERMS], m1[PM_MAX_TERMS];
     for (int i = 0; i < P; i++) {
@@ -649,12 +659,10 @@ pm_status pm_fit_point_gain(const pm_fit *fit, const pm_fit_result *res, const p
     double i00 = s11 / det, i01 = -s01 / det, i10 = -s10 / det, i11 = s00 / det;
     double sum = 0;
     for (int g = 0; g < n_sky; g++) {
-        double th = sky[2 * g], dh = sky[2 * g + 1], ta, da, g0[PM_MAX_TERMS], g1[PM_MAX_TERMS];
+        double th = sky[2 * g], dh = sky[2 * g + 1], g0[PM_MAX_TERMS], g1[PM_MAX_TERMS];
         if (!finite(th) || !finite(dh))
             return PM_ERR_NONFINITE;
-        st = pm_model_apply(m, ctx, th, dh, &ta, &da);
-        if (st == PM_OK)
-            st = pm_fit_row(m, ctx, th, dh, ta, da, g0, g1, r);
+        st = rows_at(m, ctx, th, dh, g0, g1);
         if (st != PM_OK)
             return st;
         /* U = J_g M (2 x 2); the fall tr(U S^-1 U^T) / 2 */
