@@ -1,8 +1,9 @@
 #!/bin/sh
 # Install the Debian packages the build and the tests need (idempotent).
 # Usage: sh tools/deps.sh      (as root, or with sudo available)
+# One package per line below (with what needs it), so additions merge cleanly.
 set -e
-PKGS="build-essential pkg-config check liberfa-dev liblapacke-dev python3-numpy python3-scipy python3-erfa gnuplot-nox gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm valgrind clang-14 libclang-rt-14-dev"
+PKGS=$(sed -n 's/^#pkg \([^ ]*\).*/\1/p' "$0")
 missing=""
 for p in $PKGS; do
   dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"
@@ -13,3 +14,20 @@ SUDO=""
 echo "installing:$missing" >&2
 $SUDO apt-get update -qq
 DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends $missing >&2
+exit 0
+# The packages (the list the script reads above):
+#pkg build-essential          compilers, make
+#pkg pkg-config               Check's flags
+#pkg check                    the test framework
+#pkg liberfa-dev              catalogue reduction (tools/lib/runfile_reduce.cpp)
+#pkg liblapacke-dev           reference solutions in the tests, bench_fit
+#pkg python3-numpy            reference scripts (tests/ref)
+#pkg python3-scipy            reference scripts
+#pkg python3-erfa             reference scripts
+#pkg gnuplot-nox              plots in docs
+#pkg gcc-arm-none-eabi        make firmware, make bench (Cortex-M)
+#pkg libnewlib-arm-none-eabi  make firmware, make bench
+#pkg qemu-system-arm          make firmware, make bench
+#pkg valgrind                 instruction counts (bench)
+#pkg clang-14                 make sanitize, make fuzz
+#pkg libclang-rt-14-dev       make sanitize, make fuzz
