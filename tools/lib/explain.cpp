@@ -620,13 +620,53 @@ int simpler_reading(const Run &run, const State &st, std::vector<Candidate> &can
     return pick;
 }
 
+// The generic reading when it holds the chosen periodic family (a few
+// cycles over the sampled range are a smooth shape, which the harmonics can
+// hold; the physical families keep their precedence): if higher_order is
+// significant too, and with both fitted the chosen family adds nothing (its
+// partial F-test, times its trials, not below alpha: the backward pass's
+// test) while higher_order given the family does (times the step's K) and
+// predicts better than the current model (cross-validated, as every finding
+// must), the family was one part of the higher-order structure: take
+// higher_order.  (A degree-2 distortion of an
+// alt-az mount's azimuth angle, cos^2(el) cos 2az, is half explained by a
+// two-cycle azimuth term; order 2 explains all of it and the two-cycle term
+// nothing beyond.)  The family stays a candidate of the next step.
+int generic_reading(const Run &run, const State &st, std::vector<Candidate> &cands, int k,
+                    const ExplainOptions &opt)
+{
+    const Candidate &c = cands[(size_t)k];
+    if (!(c.peak_g > 0) || c.members.size() != 1)
+        return k;
+    auto h = std::find_if(cands.begin(), cands.end(),
+                          [](const Candidate &x) { return x.effect == "higher_order"; });
+    if (h == cands.end() || !h->fit.ok || !(h->log_fap < std::log(opt.alpha)))
+        return k;
+    Fit both = fit_spec(run, st.use, h->order, c.adds);
+    if (!both.ok || both.P <= h->fit.P || both.P <= c.fit.P)
+        return k;
+    double d2 = (double)(2 * both.N - both.P), s2 = both.chi2 / d2;
+    double dc = both.P - h->fit.P, dh = both.P - c.fit.P;
+    double fc = ((h->fit.chi2 - both.chi2) / dc) / s2, fh = ((c.fit.chi2 - both.chi2) / dh) / s2;
+    bool c_needed = log_f_tail(fc, dc, d2) + std::log(c.trials) < std::log(opt.alpha);
+    bool h_needed = log_f_tail(fh, dh, d2) + std::log((double)cands.size()) < std::log(opt.alpha);
+    if (c_needed || !h_needed)
+        return k;
+    h->cv = cv_rms(run, st.use, h->order, h->adds, opt.folds, opt.seed);
+    if (!(h->cv < st.cur_cv))
+        return k;
+    return (int)(h - cands.begin());
+}
+
 int choose(const Run &run, const State &st, std::vector<Candidate> &cands,
            const ExplainOptions &opt)
 {
     int k = first_passing(run, st, cands, opt);
-    if (k < 0 || cands[(size_t)k].effect != "higher_order")
+    if (k < 0)
         return k;
-    return simpler_reading(run, st, cands, k, opt);
+    if (cands[(size_t)k].effect == "higher_order")
+        k = simpler_reading(run, st, cands, k, opt);
+    return generic_reading(run, st, cands, k, opt);
 }
 
 // Pairs of the single families (not higher_order, not outliers) where no
