@@ -7,7 +7,7 @@
 //                 [--robust [--clip K]]
 //   pmfit eval MODEL RUN [--json] [--residuals FILE] [--no-refraction] [--skip-bad]
 //   pmfit report RUN -o PAGE.html [--order L] [--add EFFECT ...] [--compare OLD] [--next K]
-//                 [--alpha P] [--gear [ha:|dec:]G ...] [--quiet]
+//                 [--alpha P] [--gear [ha:|dec:]G ...] [--quiet | --progress]
 //   pmfit simulate OUT [--n N] [--seed S] [--lat DEG] [--mount equatorial|altaz]
 //                 [--fork] [--el-limit DEG] [--noise ARCSEC] [--order L]
 //                 [--term NAME=ARCSEC ...] [--random-aniso ARCSEC]
@@ -85,6 +85,7 @@ struct Options {
     std::string shape_opt;           // a simulate option that shapes a simulated run
     std::string output, compare;     // report: -o PAGE.html, --compare OLD
     bool quiet = false;              // report: no progress on stderr
+    bool progress = false;           // report: a line per stage on stderr, always
 };
 
 void usage(FILE *f)
@@ -168,14 +169,15 @@ void usage(FILE *f)
         "\n"
         "usage: pmfit report RUN -o PAGE.html [--order L] [--add EFFECT ...] [--compare OLD]\n"
         "                    [--next K] [--alpha P] [--gear [ha:|dec:]G ...] [--no-refraction]\n"
-        "                    [--skip-bad] [--quiet]\n"
+        "                    [--skip-bad] [--quiet | --progress]\n"
         "\n"
         "  one self-contained HTML page (inline SVG, no script, no network): the fit and its\n"
         "  table, the residuals on the sky and against azimuth, elevation, hour angle,\n"
         "  declination, time and temperature, the model's correction and predicted error\n"
         "  over the sky, the explain findings with before/after plots, the next K targets\n"
         "  (default 5) and, with --compare OLD (a saved model or a run), what changed since;\n"
-        "  progress on stderr unless --quiet (docs/report.md)\n"
+        "  progress on stderr (on a terminal, or once it has taken a second; --progress:\n"
+        "  always, a line per stage; --quiet: never) (docs/report.md)\n"
         "\n"
         "usage: pmfit simulate OUT [--n N] [--seed S] [--lat DEG] [--mount equatorial|altaz]\n"
         "                      [--fork] [--el-limit DEG] [--noise ARCSEC] [--order L]\n"
@@ -270,6 +272,8 @@ Options parse_report(Options o, int argc, char **argv)
             o.skip_bad = true;
         } else if (a == "--quiet" || a == "-q") {
             o.quiet = true;
+        } else if (a == "--progress") {
+            o.progress = true;
         } else if (!a.empty() && a[0] == '-') {
             die("report: unknown option '" + a + "'; see pmfit --help");
         } else if (o.run.empty()) {
@@ -282,6 +286,8 @@ Options parse_report(Options o, int argc, char **argv)
         die("report: no run file given; usage: pmfit report RUN -o PAGE.html");
     if (o.output.empty())
         die("report: no output given; usage: pmfit report RUN -o PAGE.html");
+    if (o.quiet && o.progress)
+        die("report: --quiet and --progress contradict each other");
     return o;
 }
 
@@ -1168,8 +1174,9 @@ void check_output(const std::string &opt, const std::string &path)
 
 // pmfit report RUN -o PAGE.html: the page, written through a temporary file
 // and a rename, so a failure leaves the output path as it was.  Progress on
-// stderr: one updated line on a terminal, a line per stage otherwise;
-// --quiet: none.
+// stderr: on a terminal one line updated per stage; otherwise a line per
+// stage once the page has taken a second (a short run stays quiet but for
+// the closing 'wrote'); --progress: a line per stage always; --quiet: none.
 int cmd_report(const Options &o, const Run &run, int argc, char **argv)
 {
     ReportOptions ro;
@@ -1189,19 +1196,20 @@ int cmd_report(const Options &o, const Run &run, int argc, char **argv)
     bool tty = isatty(fileno(stderr)) != 0;
     auto t0 = std::chrono::steady_clock::now();
     ReportProgress progress = [&](const std::string &stage, double done) {
-        if (o.quiet)
-            return;
         double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        std::fprintf(stderr, tty ? "\rpmfit report: [%3.0f%%] %-20s %6.1f s" : "pmfit report: [%3.0f%%] %s (%.1f s)\n",
+        if (o.quiet || (!tty && !o.progress && sec < 1))
+            return;
+        bool line = !tty || o.progress;
+        std::fprintf(stderr, line ? "pmfit report: [%3.0f%%] %s (%.1f s)\n" : "\rpmfit report: [%3.0f%%] %-20s %6.1f s",
                      done * 100, stage.c_str(), sec);
-        if (tty && stage == "done")
+        if (!line && stage == "done")
             std::fprintf(stderr, "\n");
     };
     std::string html;
     try {
         html = report_html(run, ro, progress);
     } catch (const std::exception &x) {
-        if (tty && !o.quiet)
+        if (tty && !o.quiet && !o.progress)
             std::fprintf(stderr, "\n");
         die(std::string(x.what()) + " (no page written)", 1);
     }

@@ -241,7 +241,7 @@ struct Panel {
     }
 };
 
-// A legend entry: kind 'o' dot, '-' line, '=' dashed line, 'b' bar, '>' arrow of `len` px.
+// A legend entry: kind 'o' dot, 'r' ring, '-' line, '=' dashed line, 'b' bar, '>' arrow of `len` px.
 struct Item { char kind; const char *col; std::string label; double len; };
 
 // Legend entries in centred rows within [l, r] starting at y; returns the height used.
@@ -260,6 +260,8 @@ double legend(Svg &g, const std::vector<Item> &items, double l, double r, double
             const Item &it = items[i];
             double sw = it.kind == '>' ? it.len : 22;
             if (it.kind == 'o') g.s += fmt("<circle cx=\"%.1f\" cy=\"%.1f\" r=\"4.5\" fill=\"%s\"/>\n", x + 11, cy, it.col);
+            if (it.kind == 'r')
+                g.s += fmt("<circle cx=\"%.1f\" cy=\"%.1f\" r=\"6\" fill=\"none\" stroke=\"%s\" stroke-width=\"2\"/>\n", x + 11, cy, it.col);
             if (it.kind == '-' || it.kind == '=')
                 g.line(x, cy, x + 22, cy, it.col, 2.5, it.kind == '=' ? " stroke-dasharray=\"6 4\"" : "");
             if (it.kind == 'b') g.rect(x + 4, cy - 6, 14, 12, it.col);
@@ -420,7 +422,7 @@ std::string ramp(double f)
 int sky_scalar(const Out &path, const std::string &title, const std::string &xlabel,
                const std::string &ylabel, const std::vector<Cell> &cells, const std::string &unit,
                const std::vector<std::pair<double, double>> &marks, const std::string &marks_name,
-               std::string *err)
+               std::string *err, const std::vector<std::string> &mark_labels)
 {
     double mnx = INFINITY, mxx = -INFINITY, mny = INFINITY, mxy = -INFINITY, vmax = 0;
     size_t n = 0;
@@ -435,7 +437,7 @@ int sky_scalar(const Out &path, const std::string &title, const std::string &xla
     Svg g(W, H, title);
     std::vector<Item> items;
     if (!marks.empty())
-        items.push_back({'o', INK, marks_name + fmt(" (%zu)", marks.size()), 0});
+        items.push_back({mark_labels.empty() ? 'o' : 'r', INK, marks_name + fmt(" (%zu)", marks.size()), 0});
     double top = 50 + legend(g, items, 40, W - 140, 46) + 20;
     Panel p(g, 90, top, W - 150, H - 62);
     p.ax.angular = p.ay.angular = true;
@@ -454,10 +456,23 @@ int sky_scalar(const Out &path, const std::string &title, const std::string &xla
         g.rect(std::min(x0, x1), std::min(y0, y1), std::fabs(x1 - x0) + 0.6, std::fabs(y1 - y0) + 0.6,
                ramp(c.v / vtop).c_str());
     }
-    for (const auto &m : marks)
-        if (fin(m.first) && fin(m.second))
+    for (size_t k = 0; k < marks.size(); k++) {
+        const auto &m = marks[k];
+        if (!fin(m.first) || !fin(m.second))
+            continue;
+        double x = p.ax.map(m.first), y = p.ay.map(m.second);
+        if (mark_labels.empty()) {
             g.s += fmt("<circle cx=\"%.1f\" cy=\"%.1f\" r=\"2.6\" fill=\"none\" stroke=\"%s\" "
-                       "stroke-width=\"1.2\"/>\n", p.ax.map(m.first), p.ay.map(m.second), INK);
+                       "stroke-width=\"1.2\"/>\n", x, y, INK);
+            continue;
+        }
+        // labelled marks: a bold ring on a white one, and its label beside it
+        g.s += fmt("<circle cx=\"%.1f\" cy=\"%.1f\" r=\"7\" fill=\"none\" stroke=\"#ffffff\" stroke-width=\"4.5\"/>\n"
+                   "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"7\" fill=\"none\" stroke=\"#111111\" stroke-width=\"2\"/>\n",
+                   x, y, x, y);
+        if (k < mark_labels.size())
+            g.text(x + 10, y - 6, mark_labels[k], 14, "start", "#111111", std::string(" font-weight=\"bold\"") + HALO);
+    }
     p.over(g, xlabel, ylabel, n == 0);
     // the colour bar, 0 .. vmax
     double bx = W - 120, by0 = top, by1 = H - 62, steps = 40;

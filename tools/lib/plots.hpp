@@ -68,11 +68,12 @@ struct Cell {
 // A map of a scalar over the sky: each cell filled by its value on a sequential colour
 // scale from 0 to the largest value (a colour bar with ticks and `unit` beside the frame),
 // and the points `marks` (x, y in degrees, e.g. the observed stars) drawn as small black
-// rings on top, named `marks_name` in the legend.
+// rings on top, named `marks_name` in the legend.  With mark_labels (one per mark, e.g.
+// "1", "2", ...) the marks are bold rings with their label beside them (targets).
 int sky_scalar(const Out &path, const std::string &title, const std::string &xlabel,
                const std::string &ylabel, const std::vector<Cell> &cells, const std::string &unit,
                const std::vector<std::pair<double, double>> &marks, const std::string &marks_name,
-               std::string *err);
+               std::string *err, const std::vector<std::string> &mark_labels = {});
 
 // A series of an xy plot.  line = true: a polyline in the given order (a non-finite point
 // breaks it), e.g. a model curve; line = false: scatter points.  x and y must have the

@@ -159,10 +159,16 @@ void table(Page &p, const std::string &caption, const std::vector<std::string> &
     for (const std::string &c : head)
         p.body += "<th scope=\"col\">" + c + "</th>";
     p.body += "</tr></thead>\n<tbody>\n";
+    auto is_number = [](const std::string &c) { // after any leading tags
+        size_t k = 0;
+        while (k < c.size() && c[k] == '<')
+            k = c.find('>', k) == std::string::npos ? c.size() : c.find('>', k) + 1;
+        return k < c.size() && (std::strchr("0123456789+-.", c[k]) || c.compare(k, 3, "\xe2\x80\x93") == 0);
+    };
     for (const auto &r : rows) {
         p.body += "<tr>";
         for (const std::string &c : r)
-            p.body += "<td>" + c + "</td>";
+            p.body += (is_number(c) ? "<td>" : "<td class=\"t\">") + c + "</td>";
         p.body += "</tr>\n";
     }
     p.body += "</tbody>\n</table>\n";
@@ -667,18 +673,18 @@ void explain_findings(Page &p, const Data &d)
 {
     const Explanation &ex = d.ex;
     std::vector<std::vector<std::string>> rows = {
-        {"baseline", "", "", num(ex.base_sigma_arcsec, 3), num(ex.base_cv_rms_arcsec, 3), fmt("%d", ex.base_n_params)}};
+        {"0", "baseline", "", num(ex.base_sigma_arcsec, 3), num(ex.base_cv_rms_arcsec, 3), fmt("%d", ex.base_n_params)}};
     for (size_t k = 0; k < ex.findings.size(); k++) {
         const Finding &f = ex.findings[k];
-        rows.push_back({fmt("%zu. <b>", k + 1) + h(f.effect) + "</b>", h(f.text) + "<br><i>where:</i> " + h(f.where),
+        rows.push_back({fmt("%zu", k + 1), fmt("<a href=\"#finding%zu\">", k + 1) + h(f.effect) + "</a>",
                         fmt("%.2g", f.false_alarm_probability), num(f.sigma_after_arcsec, 3),
                         num(f.cv_rms_after_arcsec, 3), fmt("%d", f.n_params_after)});
     }
     table(p, "What the model left out, step by step: each finding, its false-alarm probability (the "
              "chance that noise alone makes so large an improvement, corrected for the periods and "
              "candidates tried) and the fit once it is added.",
-          {"step", "finding", "false-alarm probability", "&sigma; after (arcsec)", "cross-validated RMS (arcsec)",
-           "terms P"}, rows, "findings");
+          {"step", "added", "false-alarm probability", "&sigma; after (arcsec)", "cross-validated RMS (arcsec)",
+           "terms P"}, rows, "num");
     for (size_t k = 0; k < ex.findings.size(); k++) {
         const Finding &f = ex.findings[k];
         std::string extra;
@@ -745,7 +751,7 @@ void section_explain(Page &p, const Data &d)
                   d.o.alpha, pg.trials),
                [&](const pmplot::Out &out, std::string *err) {
                    return pmplot::periodogram(out, "Periodogram of the baseline residuals, " + axis + " axis",
-                                              "power (chi^2 reduction / sigma^2, no unit)", pg.g, pg.power,
+                                              "power (\xcf\x87\xc2\xb2 reduction / \xcf\x83\xc2\xb2, no unit)", pg.g, pg.power,
                                               pg.threshold, fmt("false-alarm %g", d.o.alpha), pg.peak_g, true, err);
                });
     }
@@ -772,9 +778,11 @@ void section_plan(Page &p, const Data &d)
                 (d.o.adds.empty() ? "" : " --add &hellip;") + "</code>.");
     std::vector<std::vector<std::string>> rows;
     std::vector<std::pair<double, double>> marks;
+    std::vector<std::string> labels;
     for (size_t k = 0; k < pl.targets.size(); k++) {
         const Target &t = pl.targets[k];
         marks.push_back({t.x_deg, t.y_deg});
+        labels.push_back(fmt("%zu", k + 1));
         if (d.altaz)
             rows.push_back({fmt("%zu", k + 1), num(t.x_deg, 2), num(t.y_deg, 2), arcsec_text(t.after_arcsec)});
         else
@@ -787,11 +795,12 @@ void section_plan(Page &p, const Data &d)
     else
         table(p, "The next targets.", {"#", "hour angle (h)", "declination (deg)", "elevation (deg)", "pier side",
                                        "predicted mean error after (arcsec)"}, rows, "num targets");
-    figure(p, "Where the next targets are (rings) on the predicted error map of the current fit (1&sigma; "
+    figure(p, "Where the next targets are (numbered rings, in the order of the table) on the predicted error map of the current fit (1&sigma; "
               "per axis, arcsec, colour bar). Axes: " + h(d.xlabel()) + " and " + h(d.ylabel()) + ".",
            [&](const pmplot::Out &out, std::string *err) {
                return pmplot::sky_scalar(out, "Next targets on the predicted error map", d.xlabel(), d.ylabel(),
-                                         d.emap.cells, "1 sigma (arcsec)", marks, "next targets", err);
+                                         d.emap.cells, "1 sigma (arcsec)", marks, "next targets, in order", err,
+                                         labels);
            });
     end_section(p);
 }
@@ -836,8 +845,7 @@ const char *const CSS =
     "table{border-collapse:collapse;margin:.8em 0;font-size:.92em}caption{text-align:left;padding:.3em 0;"
     "caption-side:top}\n"
     "th,td{border:1px solid #ccc;padding:.25em .55em;vertical-align:top}th{background:#f0f4f8;text-align:left}\n"
-    "table.num td{text-align:right}table.num td:nth-child(-n+2){text-align:left}\n"
-    "table.findings td:nth-child(n+3){text-align:right;white-space:nowrap}\n"
+        "table.num td{text-align:right}table.num td.t{text-align:left}\n"
     "dl.summary{display:grid;grid-template-columns:max-content auto;gap:.2em 1em}dl.summary dt{font-weight:bold}"
     "dl.summary dd{margin:0}\n"
     "figure{margin:1.2em 0;padding:.5em;border:1px solid #ddd;background:#fff}figure svg{display:block;"
