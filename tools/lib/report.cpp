@@ -403,27 +403,33 @@ struct Variable {
     double (*get)(const Where &, const Obs &);
 };
 
-// One figure of the residuals against var; false (nothing drawn) when no
-// observation has it.
-bool residual_figure(Page &p, const Data &d, const Variable &var)
+// One figure of the residuals against var; nothing drawn, and a note why
+// in *why, when no observation has it or all have the same value.
+bool residual_figure(Page &p, const Data &d, const Variable &var, std::string *why)
 {
     const FitOut &f = d.fit;
     pmplot::Series s1{d.altaz ? "axis 1 (azimuth, on the sky)" : "axis 1 (hour angle, on the sky)", {}, {}, false};
     pmplot::Series s2{d.altaz ? "axis 2 (elevation)" : "axis 2 (declination)", {}, {}, false};
     size_t n = 0;
+    double lo = INFINITY, hi = -INFINITY;
     for (size_t j = 0; j < f.idx.size(); j++) {
         const Obs &o = d.run.obs[f.idx[j]];
         double x = var.get(where_of(d.run, o), o);
-        n += std::isfinite(x);
+        if (std::isfinite(x))
+            n++, lo = std::min(lo, x), hi = std::max(hi, x);
         s1.x.push_back(x), s1.y.push_back(f.r0[j] * RAD2AS);
         s2.x.push_back(x), s2.y.push_back(f.r1[j] * RAD2AS);
     }
-    if (!n)
+    std::string unit = var.label.substr(var.label.find('(') + 1, var.label.size() - var.label.find('(') - 2);
+    if (!n || hi == lo) {
+        *why = var.words + (n ? fmt(": the run gives one value, %.6g %s, for every observation", lo, unit.c_str())
+                              : std::string(": the run gives it for no observation") +
+                                    (std::isfinite(d.run.latitude) ? "" : " (or no latitude to convert the axes)"));
         return false;
+    }
     std::string what = var.label.substr(0, var.label.find(" ("));
     figure(p, "Residuals of the fit (observed minus model, arcsec on the sky) against " + h(var.words) +
-                  " (" + h(var.label.substr(var.label.find('(') + 1, var.label.size() - var.label.find('(') - 2)) +
-                  "): " + h(axis_names(d)) + ". A trend is a term the model lacks" +
+                  " (" + h(unit) + "): " + h(axis_names(d)) + ". A trend is a term the model lacks" +
                   (n < f.idx.size() ? fmt("; %zu observations without it are not drawn", f.idx.size() - n) : "") + ".",
            [&](const pmplot::Out &out, std::string *err) {
                return pmplot::xy(out, "Residuals against " + what, var.label, "residual (arcsec)", {s1, s2}, err);
@@ -451,16 +457,10 @@ void section_residuals(Page &p, const Data &d)
         {"time (h)", "time (hours, the run's own zero point)", [](const Where &, const Obs &o) { return o.ctx.time_h; }},
         {"temperature (\xc2\xb0" "C)", "air temperature", [](const Where &, const Obs &o) { return o.ctx.temp_c; }},
     };
-    std::vector<std::string> absent;
-    for (const Variable &var : vars)
-        if (!residual_figure(p, d, var))
-            absent.push_back(var.words);
-    if (!absent.empty()) {
-        std::string a;
-        for (size_t k = 0; k < absent.size(); k++)
-            a += (k ? (k + 1 == absent.size() ? " and " : ", ") : "") + absent[k];
-        para(p, "Not drawn: " + h(a) + (absent.size() > 1 ? " (the run gives them" : " (the run gives it") +
-                    " for no observation" + (std::isfinite(d.run.latitude) ? "" : ", or no latitude to convert the axes") + ").");
+    for (const Variable &var : vars) {
+        std::string why;
+        if (!residual_figure(p, d, var, &why))
+            para(p, "Not drawn: the residuals against " + h(why) + ".");
     }
     end_section(p);
 }
@@ -654,6 +654,17 @@ void finding_figure(Page &p, const Data &d, const Finding &f, size_t k)
         before = d.ex.baseline;
     std::string xlab;
     std::vector<pmplot::Series> b = finding_series(d, f, before, &xlab), a = finding_series(d, f, d.ex.final, &xlab);
+    if (f.effect == "outlier") { // the points left out, on top
+        pmplot::Series out{"left out (both axes)", {}, {}, false};
+        for (size_t j = 0; j < before.idx.size(); j++) {
+            const Obs &o = d.run.obs[before.idx[j]];
+            if (std::find(f.lines.begin(), f.lines.end(), o.line) == f.lines.end())
+                continue;
+            out.x.insert(out.x.end(), {(double)o.line, (double)o.line});
+            out.y.insert(out.y.end(), {before.r0[j] * RAD2AS, before.r1[j] * RAD2AS});
+        }
+        b.push_back(out);
+    }
     std::string bt = fmt("without it: sigma %.2f\"", before.res.sigma * RAD2AS);
     std::string at = fmt("with it: sigma %.2f\"", d.ex.final.res.sigma * RAD2AS);
     figure(p, fmt("Finding %zu, <b>%s</b>, before and after: the residuals (arcsec; ", k + 1, h(f.effect).c_str()) +
