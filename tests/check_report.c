@@ -268,6 +268,28 @@ START_TEST(test_report_altaz)
 }
 END_TEST
 
+/* An equatorial run without a latitude: no azimuth, elevation or targets,
+** each said on the page; the rest drawn. */
+START_TEST(test_report_no_latitude)
+{
+    char path[512], cmd[4096];
+    char *html;
+    snprintf(path, sizeof path, "%s/nolat.dat", tmp);
+    snprintf(cmd, sizeof cmd, "grep -v '^# latitude:' '%s/examples/sim_gem.dat' > '%s'", top(), path);
+    ck_assert_int_eq(system(cmd), 0);
+    ck_assert_msg(report(path, "", "nolat.html") == 0, "pmfit report failed: %s", out);
+    snprintf(path, sizeof path, "%s/nolat.html", tmp);
+    html = slurp(path);
+    ck_assert_ptr_nonnull(html);
+    check_page(html, "page without a latitude", 12, 0);
+    ck_assert_msg(strstr(html, "site latitude not given") != NULL, "summary");
+    ck_assert_msg(strstr(html, "Not drawn: the residuals against elevation") != NULL, "no elevation");
+    ck_assert_msg(strstr(html, "Not available for this run: plan: an equatorial mount needs the site latitude"),
+                  "no targets");
+    free(html);
+}
+END_TEST
+
 /* --compare OLD: a saved model, and a run; the numbers of pmfit compare. */
 START_TEST(test_report_compare)
 {
@@ -558,6 +580,7 @@ static Suite *suite(void)
     tcase_set_timeout(t, 600);
     tcase_add_test(t, test_report_example);
     tcase_add_test(t, test_report_altaz);
+    tcase_add_test(t, test_report_no_latitude);
     tcase_add_test(t, test_report_compare);
     suite_add_tcase(s, t);
     t = tcase_create("errors");

@@ -2,10 +2,11 @@
 //
 // Each function writes one standalone SVG 1.1 file (through pmhost::write_atomic, so a
 // failure never leaves a half-written file), or the same document into a string (Out),
-// and returns 0, or -1 with a message in *err (err may be NULL).  Non-finite values are skipped; with nothing left to draw the figure
-// still gets its title and axes and says "no data".  Text is escaped for XML; control
-// characters become spaces and invalid UTF-8 bytes '?'.  Fonts: DejaVu Sans, Helvetica,
-// Arial, sans-serif; sizes 18 (title), 14 (axis labels), 12-13 (ticks, legend).
+// and returns 0, or -1 with a message in *err (err may be NULL).  Non-finite values are
+// skipped; with nothing left to draw the figure still gets its title and axes and says
+// "no data".  Text is escaped for XML; control characters become spaces and invalid UTF-8
+// bytes '?'.  Fonts: DejaVu Sans, Helvetica, Arial, sans-serif; sizes 18 (title), 14 (axis
+// labels), 12-13 (ticks, legend).
 //
 // Labels are drawn as given: put the units in them ("hour angle (deg)").
 // Colours (Okabe-Ito, colour-blind safe) are assigned in order: blue, vermillion, green,
