@@ -116,6 +116,8 @@ demo-run: all
 	$(B)/pmfit fit examples/sim_gem.dat --order 1 --residuals $(B)/sim_gem.res --save $(B)/sim_gem.pm
 	@echo; echo "== what did the model leave out? (plots in $(B)/sim_gem_plots)"
 	$(B)/pmfit explain examples/sim_gem.dat --plots $(B)/sim_gem_plots
+	@echo; echo "== one page with all of it: $(B)/sim_gem_report.html (docs/report.md)"
+	$(B)/pmfit report examples/sim_gem.dat -o $(B)/sim_gem_report.html
 	@if [ -d $(DATA) ]; then \
 	  echo "== real runs in $(DATA)"; \
 	  $(B)/pmfit fit $(DATA)/mmt/k_and_e.dat --order 1; \

@@ -31,3 +31,4 @@ exit 0
 #pkg valgrind                 instruction counts (bench)
 #pkg clang-14                 make sanitize, make fuzz
 #pkg libclang-rt-14-dev       make sanitize, make fuzz
+#pkg chromium                 pmfit report's browser test (tests/check_report.c)

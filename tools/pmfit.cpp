@@ -6,6 +6,8 @@
 //   pmfit explain RUN [--order L] [--add EFFECT ...] [--json] [--plots DIR] [--alpha P]
 //                 [--robust [--clip K]]
 //   pmfit eval MODEL RUN [--json] [--residuals FILE] [--no-refraction] [--skip-bad]
+//   pmfit report RUN -o PAGE.html [--order L] [--add EFFECT ...] [--compare OLD] [--next K]
+//                 [--alpha P] [--gear [ha:|dec:]G ...] [--quiet | --progress]
 //   pmfit simulate OUT [--n N] [--seed S] [--lat DEG] [--mount equatorial|altaz]
 //                 [--fork] [--el-limit DEG] [--noise ARCSEC] [--order L]
 //                 [--term NAME=ARCSEC ...] [--random-aniso ARCSEC]
@@ -25,6 +27,7 @@
 #include "explain.hpp"
 #include "plots.hpp"
 #include "robust.hpp"
+#include "report.hpp"
 
 #include <cerrno>
 #include <cmath>
@@ -36,6 +39,7 @@
 #include <string>
 #include <vector>
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <unistd.h>
 #include <stdexcept>
@@ -79,6 +83,9 @@ struct Options {
     std::vector<std::string> inject; // simulate --inject EFFECT[=SIZE] --into RUN
     std::string into;
     std::string shape_opt;           // a simulate option that shapes a simulated run
+    std::string output, compare;     // report: -o PAGE.html, --compare OLD
+    bool quiet = false;              // report: no progress on stderr
+    bool progress = false;           // report: a line per stage on stderr, always
 };
 
 void usage(FILE *f)
@@ -160,6 +167,18 @@ void usage(FILE *f)
         "  old model leaves, the terms that moved beyond 3 sigma, and whether re-zeroing the\n"
         "  index terms (c', e') suffices or a full refit is needed (cross-validated)\n"
         "\n"
+        "usage: pmfit report RUN -o PAGE.html [--order L] [--add EFFECT ...] [--compare OLD]\n"
+        "                    [--next K] [--alpha P] [--gear [ha:|dec:]G ...] [--no-refraction]\n"
+        "                    [--skip-bad] [--quiet | --progress]\n"
+        "\n"
+        "  one self-contained HTML page (inline SVG, no script, no network): the fit and its\n"
+        "  table, the residuals on the sky and against azimuth, elevation, hour angle,\n"
+        "  declination, time and temperature, the model's correction and predicted error\n"
+        "  over the sky, the explain findings with before/after plots, the next K targets\n"
+        "  (default 5) and, with --compare OLD (a saved model or a run), what changed since;\n"
+        "  progress on stderr (on a terminal, or once it has taken a second; --progress:\n"
+        "  always, a line per stage; --quiet: never) (docs/report.md)\n"
+        "\n"
         "usage: pmfit simulate OUT [--n N] [--seed S] [--lat DEG] [--mount equatorial|altaz]\n"
         "                      [--fork] [--el-limit DEG] [--noise ARCSEC] [--order L]\n"
         "                      [--term NAME=ARCSEC ...] [--random-aniso ARCSEC]\n"
@@ -206,6 +225,72 @@ bool parse_int(const char *s, int *v)
     return true;
 }
 
+// pmfit report's options (its own list: a page, not a table on stdout).
+Options parse_report(Options o, int argc, char **argv)
+{
+    auto number = [&](const std::string &opt, const char *v, double lo, double hi) {
+        char *end = nullptr;
+        double x = std::strtod(v, &end);
+        if (!*v || *end || !(x >= lo && x <= hi))
+            die(opt + ": expected a number in " + std::to_string(lo) + ".." + std::to_string(hi) +
+                ", got '" + v + "'");
+        return x;
+    };
+    for (int i = 2; i < argc; i++) {
+        std::string a = argv[i];
+        auto need = [&](const char *what) -> const char * {
+            if (i + 1 >= argc)
+                die(a + " needs " + what);
+            return argv[++i];
+        };
+        if (a == "--order") {
+            const char *v = need("an order");
+            if (!parse_int(v, &o.order) || o.order < 0 || o.order > PM_MAX_L)
+                die(std::string("--order: expected an integer 0..") + std::to_string(PM_MAX_L) +
+                    ", got '" + v + "'");
+        } else if (a == "--add") {
+            o.adds.push_back(need("an effect (see pmfit --help)"));
+        } else if (a == "-o" || a == "--output") {
+            o.output = need("a file name (the HTML page)");
+        } else if (a == "--compare") {
+            o.compare = need("OLD: a saved model or a run");
+        } else if (a == "--next") {
+            o.next = (int)number(a, need("a count"), 1, 1000);
+        } else if (a == "--alpha") {
+            o.alpha = number(a, need("a probability"), 1e-12, 0.5);
+        } else if (a == "--gear") {
+            std::string v = need("a gear period in cycles per revolution ([ha:|dec:]G)");
+            bool ha = v.rfind("dec:", 0) != 0, dec = v.rfind("ha:", 0) != 0;
+            double g = number(a, v.substr(ha && dec ? 0 : v.find(':') + 1).c_str(), 1e-6, 1e6);
+            if (ha)
+                o.gears_ha.push_back(g);
+            if (dec)
+                o.gears_dec.push_back(g);
+        } else if (a == "--no-refraction") {
+            o.refraction = false;
+        } else if (a == "--skip-bad") {
+            o.skip_bad = true;
+        } else if (a == "--quiet" || a == "-q") {
+            o.quiet = true;
+        } else if (a == "--progress") {
+            o.progress = true;
+        } else if (!a.empty() && a[0] == '-') {
+            die("report: unknown option '" + a + "'; see pmfit --help");
+        } else if (o.run.empty()) {
+            o.run = a;
+        } else {
+            die("more than one run file given ('" + o.run + "', '" + a + "')");
+        }
+    }
+    if (o.run.empty())
+        die("report: no run file given; usage: pmfit report RUN -o PAGE.html");
+    if (o.output.empty())
+        die("report: no output given; usage: pmfit report RUN -o PAGE.html");
+    if (o.quiet && o.progress)
+        die("report: --quiet and --progress contradict each other");
+    return o;
+}
+
 Options parse_args(int argc, char **argv)
 {
     Options o;
@@ -218,10 +303,12 @@ Options parse_args(int argc, char **argv)
         usage(stdout);
         std::exit(0);
     }
+    if (o.cmd == "report")
+        return parse_report(o, argc, argv);
     if (o.cmd != "fit" && o.cmd != "simulate" && o.cmd != "eval" && o.cmd != "explain" &&
         o.cmd != "compare" && o.cmd != "plan")
         die("unknown command '" + o.cmd +
-            "' (expected: fit, explain, eval, compare, plan or simulate); see pmfit --help");
+            "' (expected: fit, explain, eval, compare, plan, report or simulate); see pmfit --help");
     bool sim = o.cmd == "simulate", eval = o.cmd == "eval", expl = o.cmd == "explain";
     bool cmp = o.cmd == "compare", pln = o.cmd == "plan";
     auto number = [&](const std::string &opt, const char *v, double lo, double hi) {
@@ -1085,6 +1172,55 @@ void check_output(const std::string &opt, const std::string &path)
             " (nothing was done)", 1);
 }
 
+// pmfit report RUN -o PAGE.html: the page, written through a temporary file
+// and a rename, so a failure leaves the output path as it was.  Progress on
+// stderr: on a terminal one line updated per stage; otherwise a line per
+// stage once the page has taken a second (a short run stays quiet but for
+// the closing 'wrote'); --progress: a line per stage always; --quiet: none.
+int cmd_report(const Options &o, const Run &run, int argc, char **argv)
+{
+    ReportOptions ro;
+    ro.order = o.order;
+    ro.adds = o.adds;
+    ro.alpha = o.alpha;
+    ro.gears_ha = o.gears_ha;
+    ro.gears_dec = o.gears_dec;
+    ro.next = o.next;
+    ro.compare = o.compare;
+    ro.refraction = o.refraction;
+    ro.skip_bad = o.skip_bad;
+    ro.max_passes = MAX_PASSES;
+    ro.command = "pmfit";
+    for (int i = 1; i < argc; i++)
+        ro.command += std::string(" ") + argv[i];
+    bool tty = isatty(fileno(stderr)) != 0;
+    auto t0 = std::chrono::steady_clock::now();
+    ReportProgress progress = [&](const std::string &stage, double done) {
+        double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        if (o.quiet || (!tty && !o.progress && sec < 1))
+            return;
+        bool line = !tty || o.progress;
+        std::fprintf(stderr, line ? "pmfit report: [%3.0f%%] %s (%.1f s)\n" : "\rpmfit report: [%3.0f%%] %-20s %6.1f s",
+                     done * 100, stage.c_str(), sec);
+        if (!line && stage == "done")
+            std::fprintf(stderr, "\n");
+    };
+    std::string html;
+    try {
+        html = report_html(run, ro, progress);
+    } catch (const std::exception &x) {
+        if (tty && !o.quiet && !o.progress)
+            std::fprintf(stderr, "\n");
+        die(std::string(x.what()) + " (no page written)", 1);
+    }
+    char err[1024];
+    if (pmhost::write_atomic(o.output, html, err, sizeof err) != 0)
+        die(err, 1);
+    if (!o.quiet)
+        std::fprintf(stderr, "pmfit report: wrote %s (%zu kB)\n", o.output.c_str(), (html.size() + 512) / 1024);
+    return 0;
+}
+
 int run_main(int argc, char **argv)
 {
     Options o = parse_args(argc, argv);
@@ -1098,6 +1234,7 @@ int run_main(int argc, char **argv)
         check_output("--error-map", o.error_map.empty() ? o.error_map : o.error_map + sfx);
     }
     check_output("--residuals", o.residuals);
+    check_output("--output", o.output);
     if (o.cmd == "simulate")
         check_output("simulate", o.run);
     if (PM_CHECK_CONFIG() != PM_OK)
@@ -1119,6 +1256,8 @@ int run_main(int argc, char **argv)
         return cmd_compare(o, run);
     if (o.cmd == "explain")
         return cmd_explain(o, run);
+    if (o.cmd == "report")
+        return cmd_report(o, run, argc, argv);
 
     pm_model start = build_model(o.order, o.adds, obs, mount, run.latitude, aux_names);
     bool side_terms = false;

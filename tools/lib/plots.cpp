@@ -232,15 +232,16 @@ struct Panel {
             if (!t.label.empty()) g.text(x0 - 8, y + 4, t.label, 12, "end");
             wmax = std::max(wmax, text_w(t.label, 12));
         }
-        if (!xlabel.empty()) g.text((x0 + x1) / 2, y1 + 42, xlabel, 14);
+        if (!xlabel.empty()) g.text((x0 + x1) / 2, y1 + 42, xlabel, 14, "middle", INK, " class=\"axis-label x\"");
         if (!ylabel.empty()) {
             double x = x0 - wmax - 20;
-            g.text(x, (y0 + y1) / 2, ylabel, 14, "middle", INK, fmt(" transform=\"rotate(-90 %.1f %.1f)\"", x, (y0 + y1) / 2));
+            g.text(x, (y0 + y1) / 2, ylabel, 14, "middle", INK,
+                   fmt(" class=\"axis-label y\" transform=\"rotate(-90 %.1f %.1f)\"", x, (y0 + y1) / 2));
         }
     }
 };
 
-// A legend entry: kind 'o' dot, '-' line, '=' dashed line, 'b' bar, '>' arrow of `len` px.
+// A legend entry: kind 'o' dot, 'r' ring, '-' line, '=' dashed line, 'b' bar, '>' arrow of `len` px.
 struct Item { char kind; const char *col; std::string label; double len; };
 
 // Legend entries in centred rows within [l, r] starting at y; returns the height used.
@@ -259,6 +260,8 @@ double legend(Svg &g, const std::vector<Item> &items, double l, double r, double
             const Item &it = items[i];
             double sw = it.kind == '>' ? it.len : 22;
             if (it.kind == 'o') g.s += fmt("<circle cx=\"%.1f\" cy=\"%.1f\" r=\"4.5\" fill=\"%s\"/>\n", x + 11, cy, it.col);
+            if (it.kind == 'r')
+                g.s += fmt("<circle cx=\"%.1f\" cy=\"%.1f\" r=\"6\" fill=\"none\" stroke=\"%s\" stroke-width=\"2\"/>\n", x + 11, cy, it.col);
             if (it.kind == '-' || it.kind == '=')
                 g.line(x, cy, x + 22, cy, it.col, 2.5, it.kind == '=' ? " stroke-dasharray=\"6 4\"" : "");
             if (it.kind == 'b') g.rect(x + 4, cy - 6, 14, 12, it.col);
@@ -281,12 +284,16 @@ int fail(std::string *err, const std::string &msg)
     return -1;
 }
 
-int finish(const std::string &path, Svg &g, std::string *err)
+int finish(const Out &to, Svg &g, std::string *err)
 {
-    if (path.empty()) return fail(err, "plot: empty output path");
     g.s += "</svg>\n";
+    if (to.text) {
+        *to.text = g.s;
+        return 0;
+    }
+    if (to.path.empty()) return fail(err, "plot: empty output path");
     char buf[1024];
-    if (pmhost::write_atomic(path, g.s, buf, sizeof buf) != 0) return fail(err, buf);
+    if (pmhost::write_atomic(to.path, g.s, buf, sizeof buf) != 0) return fail(err, buf);
     return 0;
 }
 
@@ -339,7 +346,7 @@ void vector_panel(Svg &g, Panel &p, const std::vector<Vec> &v, double scale, con
 }
 
 // Shared by sky_vectors and sky_vectors_pair: panels side by side on common axes.
-int vectors(const std::string &path, const std::string &title, const std::string &xlabel,
+int vectors(const Out &path, const std::string &title, const std::string &xlabel,
             const std::string &ylabel, const std::vector<const std::vector<Vec> *> &sets,
             const std::vector<std::string> &ptitles, double scale,
             const std::vector<std::string> &names, std::string *err)
@@ -378,14 +385,14 @@ int vectors(const std::string &path, const std::string &title, const std::string
 
 } // namespace
 
-int sky_vectors(const std::string &path, const std::string &title, const std::string &xlabel,
+int sky_vectors(const Out &path, const std::string &title, const std::string &xlabel,
                 const std::string &ylabel, const std::vector<Vec> &v, double scale_arcsec,
                 const std::vector<std::string> &group_names, std::string *err)
 {
     return vectors(path, title, xlabel, ylabel, {&v}, {""}, scale_arcsec, group_names, err);
 }
 
-int sky_vectors_pair(const std::string &path, const std::string &title, const std::string &xlabel,
+int sky_vectors_pair(const Out &path, const std::string &title, const std::string &xlabel,
                      const std::string &ylabel, const std::vector<Vec> &before,
                      const std::vector<Vec> &after, const std::string &before_title,
                      const std::string &after_title, double scale_arcsec,
@@ -412,10 +419,10 @@ std::string ramp(double f)
 
 } // namespace
 
-int sky_scalar(const std::string &path, const std::string &title, const std::string &xlabel,
+int sky_scalar(const Out &path, const std::string &title, const std::string &xlabel,
                const std::string &ylabel, const std::vector<Cell> &cells, const std::string &unit,
                const std::vector<std::pair<double, double>> &marks, const std::string &marks_name,
-               std::string *err)
+               std::string *err, const std::vector<std::string> &mark_labels)
 {
     double mnx = INFINITY, mxx = -INFINITY, mny = INFINITY, mxy = -INFINITY, vmax = 0;
     size_t n = 0;
@@ -430,7 +437,7 @@ int sky_scalar(const std::string &path, const std::string &title, const std::str
     Svg g(W, H, title);
     std::vector<Item> items;
     if (!marks.empty())
-        items.push_back({'o', INK, marks_name + fmt(" (%zu)", marks.size()), 0});
+        items.push_back({mark_labels.empty() ? 'o' : 'r', INK, marks_name + fmt(" (%zu)", marks.size()), 0});
     double top = 50 + legend(g, items, 40, W - 140, 46) + 20;
     Panel p(g, 90, top, W - 150, H - 62);
     p.ax.angular = p.ay.angular = true;
@@ -449,10 +456,23 @@ int sky_scalar(const std::string &path, const std::string &title, const std::str
         g.rect(std::min(x0, x1), std::min(y0, y1), std::fabs(x1 - x0) + 0.6, std::fabs(y1 - y0) + 0.6,
                ramp(c.v / vtop).c_str());
     }
-    for (const auto &m : marks)
-        if (fin(m.first) && fin(m.second))
+    for (size_t k = 0; k < marks.size(); k++) {
+        const auto &m = marks[k];
+        if (!fin(m.first) || !fin(m.second))
+            continue;
+        double x = p.ax.map(m.first), y = p.ay.map(m.second);
+        if (mark_labels.empty()) {
             g.s += fmt("<circle cx=\"%.1f\" cy=\"%.1f\" r=\"2.6\" fill=\"none\" stroke=\"%s\" "
-                       "stroke-width=\"1.2\"/>\n", p.ax.map(m.first), p.ay.map(m.second), INK);
+                       "stroke-width=\"1.2\"/>\n", x, y, INK);
+            continue;
+        }
+        // labelled marks: a bold ring on a white one, and its label beside it
+        g.s += fmt("<circle cx=\"%.1f\" cy=\"%.1f\" r=\"7\" fill=\"none\" stroke=\"#ffffff\" stroke-width=\"4.5\"/>\n"
+                   "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"7\" fill=\"none\" stroke=\"#111111\" stroke-width=\"2\"/>\n",
+                   x, y, x, y);
+        if (k < mark_labels.size())
+            g.text(x + 10, y - 6, mark_labels[k], 14, "start", "#111111", std::string(" font-weight=\"bold\"") + HALO);
+    }
     p.over(g, xlabel, ylabel, n == 0);
     // the colour bar, 0 .. vmax
     double bx = W - 120, by0 = top, by1 = H - 62, steps = 40;
@@ -472,33 +492,15 @@ int sky_scalar(const std::string &path, const std::string &title, const std::str
         g.line(bx + 18, y, bx + 23, y, FRAME, 1);
         if (!t.label.empty()) g.text(bx + 26, y + 4, t.label, 12, "start");
     }
-    g.text(bx + 9, by0 - 8, unit, 13);
+    g.text(bx + 9, by0 - 8, unit, 13, "middle", INK, " class=\"axis-label bar\"");
     return finish(path, g, err);
 }
 
-int xy(const std::string &path, const std::string &title, const std::string &xlabel,
-       const std::string &ylabel, const std::vector<Series> &s, std::string *err)
+namespace {
+
+// The series of one xy panel, drawn into the open data group of p.
+void xy_series(Svg &g, const Panel &p, const std::vector<Series> &s)
 {
-    double mnx = INFINITY, mxx = -INFINITY, mny = INFINITY, mxy = -INFINITY;
-    std::vector<Item> items;
-    for (size_t k = 0; k < s.size(); k++) {
-        if (s[k].x.size() != s[k].y.size())
-            return fail(err, fmt("%s: series %zu (\"%s\"): %zu x values but %zu y values", path.c_str(), k,
-                                 s[k].name.c_str(), s[k].x.size(), s[k].y.size()));
-        for (size_t i = 0; i < s[k].x.size(); i++)
-            if (fin(s[k].x[i]) && fin(s[k].y[i])) {
-                mnx = std::min(mnx, s[k].x[i]), mxx = std::max(mxx, s[k].x[i]);
-                mny = std::min(mny, s[k].y[i]), mxy = std::max(mxy, s[k].y[i]);
-            }
-        if (!s[k].name.empty()) items.push_back({s[k].line ? '-' : 'o', colour((int)k), s[k].name, 0});
-    }
-    const int W = 800, H = 520;
-    Svg g(W, H, title);
-    double top = 50 + legend(g, items, 40, W - 40, 46) + 12;
-    Panel p(g, 92, top, W - 28, H - 62);
-    set_range(p.ax, mnx, mxx, 0.04);
-    set_range(p.ay, mny, mxy, 0.06);
-    p.under(g);
     for (size_t k = 0; k < s.size(); k++) {
         const Series &q = s[k];
         std::string d;
@@ -516,23 +518,74 @@ int xy(const std::string &path, const std::string &title, const std::string &xla
         else
             g.s += fmt("<g fill=\"%s\" fill-opacity=\"0.75\">\n", colour((int)k)) + d + "</g>\n";
     }
-    p.over(g, xlabel, ylabel, !(mnx <= mxx));
+}
+
+// Shared by xy and xy_pair: panels side by side on common axes, one legend (from the
+// first set's names).
+int xy_panels(const Out &path, const std::string &title, const std::string &xlabel,
+              const std::string &ylabel, const std::vector<const std::vector<Series> *> &sets,
+              const std::vector<std::string> &ptitles, std::string *err)
+{
+    double mnx = INFINITY, mxx = -INFINITY, mny = INFINITY, mxy = -INFINITY;
+    std::vector<Item> items;
+    for (const auto *set : sets)
+        for (size_t k = 0; k < set->size(); k++) {
+            const Series &q = (*set)[k];
+            if (q.x.size() != q.y.size())
+                return fail(err, fmt("%s: series %zu (\"%s\"): %zu x values but %zu y values", path.path.c_str(), k,
+                                     q.name.c_str(), q.x.size(), q.y.size()));
+            for (size_t i = 0; i < q.x.size(); i++)
+                if (fin(q.x[i]) && fin(q.y[i])) {
+                    mnx = std::min(mnx, q.x[i]), mxx = std::max(mxx, q.x[i]);
+                    mny = std::min(mny, q.y[i]), mxy = std::max(mxy, q.y[i]);
+                }
+            if (set == sets[0] && !q.name.empty()) items.push_back({q.line ? '-' : 'o', colour((int)k), q.name, 0});
+        }
+    int np = (int)sets.size(), W = np == 1 ? 800 : 1320, H = 520;
+    Svg g(W, H, title);
+    double top = 50 + legend(g, items, 40, W - 40, 46) + (ptitles[0].empty() ? 12 : 34);
+    for (int i = 0; i < np; i++) {
+        double l = np == 1 ? 92 : i * (W - 30) / np + 92.0, r = np == 1 ? W - 28 : (i + 1) * (W - 30) / np - 10.0;
+        Panel p(g, l, top, r, H - 62);
+        set_range(p.ax, mnx, mxx, 0.04);
+        set_range(p.ay, mny, mxy, 0.06);
+        if (!ptitles[i].empty()) g.text(p.x0, p.y0 - 9, ptitles[i], 15, "start", "#111111", " font-weight=\"bold\"");
+        p.under(g);
+        xy_series(g, p, *sets[i]);
+        p.over(g, xlabel, i == 0 ? ylabel : "", !(mnx <= mxx));
+    }
     return finish(path, g, err);
 }
 
-int periodogram(const std::string &path, const std::string &title, const std::vector<double> &freq,
+} // namespace
+
+int xy(const Out &path, const std::string &title, const std::string &xlabel,
+       const std::string &ylabel, const std::vector<Series> &s, std::string *err)
+{
+    return xy_panels(path, title, xlabel, ylabel, {&s}, {""}, err);
+}
+
+int xy_pair(const Out &path, const std::string &title, const std::string &xlabel,
+            const std::string &ylabel, const std::vector<Series> &before,
+            const std::vector<Series> &after, const std::string &before_title,
+            const std::string &after_title, std::string *err)
+{
+    return xy_panels(path, title, xlabel, ylabel, {&before, &after}, {before_title, after_title}, err);
+}
+
+int periodogram(const Out &path, const std::string &title, const std::vector<double> &freq,
                 const std::vector<double> &power, double threshold,
                 const std::string &threshold_label, double peak_freq, bool log_x, std::string *err)
 {
     return periodogram(path, title, "power", freq, power, threshold, threshold_label, peak_freq, log_x, err);
 }
 
-int periodogram(const std::string &path, const std::string &title, const std::string &ylabel,
+int periodogram(const Out &path, const std::string &title, const std::string &ylabel,
                 const std::vector<double> &freq, const std::vector<double> &power, double threshold,
                 const std::string &threshold_label, double peak_freq, bool log_x, std::string *err)
 {
     if (freq.size() != power.size())
-        return fail(err, fmt("%s: %zu frequencies but %zu power values", path.c_str(), freq.size(), power.size()));
+        return fail(err, fmt("%s: %zu frequencies but %zu power values", path.path.c_str(), freq.size(), power.size()));
     auto ok = [&](size_t i) { return fin(freq[i]) && fin(power[i]) && (!log_x || freq[i] > 0); };
     double mnx = INFINITY, mxx = -INFINITY, mny = 0, mxy = -INFINITY;
     size_t ipk = freq.size();
@@ -578,12 +631,12 @@ int periodogram(const std::string &path, const std::string &title, const std::st
     return finish(path, g, err);
 }
 
-int steps(const std::string &path, const std::string &title, const std::vector<std::string> &labels,
+int steps(const Out &path, const std::string &title, const std::vector<std::string> &labels,
           const std::vector<double> &sigma, const std::vector<double> &cv_rms, std::string *err)
 {
     size_t n = labels.size();
     if ((!sigma.empty() && sigma.size() != n) || (!cv_rms.empty() && cv_rms.size() != n))
-        return fail(err, fmt("%s: %zu steps but %zu sigma and %zu CV RMS values", path.c_str(), n, sigma.size(),
+        return fail(err, fmt("%s: %zu steps but %zu sigma and %zu CV RMS values", path.path.c_str(), n, sigma.size(),
                              cv_rms.size()));
     std::vector<const std::vector<double> *> ser;
     std::vector<Item> items;
