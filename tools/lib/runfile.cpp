@@ -498,7 +498,10 @@ private:
             format = PMRUN_FORMAT_RTS2;
             why = format_str("its '#' line %d is an RTS2 gpoint header", first_hash_);
         } else if (!held_.empty() || !t) {
-            if (t && csv_header(*t)) {
+            if (t && t->compare(0, 4, "CAT:") == 0) {
+                format = PMRUN_FORMAT_MMT;
+                why = format_str("line %d starts with 'CAT:'", n);
+            } else if (t && csv_header(*t)) {
                 format = PMRUN_FORMAT_CSV;
                 why = format_str("line %d is a header of delimited names with RA and Dec", n);
             } else {

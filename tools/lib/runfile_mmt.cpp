@@ -3,7 +3,8 @@
 // per star, starting with CAT:.  RAA: is the raw (encoder) elevation and
 // azimuth, TAA: the observed (target) elevation and azimuth, both degrees,
 // azimuth from north through east; LST: the sidereal time.  An alt-az
-// mount.  docs/formats.md, section 7.
+// mount.  Blank lines and '#' comment lines (not in the MMT's own files)
+// are skipped.  docs/formats.md, section 7.
 #include "runfile_internal.hpp"
 
 #include <cmath>
@@ -33,7 +34,7 @@ public:
     bool line(int n, const std::string &text) override
     {
         std::string t = trim(text);
-        if (t.empty()) return true;
+        if (t.empty() || t[0] == '#') return true;   // '#' comments: ours, not the MMT's
         size_t colon = t.find(':');
         std::string key = colon == std::string::npos ? std::string() : t.substr(0, colon);
         bool key_ok = !key.empty();
