@@ -271,7 +271,7 @@ std::unique_ptr<FormatParser> make_parser(Context &ctx, int format)
 const char *format_description(int format)
 {
     switch (format) {
-    case PMRUN_FORMAT_FOUR_COLUMN: return "a four-column file";
+    case PMRUN_FORMAT_FOUR_COLUMN: return "a four-column or named-column file";
     case PMRUN_FORMAT_NAMED: return "a named-column file";
     case PMRUN_FORMAT_TPOINT: return "a TPOINT data file";
     case PMRUN_FORMAT_RTS2: return "an RTS2 gpoint input file";
@@ -417,8 +417,8 @@ bool csv_header(const std::string &line)
     if (line.find(',') == std::string::npos && line.find(';') == std::string::npos) return false;
     int ra = 0, dec = 0;
     for (const std::string &n : csv_header_names(line)) {
-        ra += n.find("ra") != std::string::npos && n.size() <= 16 ? 1 : 0;
-        dec += n.find("dec") != std::string::npos && n.size() <= 16 ? 1 : 0;
+        ra += n.find("ra") != std::string::npos ? 1 : 0;
+        dec += n.find("dec") != std::string::npos ? 1 : 0;
     }
     return ra >= 2 && dec >= 2;   // the mount's and the solved position
 }
@@ -506,6 +506,10 @@ private:
                 why = format_str("line %d is a header of delimited names with RA and Dec", n);
             } else {
                 format = PMRUN_FORMAT_FOUR_COLUMN;   // four-column or named
+                if (t && (t->find(',') != std::string::npos || t->find(';') != std::string::npos))
+                    why = format_str("line %d has ',' or ';' but is not a CSV header naming the "
+                                     "mount's and the solved RA and Dec",
+                                     n);
             }
         } else if ((*t)[0] == '!' || (*t)[0] == ':') {
             format = PMRUN_FORMAT_TPOINT;
@@ -532,6 +536,11 @@ private:
                 format = PMRUN_FORMAT_FOUR_COLUMN;
             } else {
                 format = PMRUN_FORMAT_TPOINT;
+                if (t->find(',') != std::string::npos || t->find(';') != std::string::npos)
+                    why = format_str("line %d is taken as its caption: it has ',' or ';' but is "
+                                     "not a CSV header naming the mount's and the solved RA and "
+                                     "Dec",
+                                     n);
             }
         }
         parser_ = make_parser(ctx_, format);
