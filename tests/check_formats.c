@@ -591,6 +591,9 @@ START_TEST(test_pmtp_terms_first_order_agree_with_pm)
 {
     double big = worst_first_order(20.0, 11, -1), small = worst_first_order(2.0, 11, -1);
     int k;
+    fprintf(stderr, "check_formats: TPOINT first-order formulas vs pm_model_apply: worst %.4f\" "
+                    "with 10-20\" terms, %.6f\" with 1-2\" terms\n",
+            big, small);
     ck_assert_msg(big < TOL_FIRST_ORDER_AS, "TPOINT formulas vs pm: %.4g arcsec at 20\" terms", big);
     /* the difference is second order: 10x smaller terms, ~100x smaller */
     ck_assert_msg(big / small > 50, "not second order: %.4g\" at 20\", %.4g\" at 2\"", big, small);
