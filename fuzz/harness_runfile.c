@@ -1,7 +1,8 @@
 /*
 **  harness_runfile.c - fuzz target body: the bytes as a pointing-run file
-**  read by pmrun_read (all three formats: four-column, named columns,
-**  TPOINT), then every accessor walked.
+**  read by pmrun_read (all seven formats: four-column, named columns,
+**  TPOINT, RTS2 gpoint, MountWizzard4 JSON, CSV logs, the MMT log), then
+**  every accessor walked.
 **
 **  Input: byte 0 picks the options, the rest is the file.
 **     bit 0     skip_bad
@@ -11,7 +12,10 @@
 **     bits 6-7  1: every 0x01 byte of the file becomes 70000 '9's (lines
 **               longer than PMRUN_MAX_LINE); 2: a file of at most 64 bytes
 **               is repeated 1001 times (more than PMRUN_MAX_MESSAGES
-**               warnings); 0, 3: the file as it is
+**               warnings); 0: the file as it is; 3: byte 1 forces a
+**               format and an equinox (format = (byte & 7) - 1, -1 the
+**               detection; equinox = (byte >> 3) % 3) and the file starts
+**               at byte 2
 */
 #ifndef _GNU_SOURCE
 #define _GNU_SOURCE
@@ -62,7 +66,7 @@ static char *rf_expand(unsigned flags, const unsigned char *p, size_t n, size_t 
     return buf;
 }
 
-static int rf_walk(const pmrun *run, const char *path, int skip_bad)
+static int rf_walk(const pmrun *run, const char *path, int skip_bad, int forced)
 {
     size_t i, n = pmrun_count(run);
     int fmt = pmrun_format(run), mount = pmrun_mount(run);
@@ -73,8 +77,14 @@ static int rf_walk(const pmrun *run, const char *path, int skip_bad)
     double lat;
 
     snprintf(pre, sizeof pre, "%s:", path);
-    if (fmt < PMRUN_FORMAT_FOUR_COLUMN || fmt > PMRUN_FORMAT_TPOINT)
+    if (fmt < PMRUN_FORMAT_FOUR_COLUMN || fmt > PMRUN_FORMAT_MMT)
         return pmfz_fail("runfile: format %d", fmt);
+    if (forced != PMRUN_FORMAT_AUTO && fmt != forced &&
+        !(forced <= PMRUN_FORMAT_NAMED && fmt <= PMRUN_FORMAT_NAMED))
+        return pmfz_fail("runfile: forced format %d read as %d", forced, fmt);
+    if ((fmt == PMRUN_FORMAT_MMT && mount != PMRUN_MOUNT_ALTAZ) ||
+        ((fmt == PMRUN_FORMAT_MW4 || fmt == PMRUN_FORMAT_CSV) && mount != PMRUN_MOUNT_EQUATORIAL))
+        return pmfz_fail("runfile: format %d with mount %d", fmt, mount);
     if (mount != PMRUN_MOUNT_EQUATORIAL && mount != PMRUN_MOUNT_ALTAZ)
         return pmfz_fail("runfile: mount %d", mount);
     if (n < 1)
@@ -146,12 +156,21 @@ static int rf_walk(const pmrun *run, const char *path, int skip_bad)
                              o->app_ha);
         if (o->pier < -1 || o->pier > 1 || o->dir < -1 || o->dir > 1)
             return pmfz_fail("runfile: record %zu pier %d dir %d", i, o->pier, o->dir);
-        if (fmt != PMRUN_FORMAT_NAMED) {
+        if (fmt != PMRUN_FORMAT_NAMED && fmt != PMRUN_FORMAT_MW4 && fmt != PMRUN_FORMAT_CSV) {
             int want = mount == PMRUN_MOUNT_ALTAZ ? 0 : (fabs(o->enc_dec) > M_PI / 2 ? -1 : 1);
             if (o->pier != want || o->dir != 0)
                 return pmfz_fail("runfile: record %zu pier %d (expected %d), dir %d", i, o->pier,
                                  want, o->dir);
         }
+        /* MW4, CSV: the side of pier from the file, the encoder beyond the
+        ** pole exactly for the west side (the sky place unfolded) */
+        if ((fmt == PMRUN_FORMAT_MW4 || fmt == PMRUN_FORMAT_CSV) &&
+            (o->dir != 0 || (o->pier != 1 && o->pier != -1) ||
+             (o->pier == -1) != (fabs(o->enc_dec) > M_PI / 2 - RF_EPS) ||
+             (o->pier == 1 && fabs(o->enc_dec) > M_PI / 2 + RF_EPS)))
+            return pmfz_fail("runfile: %s record %zu pier %d with encoder dec %.17g, dir %d",
+                             fmt == PMRUN_FORMAT_MW4 ? "MW4" : "CSV", i, o->pier, o->enc_dec,
+                             o->dir);
         if (fmt == PMRUN_FORMAT_FOUR_COLUMN && (!isnan(o->temp_c) || !isnan(o->time_h)))
             return pmfz_fail("runfile: four-column record %zu has temp/time", i);
         if ((!isnan(o->temp_c) && !pmfz_finite(o->temp_c)) ||
@@ -184,6 +203,9 @@ int pmfz_runfile(const unsigned char *data, size_t size)
     const pmrun_options *optp = &opt;
     pmrun *run = (pmrun *)&opt; /* must be overwritten */
     int fd, st, bad = 0, set = (int)((flags >> 2) & 3u);
+    int forced = PMRUN_FORMAT_AUTO, equinox = PMRUN_EQUINOX_FILE;
+    const unsigned char *body = size ? data + 1 : data;
+    size_t body_len = size ? size - 1 : 0;
 
     if (pmrun_count(NULL) != 0 || pmrun_get(NULL, 0) || pmrun_format(NULL) != -1 ||
         pmrun_mount(NULL) != -1 || !isnan(pmrun_latitude_rad(NULL)) || pmrun_n_aux(NULL) != 0 ||
@@ -191,7 +213,13 @@ int pmfz_runfile(const unsigned char *data, size_t size)
         pmrun_skipped(NULL, 0) || pmrun_aux_name(NULL, 0))
         return pmfz_fail("runfile: an accessor mishandles NULL");
 
-    text = rf_expand(flags, size ? data + 1 : data, size ? size - 1 : 0, &len);
+    if ((flags >> 6) == 3u && body_len > 0) {
+        forced = (int)(body[0] & 7u) - 1;
+        equinox = (int)((body[0] >> 3) % 3u);
+        body++;
+        body_len--;
+    }
+    text = rf_expand(flags, body, body_len, &len);
     if (!text)
         return 0;
     fd = pmfz_memfile(text, len, path, sizeof path);
@@ -210,6 +238,8 @@ int pmfz_runfile(const unsigned char *data, size_t size)
     } else if (flags == 0) {
         optp = NULL; /* the defaults */
     }
+    opt.format = forced;
+    opt.equinox = equinox;
     switch ((flags >> 4) & 3u) {
     case 1: errp = NULL; errlen = 0; break;
     case 2: errlen = 1; break;
@@ -232,7 +262,7 @@ int pmfz_runfile(const unsigned char *data, size_t size)
     } else if (!run) {
         bad = pmfz_fail("runfile: PMRUN_OK and *out NULL");
     } else {
-        bad = rf_walk(run, path, opt.skip_bad);
+        bad = rf_walk(run, path, opt.skip_bad, forced);
         pmrun_free(run);
     }
     close(fd);

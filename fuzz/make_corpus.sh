@@ -15,9 +15,20 @@ mkdir -p $C/runfile $C/modelfile $C/capi $C/fit
 opt() { # opt BYTE SRC NAME
     { printf "\\$(printf '%03o' "$1")"; cat "$2"; } > $C/runfile/$3
 }
-for f in tests/data/*.dat; do
-    opt 0 "$f" "$(basename "$f" .dat)"
+for f in tests/data/*.dat tests/data/*.json tests/data/*.csv; do
+    b=$(basename "$f"); opt 0 "$f" "${b%.*}"
 done
+# the new readers forced (option byte 0xc0: byte 1 = format + 1, equinox << 3)
+force() { # force OPTBYTE2 SRC NAME
+    { printf '\300'; printf "\\$(printf '%03o' "$1")"; cat "$2"; } > $C/runfile/$3
+}
+force 4 tests/data/rts2_gpoint.dat forced_rts2                  # rts2
+force 12 tests/data/rts2_gpoint_j2000.dat forced_rts2_j2000     # rts2, J2000
+force 5 tests/data/mw4_model.json forced_mw4                    # mw4
+force 6 tests/data/nina_jnow.csv forced_csv                     # csv
+force 22 tests/data/nina_jnow.csv forced_csv_jnow               # csv, JNow
+force 7 tests/data/mmt_log.dat forced_mmt                       # mmt
+force 7 tests/data/nina_j2000.csv forced_mmt_on_csv             # a wrong format
 head -n 12 examples/sim_gem.dat > $B/sim_gem_head.dat
 opt 0 $B/sim_gem_head.dat sim_gem_head
 opt 1 tests/data/bad_records_skip.dat skip_bad_records          # skip_bad

@@ -149,6 +149,12 @@ START_TEST(test_fuzz_runfile_seeds_reach_every_parser)
     ck_assert_int_eq(seed_format("named_altaz"), PMRUN_FORMAT_NAMED);
     ck_assert_int_eq(seed_format("tpoint_equat"), PMRUN_FORMAT_TPOINT);
     ck_assert_int_eq(seed_format("tpoint_altaz"), PMRUN_FORMAT_TPOINT);
+    ck_assert_int_eq(seed_format("rts2_gpoint"), PMRUN_FORMAT_RTS2);
+    ck_assert_int_eq(seed_format("rts2_altaz"), PMRUN_FORMAT_RTS2);
+    ck_assert_int_eq(seed_format("mw4_model"), PMRUN_FORMAT_MW4);
+    ck_assert_int_eq(seed_format("nina_j2000"), PMRUN_FORMAT_CSV);
+    ck_assert_int_eq(seed_format("nina_jnow"), PMRUN_FORMAT_CSV);
+    ck_assert_int_eq(seed_format("mmt_log"), PMRUN_FORMAT_MMT);
     ck_assert_int_eq(seed_format("bad_nan"), -1);
 }
 END_TEST

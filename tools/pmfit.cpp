@@ -2,7 +2,8 @@
 //
 //   pmfit fit RUN [--order L] [--pier joint|split] [--json] [--residuals FILE]
 //                 [--save MODEL] [--emit-c HEADER] [--no-refraction] [--skip-bad]
-//                 [--robust [--clip K]]
+//                 [--robust [--clip K]] [--tpoint-terms FILE] [--format NAME]
+//                 [--equinox J2000|JNow]
 //   pmfit explain RUN [--order L] [--add EFFECT ...] [--json] [--plots DIR] [--alpha P]
 //                 [--robust [--clip K]]
 //   pmfit eval MODEL RUN [--json] [--residuals FILE] [--no-refraction] [--skip-bad]
@@ -28,7 +29,9 @@
 #include "plots.hpp"
 #include "robust.hpp"
 #include "report.hpp"
+#include "tpointterms.h"
 
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -86,6 +89,9 @@ struct Options {
     std::string output, compare;     // report: -o PAGE.html, --compare OLD
     bool quiet = false;              // report: no progress on stderr
     bool progress = false;           // report: a line per stage on stderr, always
+    int format = PMRUN_FORMAT_AUTO;  // --format NAME (docs/formats.md)
+    int equinox = PMRUN_EQUINOX_FILE; // --equinox J2000|JNow
+    std::string tpoint_terms;        // fit --tpoint-terms FILE
 };
 
 void usage(FILE *f)
@@ -93,10 +99,11 @@ void usage(FILE *f)
     std::fprintf(f,
         "usage: pmfit fit RUN [--order L] [--pier joint|split] [--add EFFECT ...] [--json]\n"
         "                     [--residuals FILE] [--save MODEL] [--emit-c HEADER]\n"
-        "                     [--no-refraction] [--skip-bad] [--robust [--clip K]]\n"
+        "                     [--tpoint-terms FILE] [--no-refraction] [--skip-bad]\n"
+        "                     [--robust [--clip K]] [--format NAME] [--equinox J2000|JNow]\n"
         "\n"
-        "  RUN              pointing run: four-column, named-column or TPOINT file\n"
-        "                   (docs/formats.md)\n"
+        "  RUN              pointing run: four-column, named-column, TPOINT, RTS2 gpoint,\n"
+        "                   MountWizzard4 JSON, CSV log or MMT log (docs/formats.md)\n"
         "  --order L        spherical-harmonic order, 0..%d (default 1, the paper's L=1)\n"
         "  --pier split     fit each pier side separately (default: joint)\n"
         "  --json           one JSON object on standard output\n"
@@ -121,8 +128,15 @@ void usage(FILE *f)
         "  --error-map F    write the predicted pointing error of the model over the sky\n"
         "                   (1 sigma, from the fit's covariance) as an SVG map; with\n"
         "                   --pier split: F-east and F-west (docs/model.md)\n"
-        "  --no-refraction  leave refraction out of the TPOINT reduction\n"
+"  --tpoint-terms F write the fitted model as a TPOINT-style term list (IH ID NP CH\n"
+        "                   MA ME, TF TX when added; the other terms listed apart) to F;\n"
+        "                   with --pier split: F-east and F-west (docs/formats.md)\n"
+        "  --no-refraction  leave refraction out of the reductions (TPOINT, CSV, RTS2)\n"
         "  --skip-bad       skip malformed records (each is reported) instead of failing\n"
+        "  --format NAME    read RUN as this format, not the detected one: four-column,\n"
+        "                   named, tpoint, rts2, mw4, csv, mmt (every command reading a run)\n"
+        "  --equinox E      J2000 or JNow: the equinox of a CSV log's or an RTS2 file's\n"
+        "                   RA/Dec places, over what the file says (docs/formats.md)\n"
         "  --robust         ignore gross outliers (failed plate solves): clip points whose\n"
         "                   residual on the sky exceeds K robust sigmas, refit, repeat until\n"
         "                   stable; the report lists them by line (docs/robust.md)\n"
@@ -169,7 +183,8 @@ void usage(FILE *f)
         "\n"
         "usage: pmfit report RUN -o PAGE.html [--order L] [--add EFFECT ...] [--compare OLD]\n"
         "                    [--next K] [--alpha P] [--gear [ha:|dec:]G ...] [--no-refraction]\n"
-        "                    [--skip-bad] [--quiet | --progress]\n"
+        "                    [--skip-bad] [--format NAME] [--equinox J2000|JNow]\n"
+        "                    [--quiet | --progress]\n"
         "\n"
         "  one self-contained HTML page (inline SVG, no script, no network): the fit and its\n"
         "  table, the residuals on the sky and against azimuth, elevation, hour angle,\n"
@@ -226,6 +241,28 @@ bool parse_int(const char *s, int *v)
 }
 
 // pmfit report's options (its own list: a page, not a table on stdout).
+// --format NAME and --equinox E (every command that reads a run).
+void set_format(Options &o, const std::string &v)
+{
+    o.format = pmrun_format_from_name(v.c_str());
+    if (o.format == -2)
+        die("--format: expected auto, four-column, named, tpoint, rts2, mw4, csv or mmt, "
+            "got '" + v + "'");
+}
+
+void set_equinox(Options &o, const std::string &v)
+{
+    std::string l = v;
+    for (char &c : l)
+        c = (char)std::tolower((unsigned char)c);
+    if (l == "j2000")
+        o.equinox = PMRUN_EQUINOX_J2000;
+    else if (l == "jnow")
+        o.equinox = PMRUN_EQUINOX_JNOW;
+    else
+        die("--equinox: expected J2000 or JNow, got '" + v + "'");
+}
+
 Options parse_report(Options o, int argc, char **argv)
 {
     auto number = [&](const std::string &opt, const char *v, double lo, double hi) {
@@ -270,6 +307,10 @@ Options parse_report(Options o, int argc, char **argv)
             o.refraction = false;
         } else if (a == "--skip-bad") {
             o.skip_bad = true;
+        } else if (a == "--format") {
+            set_format(o, need("a format name"));
+        } else if (a == "--equinox") {
+            set_equinox(o, need("J2000 or JNow"));
         } else if (a == "--quiet" || a == "-q") {
             o.quiet = true;
         } else if (a == "--progress") {
@@ -416,6 +457,12 @@ Options parse_args(int argc, char **argv)
             if (eq == std::string::npos || eq == 0)
                 die("--term: expected NAME=ARCSEC, got '" + v + "'");
             o.terms.push_back({v.substr(0, eq), number(a, v.c_str() + eq + 1, -1e6, 1e6)});
+        } else if (a == "--format") {
+            set_format(o, need("a format name"));
+        } else if (a == "--equinox") {
+            set_equinox(o, need("J2000 or JNow"));
+        } else if (!sim && !eval && !expl && a == "--tpoint-terms") {
+            o.tpoint_terms = need("a file name");
         } else if (a == "--no-refraction") {
             o.refraction = false;
         } else if (a == "--skip-bad") {
@@ -443,8 +490,12 @@ Options parse_args(int argc, char **argv)
             "an effect use --effect");
     if (sim && !o.into.empty() && o.inject.empty())
         die("--into RUN needs at least one --inject EFFECT[=SIZE]");
-    if (sim && o.into.empty() && (!o.refraction || o.skip_bad))
-        die("--no-refraction and --skip-bad apply to reading a run: with --into only");
+    if (sim && o.into.empty() && (!o.refraction || o.skip_bad || o.format != PMRUN_FORMAT_AUTO ||
+                                  o.equinox != PMRUN_EQUINOX_FILE))
+        die("--no-refraction, --skip-bad, --format and --equinox apply to reading a run: with "
+            "--into only");
+    if ((cmp || pln) && !o.tpoint_terms.empty())
+        die("--tpoint-terms writes the model of pmfit fit; see pmfit --help");
     if (o.clip_given && !o.robust)
         die("--clip K sets the threshold of --robust; add --robust");
     if (eval && o.model.empty())
@@ -732,7 +783,7 @@ int cmd_plan(const Options &o)
     Run run;
     PlanOptions po;
     if (!o.run.empty()) {
-        run = load_run(o.run, o.refraction, o.skip_bad);
+        run = load_run(o.run, o.refraction, o.skip_bad, o.format, o.equinox);
         po.mount = run.mount;
         po.latitude = run.latitude;
     }
@@ -831,7 +882,7 @@ int cmd_compare(const Options &o, const Run &run)
         if (pmmodel_load(o.model.c_str(), &old_model, err, sizeof err) != 0)
             die(err, 1);
     } else {
-        Run old_run = load_run(o.model, o.refraction, o.skip_bad);
+        Run old_run = load_run(o.model, o.refraction, o.skip_bad, o.format, o.equinox);
         std::vector<int> all(old_run.obs.size());
         for (size_t i = 0; i < all.size(); i++)
             all[i] = (int)i;
@@ -1056,7 +1107,7 @@ int cmd_inject(const Options &o, int argc, char **argv)
         in.seed = o.seed;
         list.push_back(in);
     }
-    Run run = load_run(o.into, o.refraction, o.skip_bad);
+    Run run = load_run(o.into, o.refraction, o.skip_bad, o.format, o.equinox);
     for (const std::string &n : run.notes)
         std::fprintf(stderr, "pmfit: note: %s\n", n.c_str());
     InjectReport rep = inject(run, list);
@@ -1189,6 +1240,8 @@ int cmd_report(const Options &o, const Run &run, int argc, char **argv)
     ro.compare = o.compare;
     ro.refraction = o.refraction;
     ro.skip_bad = o.skip_bad;
+    ro.format = o.format;
+    ro.equinox = o.equinox;
     ro.max_passes = MAX_PASSES;
     ro.command = "pmfit";
     for (int i = 1; i < argc; i++)
@@ -1232,6 +1285,7 @@ int run_main(int argc, char **argv)
         check_output("--save", o.save.empty() ? o.save : o.save + sfx);
         check_output("--emit-c", o.emit_c.empty() ? o.emit_c : o.emit_c + sfx);
         check_output("--error-map", o.error_map.empty() ? o.error_map : o.error_map + sfx);
+        check_output("--tpoint-terms", o.tpoint_terms.empty() ? o.tpoint_terms : o.tpoint_terms + sfx);
     }
     check_output("--residuals", o.residuals);
     check_output("--output", o.output);
@@ -1244,7 +1298,7 @@ int run_main(int argc, char **argv)
     if (o.cmd == "plan")
         return cmd_plan(o);
 
-    Run run = load_run(o.run, o.refraction, o.skip_bad);
+    Run run = load_run(o.run, o.refraction, o.skip_bad, o.format, o.equinox);
     for (const std::string &n : run.notes)
         std::fprintf(stderr, "pmfit: note: %s\n", n.c_str());
     std::vector<Obs> &obs = run.obs;
@@ -1350,6 +1404,16 @@ int run_main(int argc, char **argv)
         if (!o.save.empty() &&
             pmmodel_save((o.save + suffix).c_str(), &fits[k].model, note.c_str(), e, sizeof e) != 0)
             write_errors.push_back(e);
+        if (!o.tpoint_terms.empty()) {
+            if (fits[k].model.mount != PM_MOUNT_EQUATORIAL)
+                write_errors.push_back("--tpoint-terms " + o.tpoint_terms + suffix +
+                                       ": TPOINT terms are written for equatorial models only "
+                                       "(TPOINT's alt-az terms are not exported; docs/formats.md)");
+            else if (pmtp_write((o.tpoint_terms + suffix).c_str(), &fits[k].model, fits[k].res.err,
+                                ("pmfit fit " + o.run + " (" + titles[k] + ")").c_str(), e,
+                                sizeof e) != 0)
+                write_errors.push_back(e);
+        }
         if (!o.emit_c.empty()) {
             std::string prefix = fits.size() == 1 ? "pm_fitted" : (k == 0 ? "pm_east" : "pm_west");
             if (pmmodel_emit_c((o.emit_c + suffix).c_str(), &fits[k].model, prefix.c_str(),

@@ -11,12 +11,14 @@
 
 namespace pmhost {
 
-Run load_run(const std::string &path, bool refraction, bool skip_bad)
+Run load_run(const std::string &path, bool refraction, bool skip_bad, int format, int equinox)
 {
     pmrun_options ro;
     pmrun_options_default(&ro);
     ro.refraction = refraction ? 1 : 0;
     ro.skip_bad = skip_bad ? 1 : 0;
+    ro.format = format;
+    ro.equinox = equinox;
     pmrun *run = nullptr;
     char err[1024];
     if (pmrun_read(path.c_str(), &ro, &run, err, sizeof err) != 0)

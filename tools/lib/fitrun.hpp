@@ -48,7 +48,10 @@ struct Run {
 
 // Read a run (pmrun_read); without a direction column the slew direction on
 // axis 1 is the sign of the encoder's change from the previous observation.
-Run load_run(const std::string &path, bool refraction, bool skip_bad);
+// format: a PMRUN_FORMAT_* id or -1 (PMRUN_FORMAT_AUTO, detect); equinox:
+// a PMRUN_EQUINOX_* id (0: as the file says) (tools/lib/runfile.h).
+Run load_run(const std::string &path, bool refraction, bool skip_bad, int format = -1,
+             int equinox = 0);
 
 // Name and physical meaning of a model term.
 std::string term_name(const pm_model &m, int i);

@@ -282,7 +282,7 @@ void stage_compare(Data &d)
             throw std::runtime_error(err);
         d.old_what = "the model file " + old;
     } else {
-        old_run = load_run(old, d.o.refraction, d.o.skip_bad);
+        old_run = load_run(old, d.o.refraction, d.o.skip_bad, d.o.format, d.o.equinox);
         old_fit = do_fit(old_run.obs, all_of(old_run.obs.size()),
                          build_model(d.o.order, d.o.adds, old_run.obs, old_run.mount,
                                      old_run.latitude, old_run.aux_names), d.o.max_passes);

@@ -10,6 +10,7 @@
 #define PM_REPORT_HPP
 
 #include "fitrun.hpp"
+#include "runfile.h"
 
 #include <functional>
 #include <string>
@@ -26,6 +27,8 @@ struct ReportOptions {
     std::string compare;               // OLD: a model file or a run; empty: no comparison
     bool refraction = true;            // reading OLD when it is a run
     bool skip_bad = false;
+    int format = PMRUN_FORMAT_AUTO;    // reading OLD: as pmfit --format, --equinox
+    int equinox = PMRUN_EQUINOX_FILE;
     std::string command;               // the command line, quoted at the end of the page
     int max_passes = 2000;             // Gauss-Newton passes of the fit (as pmfit fit)
 };

@@ -76,7 +76,8 @@ bool Context::fail(int line, const char *fmt, ...)
     if (!failed()) {
         va_list ap;
         va_start(ap, fmt);
-        error_ = where(line) + vformat(fmt, ap);
+        error_ = where(line) + (reading_as_.empty() ? "" : "read as " + reading_as_ + ": ") +
+                 vformat(fmt, ap);
         va_end(ap);
         status_ = PMRUN_ERR_FORMAT;
     }
@@ -115,6 +116,7 @@ void Context::warn(int line, const char *fmt, ...)
 bool Context::bad_record(int line, const std::string &why)
 {
     if (!opt_.skip_bad) return fail(line, "%s", why.c_str());
+    // (skipped records: "path:LINE: skipped: why", without the format)
     std::string msg = where(line) + "skipped: " + why;
     if (run_->skipped.size() < PMRUN_MAX_MESSAGES) run_->skipped.push_back(msg);
     ++run_->n_skipped;
@@ -252,6 +254,34 @@ bool parse_number(const std::string &tok, double &v, std::string &why)
 
 double standard_pressure_hpa(double height_m) { return 1013.25 * std::exp(-height_m / 8434.5); }
 
+std::unique_ptr<FormatParser> make_parser(Context &ctx, int format)
+{
+    switch (format) {
+    case PMRUN_FORMAT_FOUR_COLUMN:
+    case PMRUN_FORMAT_NAMED: return make_column_parser(ctx);
+    case PMRUN_FORMAT_TPOINT: return make_tpoint_parser(ctx);
+    case PMRUN_FORMAT_RTS2: return make_rts2_parser(ctx);
+    case PMRUN_FORMAT_MW4: return make_mw4_parser(ctx);
+    case PMRUN_FORMAT_CSV: return make_csv_parser(ctx);
+    case PMRUN_FORMAT_MMT: return make_mmt_parser(ctx);
+    default: return nullptr;
+    }
+}
+
+const char *format_description(int format)
+{
+    switch (format) {
+    case PMRUN_FORMAT_FOUR_COLUMN: return "a four-column or named-column file";
+    case PMRUN_FORMAT_NAMED: return "a named-column file";
+    case PMRUN_FORMAT_TPOINT: return "a TPOINT data file";
+    case PMRUN_FORMAT_RTS2: return "an RTS2 gpoint input file";
+    case PMRUN_FORMAT_MW4: return "a MountWizzard4 model file (JSON)";
+    case PMRUN_FORMAT_CSV: return "a N.I.N.A./ASCOM-style CSV log";
+    case PMRUN_FORMAT_MMT: return "an MMT pointing log";
+    default: return "an unknown format";
+    }
+}
+
 // ----------------------------------------------------------- line reader
 
 namespace {
@@ -356,27 +386,188 @@ struct FileCloser {
 const char *kExpectedAny =
     "expected a pointing run: four numbers 'tau delta T D' per line, '#' comments and a "
     "'# tau delta T D ...' column header, or a TPOINT file (caption, '!' comments, ':' "
-    "options, run line, records)";
+    "options, run line, records), an RTS2 gpoint file, a MountWizzard4 JSON model file, a "
+    "CSV log with a header of named columns or an MMT pointing log";
 
-// Picks the format from the first non-blank line (docs/formats.md,
-// "Detection").
-std::unique_ptr<FormatParser> detect(Context &ctx, int n, const std::string &line)
+// The fields of a CSV header line: split at the delimiter (',' or ';'),
+// quotes removed, names normalised (letters and digits, lower case).
+std::vector<std::string> csv_header_names(const std::string &line)
 {
-    std::string t = trim(line);
-    if (t[0] == '#') return make_column_parser(ctx);
-    if (t[0] == '!' || t[0] == ':') return make_tpoint_parser(ctx);
-    std::vector<std::string> tok = tokens(strip_comment(t, '#'));
-    if (!tok.empty() && is_number(tok[0])) {
-        size_t nums = 0;
-        for (const std::string &s : tok) nums += is_number(s) ? 1 : 0;
-        if (nums == tok.size() && tok.size() == 4) return make_column_parser(ctx);
-        ctx.fail(n, "cannot tell the format: the first line '%s' starts with a number but is not "
-                    "four numbers 'tau delta T D' (a TPOINT caption must not start with a number); %s",
-                 excerpt(t).c_str(), kExpectedAny);
-        return nullptr;
+    char delim = line.find(',') != std::string::npos ? ',' : ';';
+    std::vector<std::string> out;
+    std::string cur;
+    for (size_t i = 0; i <= line.size(); ++i) {
+        if (i == line.size() || line[i] == delim) {
+            out.push_back(cur);
+            cur.clear();
+            continue;
+        }
+        char c = line[i];
+        if ((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9'))
+            cur += static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);
     }
-    return make_tpoint_parser(ctx);
+    return out;
 }
+
+// Does a line look like a CSV log's header: delimited, and naming a mount
+// RA and Dec (docs/formats.md, "CSV logs")?  A TPOINT caption with a comma
+// ("Test mount, latitude +49") does not.
+bool csv_header(const std::string &line)
+{
+    if (line.find(',') == std::string::npos && line.find(';') == std::string::npos) return false;
+    int ra = 0, dec = 0;
+    for (const std::string &n : csv_header_names(line)) {
+        ra += n.find("ra") != std::string::npos ? 1 : 0;
+        dec += n.find("dec") != std::string::npos ? 1 : 0;
+    }
+    return ra >= 2 && dec >= 2;   // the mount's and the solved position
+}
+
+// The first '#' line of an RTS2 gpoint file names its columns
+// ("#  Observation  MJD  LST-MNT  RA-MNT ..."), or a '#observatory',
+// '#gem' or '#altaz' line gives the site.
+bool rts2_comment(const std::string &t)
+{
+    std::vector<std::string> tok = tokens(t.substr(1));
+    if (tok.empty()) return false;
+    bool mjd = false, mnt = false;
+    for (const std::string &w : tok) {
+        std::string l = lower(w);
+        mjd = mjd || l == "mjd";
+        mnt = mnt || l == "lst-mnt" || l == "ra-mnt" || l == "az-mnt";
+    }
+    if (mjd && mnt) return true;
+    std::string f = lower(tok[0]);
+    if ((f == "observatory" || f == "gem" || f == "altaz" || f == "altaz-manual") && tok.size() >= 4) {
+        for (size_t i = 1; i < 4; ++i)
+            if (!is_number(tok[i])) return false;
+        return true;
+    }
+    return false;
+}
+
+// Picks the format from the first lines (docs/formats.md, "Detection"):
+// '#' and blank lines are held until the first other line, which decides
+// with them; then all are handed to the chosen parser.
+class Detector : public FormatParser {
+public:
+    explicit Detector(Context &ctx) : ctx_(ctx) {}
+
+    bool line(int n, const std::string &text) override
+    {
+        if (parser_) return parser_->line(n, text);
+        std::string t = trim(text);
+        if (t.empty() || t[0] == '#') {
+            if (!t.empty() && !rts2_ && rts2_comment(t)) {
+                rts2_ = true;
+                first_hash_ = n;
+            }
+            held_.emplace_back(n, text);
+            held_bytes_ += text.size();
+            // a long comment block: the column formats (they read '#' lines)
+            if (held_.size() > 1000 || held_bytes_ > (1u << 20)) return choose(n, nullptr);
+            return true;
+        }
+        return choose(n, &t) && parser_->line(n, text);
+    }
+
+    bool unreadable(int n, const std::string &why) override
+    {
+        if (!parser_) {
+            if (held_.empty()) return ctx_.fail(n, "%s; cannot tell the format", why.c_str());
+            if (!choose(n, nullptr)) return false;
+        }
+        return parser_->unreadable(n, why);
+    }
+
+    bool finish(int last_line) override
+    {
+        if (!parser_ && !choose(last_line, nullptr)) return false;
+        return parser_->finish(last_line);
+    }
+
+    bool empty() const { return held_.empty() && !parser_; }
+
+private:
+    // Chooses with the first non-comment line `t` (nullptr: none yet).
+    bool choose(int n, const std::string *t)
+    {
+        int format = -1;
+        std::string why;
+        if (rts2_) {
+            format = PMRUN_FORMAT_RTS2;
+            why = format_str("its '#' line %d is an RTS2 gpoint header", first_hash_);
+        } else if (!held_.empty() || !t) {
+            if (t && t->compare(0, 4, "CAT:") == 0) {
+                format = PMRUN_FORMAT_MMT;
+                why = format_str("line %d starts with 'CAT:'", n);
+            } else if (t && csv_header(*t)) {
+                format = PMRUN_FORMAT_CSV;
+                why = format_str("line %d is a header of delimited names with RA and Dec", n);
+            } else {
+                format = PMRUN_FORMAT_FOUR_COLUMN;   // four-column or named
+                if (t && (t->find(',') != std::string::npos || t->find(';') != std::string::npos))
+                    why = format_str("line %d has ',' or ';' but is not a CSV header naming the "
+                                     "mount's and the solved RA and Dec",
+                                     n);
+            }
+        } else if ((*t)[0] == '!' || (*t)[0] == ':') {
+            format = PMRUN_FORMAT_TPOINT;
+        } else if ((*t)[0] == '[' || (*t)[0] == '{') {
+            format = PMRUN_FORMAT_MW4;
+            why = format_str("line %d starts with '%c'", n, (*t)[0]);
+        } else if (t->compare(0, 4, "CAT:") == 0) {
+            format = PMRUN_FORMAT_MMT;
+            why = format_str("line %d starts with 'CAT:'", n);
+        } else if (csv_header(*t)) {
+            format = PMRUN_FORMAT_CSV;
+            why = format_str("line %d is a header of delimited names with RA and Dec", n);
+        } else {
+            std::vector<std::string> tok = tokens(strip_comment(*t, '#'));
+            if (!tok.empty() && is_number(tok[0])) {
+                size_t nums = 0;
+                for (const std::string &x : tok) nums += is_number(x) ? 1 : 0;
+                if (nums != tok.size() || tok.size() != 4)
+                    return ctx_.fail(n,
+                                     "cannot tell the format: the first line '%s' starts with a "
+                                     "number but is not four numbers 'tau delta T D' (a TPOINT "
+                                     "caption must not start with a number); %s",
+                                     excerpt(*t).c_str(), kExpectedAny);
+                format = PMRUN_FORMAT_FOUR_COLUMN;
+            } else {
+                format = PMRUN_FORMAT_TPOINT;
+                if (t->find(',') != std::string::npos || t->find(';') != std::string::npos)
+                    why = format_str("line %d is taken as its caption: it has ',' or ';' but is "
+                                     "not a CSV header naming the mount's and the solved RA and "
+                                     "Dec",
+                                     n);
+            }
+        }
+        parser_ = make_parser(ctx_, format);
+        if (!why.empty())
+            ctx_.set_reading_as(std::string(format_description(format)) + " (" + why + ")");
+        for (const auto &h : held_)
+            if (!parser_->line(h.first, h.second)) return false;
+        held_.clear();
+        return true;
+    }
+
+    static std::string format_str(const char *fmt, ...) __attribute__((format(printf, 1, 2)))
+    {
+        va_list ap;
+        va_start(ap, fmt);
+        std::string s = vformat(fmt, ap);
+        va_end(ap);
+        return s;
+    }
+
+    Context &ctx_;
+    std::unique_ptr<FormatParser> parser_;
+    std::vector<std::pair<int, std::string>> held_;
+    size_t held_bytes_ = 0;
+    int first_hash_ = 0;
+    bool rts2_ = false;
+};
 
 // Records that repeat an earlier one exactly (same encoder and apparent
 // readings and time): one warning, the fit goes on (docs/reliability.md).
@@ -504,10 +695,26 @@ int read_file(Context &ctx)
     }
     std::unique_ptr<std::FILE, FileCloser> f(raw);
     LineReader rd(raw);
+    int forced = ctx.opt().format;
     std::unique_ptr<FormatParser> parser;
+    Detector *detector = nullptr;
+    if (forced == PMRUN_FORMAT_AUTO) {
+        detector = new Detector(ctx);
+        parser.reset(detector);
+    } else {
+        parser = make_parser(ctx, forced);
+        if (!parser) {
+            ctx.fail_with(PMRUN_ERR_ARG, 0, "options.format %d is not a format, expected "
+                                            "PMRUN_FORMAT_AUTO or a PMRUN_FORMAT_* id",
+                          forced);
+            return ctx.status();
+        }
+        ctx.set_reading_as(std::string(format_description(forced)) + " (format forced: " +
+                           pmrun_format_name(forced) + ")");
+    }
     std::string line;
     bool nul = false;
-    bool any_text = false;
+    bool any_text = false, any_line = false;
     for (;;) {
         LineReader::Result r = rd.next(line, nul);
         if (r == LineReader::kEof) break;
@@ -527,19 +734,18 @@ int read_file(Context &ctx)
         else if (nul)
             why = "NUL byte in the line (binary data?), expected text";
         any_text = true;
-        if (!parser) {
-            if (!why.empty()) {
+        if (!any_line) {
+            if (!why.empty() && forced == PMRUN_FORMAT_AUTO) {
                 ctx.fail(n, "%s; cannot tell the format", why.c_str());
                 return ctx.status();
             }
-            if (trim(line).empty()) continue;
-            parser = detect(ctx, n, line);
-            if (!parser) return ctx.status();
+            if (why.empty() && trim(line).empty()) continue;
+            any_line = true;
         }
         bool ok = why.empty() ? parser->line(n, line) : parser->unreadable(n, why);
         if (!ok) return ctx.status();
     }
-    if (!parser) {
+    if (!any_line) {
         if (!any_text)
             ctx.fail(0, "empty file: %s", kExpectedAny);
         else
@@ -577,6 +783,8 @@ void pmrun_options_default(pmrun_options *opt)
     opt->temp_c = nan();
     opt->humidity = nan();
     opt->wavelength_um = nan();
+    opt->format = PMRUN_FORMAT_AUTO;
+    opt->equinox = PMRUN_EQUINOX_FILE;
 }
 
 int pmrun_read(const char *path, const pmrun_options *opt, pmrun **out, char *err, size_t errlen)
@@ -628,6 +836,26 @@ const pmrun_obs *pmrun_get(const pmrun *run, size_t i)
 int pmrun_mount(const pmrun *run) { return run ? run->mount : -1; }
 
 int pmrun_format(const pmrun *run) { return run ? run->format : -1; }
+
+static const char *const kFormatNames[] = {"four-column", "named", "tpoint", "rts2",
+                                           "mw4",         "csv",   "mmt"};
+
+const char *pmrun_format_name(int format)
+{
+    if (format == PMRUN_FORMAT_AUTO) return "auto";
+    if (format < 0 || format > PMRUN_FORMAT_MMT) return nullptr;
+    return kFormatNames[format];
+}
+
+int pmrun_format_from_name(const char *name)
+{
+    if (!name) return -2;
+    std::string l = lower(name);
+    if (l == "auto") return PMRUN_FORMAT_AUTO;
+    for (int i = 0; i <= PMRUN_FORMAT_MMT; ++i)
+        if (l == kFormatNames[i]) return i;
+    return -2;
+}
 
 double pmrun_latitude_rad(const pmrun *run) { return run ? run->site.latitude_rad : nan(); }
 

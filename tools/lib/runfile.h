@@ -2,8 +2,8 @@
 **  runfile.h - host-side reader of telescope pointing runs.
 **
 **  Reads a pointing run (a list of observed stars with the encoder readings
-**  of the mount at each) from one of three text formats, detected
-**  automatically:
+**  of the mount at each) from one of seven formats, detected from the
+**  content (or forced with pmrun_options.format):
 **
 **     PMRUN_FORMAT_FOUR_COLUMN  "tau delta T D" per line, degrees
 **                               (Pal et al., Exp Astron 2016, the FITSH
@@ -15,6 +15,16 @@
 **                               equatorial catalogue places are reduced to
 **                               observed hour angle and declination with
 **                               ERFA
+**     PMRUN_FORMAT_RTS2         RTS2 gpoint input files (MJD, LST, mount
+**                               and true RA/Dec or alt-az per line)
+**     PMRUN_FORMAT_MW4          MountWizzard4 (10Micron) model files: a
+**                               JSON list of points (mount and solved JNow
+**                               places, sidereal time, pier side, time)
+**     PMRUN_FORMAT_CSV          N.I.N.A./ASCOM-style CSV logs with named
+**                               columns (mount and solved RA/Dec, pier side,
+**                               time or LST; J2000 reduced with ERFA)
+**     PMRUN_FORMAT_MMT          the MMT mount computer's pointing log
+**                               (13 'KEY: values' lines per star; pytelpoint)
 **
 **  docs/formats.md describes every format, column, convention and message.
 **
@@ -63,7 +73,22 @@ enum pmrun_status {
 enum pmrun_format_id {
     PMRUN_FORMAT_FOUR_COLUMN = 0,
     PMRUN_FORMAT_NAMED = 1,
-    PMRUN_FORMAT_TPOINT = 2
+    PMRUN_FORMAT_TPOINT = 2,
+    PMRUN_FORMAT_RTS2 = 3,
+    PMRUN_FORMAT_MW4 = 4,
+    PMRUN_FORMAT_CSV = 5,
+    PMRUN_FORMAT_MMT = 6
+};
+
+/* pmrun_options.format: detect the format from the content. */
+#define PMRUN_FORMAT_AUTO (-1)
+
+/* pmrun_options.equinox: the equinox of the RA/Dec places of the formats
+** that give them (CSV logs, RTS2 gpoint files). */
+enum pmrun_equinox_id {
+    PMRUN_EQUINOX_FILE = 0,   /* as the file states it (or the format's rule) */
+    PMRUN_EQUINOX_J2000 = 1,  /* J2000 mean places (ICRS): reduced with ERFA */
+    PMRUN_EQUINOX_JNOW = 2    /* apparent places of date: no reduction */
 };
 
 /* Mount types (pmrun_mount). */
@@ -146,9 +171,17 @@ typedef struct pmrun_obs {
 **     temp_c         double  NaN (default), or an override (deg C)
 **     humidity       double  NaN (default), or an override (0-1)
 **     wavelength_um  double  NaN (default), or an override (micrometres)
+**     format         int     PMRUN_FORMAT_AUTO (default): detect the
+**                            format from the content; or a PMRUN_FORMAT_*
+**                            id: read the file as that format
+**     equinox        int     PMRUN_EQUINOX_FILE (default): as the file
+**                            says; PMRUN_EQUINOX_J2000 / _JNOW: override
+**                            (CSV logs and RTS2 gpoint files only)
 **
-**  The options only change the TPOINT equatorial reduction, except
-**  skip_bad which applies to every format.
+**  The weather options change the reductions (TPOINT equatorial, CSV and
+**  RTS2 J2000 places, CSV refraction); skip_bad and format apply to every
+**  format.  A zeroed struct (instead of pmrun_options_default) forces the
+**  four-column format.
 */
 typedef struct pmrun_options {
     int refraction;
@@ -157,6 +190,8 @@ typedef struct pmrun_options {
     double temp_c;
     double humidity;
     double wavelength_um;
+    int format;
+    int equinox;
 } pmrun_options;
 
 /*
@@ -183,7 +218,9 @@ typedef struct pmrun pmrun;
 **  pmrun_options_default - fill in the default options.
 **
 **  Returned:
-**     opt      pmrun_options*  refraction 1, skip_bad 0, overrides NaN
+**     opt      pmrun_options*  refraction 1, skip_bad 0, overrides NaN,
+**                              format PMRUN_FORMAT_AUTO, equinox
+**                              PMRUN_EQUINOX_FILE
 **  Notes:
 **  1) Does nothing if opt is NULL.
 */
@@ -208,8 +245,10 @@ void pmrun_options_default(pmrun_options *opt);
 **  Notes:
 **  1) *out is set to NULL on entry and only set on success: nothing is
 **     returned half-way.
-**  2) The format is detected from the first non-blank line
-**     (docs/formats.md, "Detection").
+**  2) The format is detected from the content (docs/formats.md,
+**     "Detection") unless opt->format names one.  An error of a reader
+**     chosen by detection or by opt->format says which format it read the
+**     file as ("path:LINE: read as an RTS2 gpoint input file (...): ...").
 **  3) Notes that do not stop the reading (unknown TPOINT options,
 **     implausible weather, skipped records ...) come back as warnings:
 **     pmrun_n_warnings / pmrun_warning.
@@ -242,10 +281,21 @@ const pmrun_obs *pmrun_get(const pmrun *run, size_t i);
 int pmrun_mount(const pmrun *run);
 
 /*
-**  pmrun_format - PMRUN_FORMAT_FOUR_COLUMN, _NAMED or _TPOINT (-1 for
-**  NULL).
+**  pmrun_format - PMRUN_FORMAT_FOUR_COLUMN, _NAMED, _TPOINT, _RTS2, _MW4,
+**  _CSV or _MMT (-1 for NULL).
 */
 int pmrun_format(const pmrun *run);
+
+/*
+**  pmrun_format_name - the short name of a format id ("four-column",
+**  "named", "tpoint", "rts2", "mw4", "csv", "mmt"; "auto" for
+**  PMRUN_FORMAT_AUTO), NULL for any other value.
+**
+**  pmrun_format_from_name - the id of a short name (case-insensitive; also
+**  "auto"), -2 if the name is not one of them or NULL.
+*/
+const char *pmrun_format_name(int format);
+int pmrun_format_from_name(const char *name);
 
 /*
 **  pmrun_latitude_rad - site latitude (radians), NaN if the file gives

@@ -1,7 +1,9 @@
 // runfile_internal.hpp - internals of the pointing-run reader (runfile.h).
 // Shared by runfile.cpp (API, line reader, detection), runfile_columns.cpp
-// (four-column and named formats), runfile_tpoint.cpp (TPOINT) and
-// runfile_reduce.cpp (ERFA reduction).  Not installed, not a public API.
+// (four-column and named formats), runfile_tpoint.cpp (TPOINT),
+// runfile_reduce.cpp (ERFA reduction), runfile_rts2.cpp, runfile_mw4.cpp,
+// runfile_csv.cpp, runfile_mmt.cpp (the other formats) and runfile_util.cpp
+// (their shared helpers).  Not installed, not a public API.
 #ifndef PMRUN_RUNFILE_INTERNAL_HPP
 #define PMRUN_RUNFILE_INTERNAL_HPP
 
@@ -62,6 +64,11 @@ public:
     // fail and return false.
     bool bad_record(int line, const std::string &why);
 
+    // The format a reader tries, named in its errors: "path:LINE: read as
+    // <what>: ..." (empty: no prefix, the original three formats' messages).
+    void set_reading_as(const std::string &what) { reading_as_ = what; }
+    const std::string &reading_as() const { return reading_as_; }
+
     bool failed() const { return !error_.empty(); }
     const std::string &error() const { return error_; }
     int status() const { return status_; }
@@ -72,6 +79,7 @@ private:
     void add_warning(const std::string &msg);
 
     std::string path_;
+    std::string reading_as_;
     pmrun_options opt_;
     pmrun *run_;
     std::string error_;
@@ -113,6 +121,14 @@ public:
 
 std::unique_ptr<FormatParser> make_column_parser(Context &ctx);  // four-column, named
 std::unique_ptr<FormatParser> make_tpoint_parser(Context &ctx);
+std::unique_ptr<FormatParser> make_rts2_parser(Context &ctx);
+std::unique_ptr<FormatParser> make_mw4_parser(Context &ctx);
+std::unique_ptr<FormatParser> make_csv_parser(Context &ctx);
+std::unique_ptr<FormatParser> make_mmt_parser(Context &ctx);
+// The parser of a format id (PMRUN_FORMAT_*), nullptr for another value.
+std::unique_ptr<FormatParser> make_parser(Context &ctx, int format);
+// A description of each format for messages ("an RTS2 gpoint input file").
+const char *format_description(int format);
 
 // Weather for the refraction (eraRefco arguments).
 struct Weather {
@@ -128,6 +144,13 @@ struct Reduction {
                const Weather *weather, std::string &why);
     bool observed(double ra, double dec, double lst, double utc_h, double &ha,
                   double &dec_obs, std::string &why) const;
+    // The same without refraction (the apparent place of date), whatever
+    // `refract` says.
+    bool apparent(double ra, double dec, double lst, double utc_h, double &ha,
+                  double &dec_app, std::string &why) const;
+    // Refraction of an apparent (unrefracted) HA/Dec, in place (the same
+    // model and guards as observed()); nothing if !refract.
+    void refract_place(double &ha, double &dec) const;
 
     double utc1 = 0, utc2 = 0;        // UTC quasi-JD of the date at 0h
     double latitude = 0;
@@ -138,6 +161,48 @@ struct Reduction {
 
 // Standard-atmosphere pressure (hPa) at height h (m).
 double standard_pressure_hpa(double height_m);
+
+// ---- helpers of the RTS2, MW4, CSV and MMT readers (runfile_util.cpp)
+
+// A sexagesimal or decimal angle: "12.5", "-0:30:00", "12 34 56.7",
+// "12h34m56.7s", "+45d30m00s", "+45°30'00\"" (the unit letters and marks
+// optional, ':' or spaces between parts).  Only the first part has a sign,
+// only the last a fraction, minutes and seconds below 60.  `value` is in
+// the first part's unit (hours or degrees).  On failure `why` says what.
+bool parse_sexagesimal(const std::string &text, double &value, std::string &why);
+
+// A UTC time in ISO 8601: "YYYY-MM-DD[T| ]hh:mm[:ss[.fff]][Z|+hh:mm|-hh:mm]"
+// (no zone: UTC).  Returns the calendar date of the UTC day and the hours
+// since its 0h (the zone offset applied).
+struct UtcTime {
+    int year = 0, month = 0, day = 0;
+    double hours = 0;
+};
+bool parse_iso_utc(const std::string &text, UtcTime &t, std::string &why);
+// Hours from 0h UTC of `ref`'s date to `t` (whole days counted).
+double hours_since(const UtcTime &ref, const UtcTime &t);
+// Local apparent sidereal time (radians, [0, 2pi)) at UTC `date` + `hours`
+// and east longitude `lon` (radians), UT1 taken as UTC (docs/formats.md:
+// a DUT1 below 0.9 s is a constant HA offset, the index term's).
+bool lst_from_utc(int year, int month, int day, double hours, double lon, double &lst,
+                  std::string &why);
+
+// The weather for refraction from the site (NaN: absent) and the options'
+// overrides, with defaults from the standard atmosphere at the height (one
+// warning naming what was defaulted) and errors for absurd values, as the
+// TPOINT run line's (docs/formats.md, "Weather").  `what` names the source
+// in messages ("metadata", "the MW4 points").  False after ctx.fail.
+bool refraction_weather(Context &ctx, int line, const char *what, Weather &out);
+
+// A sky place of a German mount's pointing (HA, Dec within +-90, degrees)
+// and its pier side to the encoder convention of this reader (docs/
+// formats.md, "Beyond the pole"): pier -1 (beyond the pole) gives
+// (HA + 180, 180 - Dec); both reduced into (-180, 180].
+void sky_to_encoder_deg(double ha_deg, double dec_deg, int pier, double &enc_ha_deg,
+                        double &enc_dec_deg);
+
+// A blank observation: angles 0, pier unknown, temp/time NaN, aux NaN.
+pmrun_obs blank_obs(int line);
 
 }  // namespace pmrun_detail
 

@@ -46,8 +46,8 @@ static void refract_hd(double lat, double refa, double refb, double &ha, double 
     eraAe2hd(az, el + del, lat, &ha, &dec);
 }
 
-bool Reduction::observed(double ra, double dec, double lst, double utc_h, double &ha,
-                         double &dec_obs, std::string &why) const
+bool Reduction::apparent(double ra, double dec, double lst, double utc_h, double &ha,
+                         double &dec_app, std::string &why) const
 {
     double tai1, tai2, tt1, tt2;
     int j = eraUtctai(utc1, utc2 + utc_h / 24.0, &tai1, &tai2);
@@ -62,8 +62,23 @@ bool Reduction::observed(double ra, double dec, double lst, double utc_h, double
     eraAtci13(ra, dec, 0.0, 0.0, 0.0, 0.0, tt1, tt2, &ri, &di, &eo);
     // Equinox-based apparent RA through the equation of the origins.
     double ra_app = eraAnp(ri - eo);
-    double h = eraAnpm(lst - ra_app);
-    double d = di;
+    ha = eraAnpm(lst - ra_app);
+    dec_app = di;
+    return true;
+}
+
+void Reduction::refract_place(double &ha, double &dec) const
+{
+    if (!refract) return;
+    refract_hd(latitude, refa, refb, ha, dec);
+    ha = eraAnpm(ha);
+}
+
+bool Reduction::observed(double ra, double dec, double lst, double utc_h, double &ha,
+                         double &dec_obs, std::string &why) const
+{
+    double h, d;
+    if (!apparent(ra, dec, lst, utc_h, h, d, why)) return false;
     if (refract) refract_hd(latitude, refa, refb, h, d);
     ha = eraAnpm(h);
     dec_obs = d;

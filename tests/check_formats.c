@@ -1,0 +1,793 @@
+/*
+**  check_formats.c - the readers of the pointing files users already have
+**  (RTS2 gpoint input, MountWizzard4 JSON model files, N.I.N.A./ASCOM-style
+**  CSV logs, the MMT pointing log; tools/lib/runfile.h) and the TPOINT
+**  term export (tools/lib/tpointterms.h, pmfit fit --tpoint-terms).
+**
+**  TCases: "detect" (detection by content, forcing a format, the names),
+**  "samples" (every sample in tests/data, written by tests/ref/formats_gen.py
+**  from two simulated runs, reads as the run it came from), "fit" (pmfit
+**  fits every sample to the source run's fit and to the true terms),
+**  "errors" (each bad_* sample's message, skipped records), "export" (the
+**  TPOINT formulas with the exported values against pm_model_apply),
+**  "realdata" (the MMT log against its TPOINT conversion; skipped when
+**  $PM_DATA_DIR has no mmt/).
+*/
+#define _POSIX_C_SOURCE 200809L
+#include <check.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "pm.h"
+#include "runfile.h"
+#include "tpointterms.h"
+#include "tu_runfile.h"
+#include "tu_tool.h"
+
+#define PI 3.14159265358979323846
+#define DEG (PI / 180.0)
+#define AS (DEG / 3600.0)
+
+/* A sample against its source run, record by record: the samples' decimal
+** text (LST to 1e-7 deg, angles to 1e-9 deg or 1e-10 h) and nothing else. */
+#define TOL_SAME_RAD 5e-9
+/* The J2000 samples: sexagesimal text to 1e-4 s / 1e-3 arcsec and the
+** reduction's round trip (eraAtoiq + eraAtic13 in Python, eraAtci13 and the
+** one-step refraction inverse here): 10 mas. */
+#define TOL_J2000_RAD 5e-8
+/* Times: MW4's julianDate has whole seconds, the CSV milliseconds. */
+#define TOL_TIME_H 3e-4
+/* A fit of a sample against the fit of its source run (arcsec). */
+#define TOL_FIT_SAME_AS 0.002
+/* ... and against the true terms: 4 sigma of the fit plus this. */
+#define TOL_FIT_TRUTH_AS 0.01
+/* The MMT log and its TPOINT conversion (arcsec): the conversion's -5.9"
+** elevation offset moves e' by 5.9" and, through the exact rotations, c', d
+** and i by a second-order 0.1" (docs/formats.md); with the offset applied to
+** the log too the fits agree to the conversion's 1e-7 deg rounding. */
+#define TOL_MMT_EL_OFFSET_AS 0.01
+#define TOL_MMT_SECOND_ORDER_AS 0.15
+#define TOL_MMT_SAME_AS 0.001
+/* The TPOINT first-order formulas against pm_model_apply, coefficients of
+** 20 arcsec, |dec| <= 75 deg, el >= 20 deg: the neglected second order. */
+#define TOL_FIRST_ORDER_AS 0.1
+
+/* ------------------------------------------------------------ helpers */
+
+static void data_path(char *buf, size_t n, const char *name)
+{
+    const char *top = getenv("PM_TOP");
+    snprintf(buf, n, "%s/tests/data/%s", top && *top ? top : ".", name);
+}
+
+static pmrun *read_opt(const char *name, const pmrun_options *opt)
+{
+    char path[4096], err[2048];
+    pmrun *run = NULL;
+    data_path(path, sizeof path, name);
+    int st = pmrun_read(path, opt, &run, err, sizeof err);
+    ck_assert_msg(st == PMRUN_OK, "%s: status %d: %s", name, st, err);
+    return run;
+}
+
+static pmrun *read_ok(const char *name) { return read_opt(name, NULL); }
+
+static void expect_error(const char *name, const pmrun_options *opt, int line, const char *needle)
+{
+    char path[4096];
+    data_path(path, sizeof path, name);
+    tu_read_fails(path, opt, PMRUN_ERR_FORMAT, line, needle);
+}
+
+static double wrap(double a) { return remainder(a, 2 * PI); }
+
+static int count_west(const pmrun *run)
+{
+    size_t i;
+    int n = 0;
+    for (i = 0; i < pmrun_count(run); ++i) n += pmrun_get(run, i)->pier == PMRUN_PIER_WEST;
+    return n;
+}
+
+/* Every record of `name` is the record of `source` at the same index. */
+static void same_records(const char *name, const char *source, const pmrun_options *opt,
+                         double tol, int check_time)
+{
+    pmrun *a = read_opt(name, opt), *b = read_ok(source);
+    size_t i;
+    ck_assert_uint_eq(pmrun_count(a), pmrun_count(b));
+    ck_assert_int_eq(pmrun_mount(a), pmrun_mount(b));
+    for (i = 0; i < pmrun_count(a); ++i) {
+        const pmrun_obs *x = pmrun_get(a, i), *y = pmrun_get(b, i);
+        ck_assert_msg(fabs(wrap(x->enc_ha - y->enc_ha)) < tol && fabs(x->enc_dec - y->enc_dec) < tol &&
+                          fabs(wrap(x->app_ha - y->app_ha)) < tol && fabs(x->app_dec - y->app_dec) < tol,
+                      "%s record %zu (line %d): enc %.12f %.12f app %.12f %.12f, source %.12f %.12f "
+                      "%.12f %.12f",
+                      name, i, x->line, x->enc_ha, x->enc_dec, x->app_ha, x->app_dec, y->enc_ha,
+                      y->enc_dec, y->app_ha, y->app_dec);
+        if (pmrun_mount(a) == PMRUN_MOUNT_EQUATORIAL)
+            ck_assert_int_eq(x->pier, y->pier);
+        if (check_time)
+            ck_assert_msg(fabs(x->time_h - y->time_h) < TOL_TIME_H, "%s record %zu: time %.6f vs %.6f",
+                          name, i, x->time_h, y->time_h);
+    }
+    pmrun_free(a);
+    pmrun_free(b);
+}
+
+/* The value of term `name` in pmfit's JSON (fails if absent). */
+static double term_value(const char *json, const char *name)
+{
+    char pat[128];
+    const char *p;
+    snprintf(pat, sizeof pat, "{\"name\": \"%s\", \"value_arcsec\": ", name);
+    p = strstr(json, pat);
+    ck_assert_msg(p != NULL, "no term %s in: %.300s", name, json);
+    return atof(p + strlen(pat));
+}
+
+static double term_error(const char *json, const char *name)
+{
+    char pat[128];
+    const char *p;
+    snprintf(pat, sizeof pat, "{\"name\": \"%s\", \"value_arcsec\": ", name);
+    p = strstr(json, pat);
+    ck_assert_ptr_nonnull(p);
+    p = strstr(p, "\"error_arcsec\": ");
+    ck_assert_ptr_nonnull(p);
+    return atof(p + strlen("\"error_arcsec\": "));
+}
+
+/* pmfit fit tests/data/<name> <args> --json into out; its exit code. */
+static int pmfit_json(const char *name, const char *args, char *out, size_t len)
+{
+    char path[2048], cmd[4096];
+    data_path(path, sizeof path, name);
+    snprintf(cmd, sizeof cmd, "%s fit %s %s --json 2>/dev/null", tu_pmfit_path(), path, args);
+    return tu_capture(cmd, out, len);
+}
+
+static const char *const kIso[6] = {"a", "b", "c'", "d", "e'", "i"};
+
+/* ------------------------------------------------------------- detect */
+
+START_TEST(test_pmrun_options_default_format_equinox)
+{
+    pmrun_options o;
+    memset(&o, 0x5a, sizeof o);
+    pmrun_options_default(&o);
+    ck_assert_int_eq(o.format, PMRUN_FORMAT_AUTO);
+    ck_assert_int_eq(o.equinox, PMRUN_EQUINOX_FILE);
+}
+END_TEST
+
+START_TEST(test_pmrun_format_names_round_trip)
+{
+    int f;
+    for (f = PMRUN_FORMAT_AUTO; f <= PMRUN_FORMAT_MMT; ++f) {
+        const char *n = pmrun_format_name(f);
+        ck_assert_ptr_nonnull(n);
+        ck_assert_int_eq(pmrun_format_from_name(n), f);
+    }
+    ck_assert_int_eq(pmrun_format_from_name("MW4"), PMRUN_FORMAT_MW4);
+    ck_assert_int_eq(pmrun_format_from_name("json"), -2);
+    ck_assert_int_eq(pmrun_format_from_name(NULL), -2);
+    ck_assert_ptr_null(pmrun_format_name(7));
+    ck_assert_ptr_null(pmrun_format_name(-2));
+}
+END_TEST
+
+START_TEST(test_pmrun_read_detects_each_format)
+{
+    static const struct {
+        const char *name;
+        int format, mount, n, west;
+    } k[] = {{"rts2_gpoint.dat", PMRUN_FORMAT_RTS2, PMRUN_MOUNT_EQUATORIAL, 60, 31},
+             {"rts2_altaz.dat", PMRUN_FORMAT_RTS2, PMRUN_MOUNT_ALTAZ, 50, 0},
+             {"mw4_model.json", PMRUN_FORMAT_MW4, PMRUN_MOUNT_EQUATORIAL, 60, 31},
+             {"nina_j2000.csv", PMRUN_FORMAT_CSV, PMRUN_MOUNT_EQUATORIAL, 60, 31},
+             {"nina_jnow.csv", PMRUN_FORMAT_CSV, PMRUN_MOUNT_EQUATORIAL, 60, 31},
+             {"mmt_log.dat", PMRUN_FORMAT_MMT, PMRUN_MOUNT_ALTAZ, 50, 0}};
+    size_t i;
+    for (i = 0; i < sizeof k / sizeof k[0]; ++i) {
+        pmrun *run = read_ok(k[i].name);
+        ck_assert_msg(pmrun_format(run) == k[i].format, "%s: format %d", k[i].name, pmrun_format(run));
+        ck_assert_int_eq(pmrun_mount(run), k[i].mount);
+        ck_assert_uint_eq(pmrun_count(run), (size_t)k[i].n);
+        ck_assert_int_eq(count_west(run), k[i].west);
+        pmrun_free(run);
+    }
+}
+END_TEST
+
+START_TEST(test_pmrun_read_forced_format_is_used)
+{
+    pmrun_options o;
+    pmrun *run;
+    pmrun_options_default(&o);
+    o.format = PMRUN_FORMAT_CSV;
+    run = read_opt("nina_jnow.csv", &o);
+    ck_assert_int_eq(pmrun_format(run), PMRUN_FORMAT_CSV);
+    pmrun_free(run);
+    o.format = PMRUN_FORMAT_TPOINT; /* forcing the old formats works too */
+    run = read_opt("tpoint_equat.dat", &o);
+    ck_assert_int_eq(pmrun_format(run), PMRUN_FORMAT_TPOINT);
+    pmrun_free(run);
+}
+END_TEST
+
+START_TEST(test_pmrun_read_forced_wrong_format_names_it)
+{
+    pmrun_options o;
+    pmrun_options_default(&o);
+    o.format = PMRUN_FORMAT_MMT;
+    expect_error("nina_jnow.csv", &o, 6,
+                 "read as an MMT pointing log (format forced: mmt): line "
+                 "'LST;RA;Dec;SolvedRA;SolvedDec;SideOfPier' is not 'KEY: values'");
+    o.format = PMRUN_FORMAT_CSV;
+    expect_error("rts2_gpoint.dat", &o, 7,
+                 "read as a N.I.N.A./ASCOM-style CSV log (format forced: csv): no mount RA column");
+    o.format = PMRUN_FORMAT_MW4;
+    expect_error("mmt_log.dat", &o, 1, "read as a MountWizzard4 model file (JSON) (format forced: "
+                                       "mw4): '# MMT mount ' is not a JSON value");
+    o.format = 9;
+    {
+        char path[4096];
+        data_path(path, sizeof path, "mmt_log.dat");
+        tu_read_fails(path, &o, PMRUN_ERR_ARG, 0, "options.format 9 is not a format");
+    }
+}
+END_TEST
+
+START_TEST(test_pmrun_read_wrong_guess_names_the_format)
+{
+    /* a delimited header without the CSV names: read as a column file,
+    ** and the message says so and why */
+    char tmp[] = "/tmp/pm_formats_XXXXXX";
+    int fd = mkstemp(tmp);
+    static const char text[] = "# equinox: JNow\nLST,Mount Alpha,Mount Delta,Sol Alpha,Sol Delta\n"
+                               "1,2,3,4,5\n";
+    ck_assert_int_ge(fd, 0);
+    ck_assert_int_eq(write(fd, text, sizeof text - 1), (long)(sizeof text - 1));
+    close(fd);
+    tu_read_fails(tmp, NULL, PMRUN_ERR_FORMAT, 2,
+                  "read as a four-column or named-column file (line 2 has ',' or ';' but is not a "
+                  "CSV header naming the mount's and the solved RA and Dec)");
+    unlink(tmp);
+}
+END_TEST
+
+/* ------------------------------------------------------------ samples */
+
+START_TEST(test_pmrun_read_rts2_same_as_source)
+{
+    same_records("rts2_gpoint.dat", "formats_source_eq.dat", NULL, TOL_SAME_RAD, 1);
+    same_records("rts2_altaz.dat", "formats_source_altaz.dat", NULL, TOL_SAME_RAD, 1);
+}
+END_TEST
+
+START_TEST(test_pmrun_read_rts2_j2000_reduced_with_equinox_option)
+{
+    pmrun_options o;
+    pmrun *run;
+    pmrun_options_default(&o);
+    o.equinox = PMRUN_EQUINOX_J2000;
+    same_records("rts2_gpoint_j2000.dat", "formats_source_eq.dat", &o, TOL_J2000_RAD, 1);
+    /* without the option the places are taken as they are (gpoint's way):
+    ** 24 years of precession and the refraction away from the source */
+    run = read_ok("rts2_gpoint_j2000.dat");
+    ck_assert(fabs(pmrun_get(run, 0)->app_dec - 63.975098125 * DEG) > 60 * AS);
+    pmrun_free(run);
+}
+END_TEST
+
+START_TEST(test_pmrun_read_mw4_same_as_source)
+{
+    pmrun *run;
+    same_records("mw4_model.json", "formats_source_eq.dat", NULL, TOL_SAME_RAD, 1);
+    run = read_ok("mw4_model.json");
+    ck_assert_int_eq(pmrun_n_aux(run), 2);
+    ck_assert_str_eq(pmrun_aux_name(run, 0), "angularPosRA");
+    ck_assert(fabs(pmrun_latitude_rad(run) - 47 * DEG) < 1e-12);
+    ck_assert_int_eq(pmrun_get(run, 0)->line, 2);
+    pmrun_free(run);
+}
+END_TEST
+
+START_TEST(test_pmrun_read_csv_same_as_source)
+{
+    pmrun *run;
+    same_records("nina_jnow.csv", "formats_source_eq.dat", NULL, TOL_SAME_RAD, 0);
+    same_records("nina_j2000.csv", "formats_source_eq.dat", NULL, TOL_J2000_RAD, 1);
+    run = read_ok("nina_j2000.csv");
+    ck_assert(fabs(pmrun_get(run, 0)->temp_c - 12.01) < 1e-12);
+    /* the unused 'Target' column is named in a warning, not dropped silently */
+    ck_assert_int_ge(pmrun_n_warnings(run), 1);
+    ck_assert_ptr_nonnull(strstr(pmrun_warning(run, 0), "column 'Target' not used"));
+    pmrun_free(run);
+}
+END_TEST
+
+START_TEST(test_pmrun_read_csv_equinox_option_overrides)
+{
+    pmrun_options o;
+    pmrun *a, *b;
+    pmrun_options_default(&o);
+    o.equinox = PMRUN_EQUINOX_J2000; /* the JNow file (LST, no times) as J2000 */
+    expect_error("nina_jnow.csv", &o, 7, "J2000 places need the UTC time of the row");
+    a = read_opt("nina_j2000.csv", NULL);
+    /* the J2000 file's places taken as JNow: 24 years of precession, far
+    ** more than the samples' agreement */
+    o.equinox = PMRUN_EQUINOX_JNOW; /* the J2000 file's places taken as JNow */
+    o.refraction = 1;
+    b = read_opt("nina_j2000.csv", &o);
+    ck_assert(fabs(pmrun_get(a, 0)->app_dec - pmrun_get(b, 0)->app_dec) > 60 * AS);
+    pmrun_free(a);
+    pmrun_free(b);
+}
+END_TEST
+
+START_TEST(test_pmrun_read_mmt_same_as_source)
+{
+    same_records("mmt_log.dat", "formats_source_altaz.dat", NULL, TOL_SAME_RAD, 0);
+}
+END_TEST
+
+/* ---------------------------------------------------------------- fit */
+
+static void fit_matches(const char *name, const char *source, const double truth[6],
+                        const char *args)
+{
+    char a[16384], b[16384];
+    int k;
+    ck_assert_int_eq(pmfit_json(name, args, a, sizeof a), 0);
+    ck_assert_int_eq(pmfit_json(source, "--order 0", b, sizeof b), 0);
+    for (k = 0; k < 6; ++k) {
+        double v = term_value(a, kIso[k]), s = term_value(b, kIso[k]), e = term_error(a, kIso[k]);
+        ck_assert_msg(fabs(v - s) < TOL_FIT_SAME_AS, "%s: %s = %.5f\", source %.5f\"", name, kIso[k],
+                      v, s);
+        ck_assert_msg(fabs(v - truth[k]) < 4 * e + TOL_FIT_TRUTH_AS,
+                      "%s: %s = %.4f +- %.4f\", true %.4f\"", name, kIso[k], v, e, truth[k]);
+    }
+}
+
+/* The terms of the pmfit simulate commands in the sources' first lines. */
+static const double kTruthEq[6] = {40, -25, 120, 18, -35, 22};
+static const double kTruthAz[6] = {30, 15, -200, 12, 25, -18};
+
+START_TEST(test_sources_are_the_simulations_named)
+{
+    char path[4096], line[1024];
+    FILE *f;
+    data_path(path, sizeof path, "formats_source_eq.dat");
+    f = fopen(path, "r");
+    ck_assert_ptr_nonnull(f);
+    ck_assert_ptr_nonnull(fgets(line, sizeof line, f));
+    fclose(f);
+    ck_assert_ptr_nonnull(strstr(line, "--order 0 --term a=40 --term b=-25 --term c'=120 --term d=18 "
+                                       "--term e'=-35 --term i=22 --noise 0.5"));
+    data_path(path, sizeof path, "formats_source_altaz.dat");
+    f = fopen(path, "r");
+    ck_assert_ptr_nonnull(f);
+    ck_assert_ptr_nonnull(fgets(line, sizeof line, f));
+    fclose(f);
+    ck_assert_ptr_nonnull(strstr(line, "--mount altaz --order 0 --term a=30 --term b=15 --term "
+                                       "c'=-200 --term d=12 --term e'=25 --term i=-18 --noise 0.5"));
+}
+END_TEST
+
+START_TEST(test_pmfit_fits_rts2) { fit_matches("rts2_gpoint.dat", "formats_source_eq.dat", kTruthEq, "--order 0"); }
+END_TEST
+
+START_TEST(test_pmfit_fits_rts2_j2000)
+{
+    fit_matches("rts2_gpoint_j2000.dat", "formats_source_eq.dat", kTruthEq,
+                "--order 0 --equinox J2000");
+}
+END_TEST
+
+START_TEST(test_pmfit_fits_rts2_altaz)
+{
+    fit_matches("rts2_altaz.dat", "formats_source_altaz.dat", kTruthAz, "--order 0");
+}
+END_TEST
+
+START_TEST(test_pmfit_fits_mw4) { fit_matches("mw4_model.json", "formats_source_eq.dat", kTruthEq, "--order 0"); }
+END_TEST
+
+START_TEST(test_pmfit_fits_csv_j2000)
+{
+    fit_matches("nina_j2000.csv", "formats_source_eq.dat", kTruthEq, "--order 0");
+}
+END_TEST
+
+START_TEST(test_pmfit_fits_csv_jnow)
+{
+    fit_matches("nina_jnow.csv", "formats_source_eq.dat", kTruthEq, "--order 0 --format csv");
+}
+END_TEST
+
+START_TEST(test_pmfit_fits_mmt) { fit_matches("mmt_log.dat", "formats_source_altaz.dat", kTruthAz, "--order 0"); }
+END_TEST
+
+START_TEST(test_pmfit_format_option_errors)
+{
+    char out[4096], cmd[4096], path[2048];
+    data_path(path, sizeof path, "mmt_log.dat");
+    snprintf(cmd, sizeof cmd, "%s fit %s --format tpont", tu_pmfit_path(), path);
+    ck_assert_int_eq(tu_capture(cmd, out, sizeof out), 2);
+    ck_assert_ptr_nonnull(strstr(out, "--format: expected auto, four-column, named, tpoint, rts2, "
+                                      "mw4, csv or mmt, got 'tpont'"));
+    snprintf(cmd, sizeof cmd, "%s fit %s --equinox B1950", tu_pmfit_path(), path);
+    ck_assert_int_eq(tu_capture(cmd, out, sizeof out), 2);
+    ck_assert_ptr_nonnull(strstr(out, "--equinox: expected J2000 or JNow, got 'B1950'"));
+    snprintf(cmd, sizeof cmd, "%s fit %s --format rts2", tu_pmfit_path(), path);
+    ck_assert_int_eq(tu_capture(cmd, out, sizeof out), 1);
+    ck_assert_ptr_nonnull(strstr(out, "read as an RTS2 gpoint input file (format forced: rts2)"));
+}
+END_TEST
+
+/* ------------------------------------------------------------- errors */
+
+START_TEST(test_pmrun_read_bad_rts2)
+{
+    expect_error("bad_rts2_fields.dat", NULL, 4,
+                 "read as an RTS2 gpoint input file (its '#' line 1 is an RTS2 gpoint header): 8 "
+                 "fields, expected 9: observation id, MJD, LST, mount RA, Dec");
+    expect_error("bad_rts2_latitude.dat", NULL, 2,
+                 "'#observatory' latitude 95.0 is beyond +-90 deg, expected -90..+90");
+    expect_error("bad_rts2_true_dec.dat", NULL, 3,
+                 "field 9 (DEC-TRUE) '95.5': beyond +-90 deg, expected the star's declination");
+}
+END_TEST
+
+START_TEST(test_pmrun_read_bad_mw4)
+{
+    pmrun_options o;
+    expect_error("bad_mw4_syntax.json", NULL, 5,
+                 "read as a MountWizzard4 model file (JSON) (line 1 starts with '['): expected ',' "
+                 "or '}' after a value in an object");
+    expect_error("bad_mw4_missing_key.json", NULL, 2, "point has no 'raJNowS', expected raJNowM");
+    expect_error("bad_mw4_pierside.json", NULL, 2, "'pierside' missing or not \"E\"/\"W\"");
+    expect_error("bad_mw4_not_list.json", NULL, 1,
+                 "the JSON value is not a list, expected a list of points");
+    pmrun_options_default(&o);
+    o.equinox = PMRUN_EQUINOX_J2000;
+    expect_error("mw4_model.json", &o, 0, "MW4 files are read through their JNow places");
+}
+END_TEST
+
+START_TEST(test_pmrun_read_bad_csv)
+{
+    expect_error("bad_csv_no_equinox.csv", NULL, 2,
+                 "read as a N.I.N.A./ASCOM-style CSV log (line 2 is a header of delimited names "
+                 "with RA and Dec): the equinox of the RA/Dec columns is not stated");
+    expect_error("bad_csv_missing_column.csv", NULL, 3, "no solved Dec column in the header");
+    expect_error("bad_csv_ra_range.csv", NULL, 5,
+                 "field 2 (mount RA) '25:00:00': out of range, expected 0 <= hours < 24");
+    expect_error("bad_csv_time.csv", NULL, 5,
+                 "field 1 (time) '2024-02-30T20:00:00Z': not a valid date and time");
+    expect_error("bad_csv_pier.csv", NULL, 4, "field 6 (pier side) 'pierUnknown': unknown side");
+    expect_error("bad_csv_quote.csv", NULL, 4, "a quoted field not closed by '\"'");
+    expect_error("bad_csv_no_lst.csv", NULL, 3,
+                 "no LST column and no '# longitude:': the hour angles need the sidereal time");
+}
+END_TEST
+
+START_TEST(test_pmrun_read_bad_mmt)
+{
+    expect_error("bad_mmt_no_taa.dat", NULL, 5,
+                 "read as an MMT pointing log (line 1 starts with 'CAT:'): the star's block (CAT: "
+                 "at line 5) has no TAA: line");
+    expect_error("bad_mmt_elevation.dat", NULL, 3,
+                 "TAA: elevation '97.3484799' beyond +-90 deg, expected the observed elevation");
+    expect_error("bad_mmt_twice.dat", NULL, 3,
+                 "second RAA: line in the star's block (the first at line 2), expected one per star");
+}
+END_TEST
+
+START_TEST(test_pmrun_read_skip_bad_lists_skipped)
+{
+    pmrun_options o;
+    pmrun *run;
+    pmrun_options_default(&o);
+    o.skip_bad = 1;
+    run = read_opt("bad_mmt_no_taa.dat", &o);
+    ck_assert_uint_eq(pmrun_count(run), 1);
+    ck_assert_int_eq(pmrun_n_skipped(run), 1);
+    ck_assert_ptr_nonnull(strstr(pmrun_skipped(run, 0), "bad_mmt_no_taa.dat:5: skipped: the star's "
+                                                        "block (CAT: at line 5) has no TAA: line"));
+    pmrun_free(run);
+    run = read_opt("bad_csv_ra_range.csv", &o);
+    ck_assert_uint_eq(pmrun_count(run), 1);
+    ck_assert_int_eq(pmrun_n_skipped(run), 1);
+    ck_assert_ptr_nonnull(strstr(pmrun_skipped(run, 0), ":5: skipped: field 2 (mount RA)"));
+    pmrun_free(run);
+}
+END_TEST
+
+/* ------------------------------------------------------------- export */
+
+/* The TPOINT first-order formulas (tpointterms.h, docs/formats.md), written
+** here from the published form, independent of the export code: the true
+** place of raw (h, d) at latitude phi. */
+static void tpoint_true(const double v[8], double phi, double h, double d, double *ht, double *dt)
+{
+    double ih = v[0], id = v[1], np = v[2], ch = v[3], ma = v[4], me = v[5], tf = v[6], tx = v[7];
+    double sd = sin(d), cd = cos(d), sh = sin(h), chh = cos(h), td = sd / cd;
+    double sel = sin(phi) * sd + cos(phi) * cd * chh;
+    double z = tf + tx / sel;
+    double dh = -ih - ch / cd - np * td + ma * chh * td - me * sh * td - z * cos(phi) * sh / cd;
+    double dd = -id - ma * sh - me * chh - z * (cos(phi) * chh * sd - sin(phi) * cd);
+    *ht = h + dh;
+    *dt = d + dd;
+}
+
+static double sep(double h1, double d1, double h2, double d2)
+{
+    double x1 = cos(d1) * cos(h1), y1 = cos(d1) * sin(h1), z1 = sin(d1);
+    double x2 = cos(d2) * cos(h2), y2 = cos(d2) * sin(h2), z2 = sin(d2);
+    double cx = y1 * z2 - z1 * y2, cy = z1 * x2 - x1 * z2, cz = x1 * y2 - y1 * x2;
+    return atan2(sqrt(cx * cx + cy * cy + cz * cz), x1 * x2 + y1 * y2 + z1 * z2);
+}
+
+/* A model of random isotropic terms, tube flexure and cot(el) of up to
+** `size` arcsec; the largest difference (arcsec) between pm_model_apply
+** and the TPOINT formulas with the exported values at 4000 places (both
+** sides, |dec| <= 75, el >= 20); flip: the sign of one exported value
+** turned (a negative control). */
+static double worst_first_order(double size, unsigned seed, int flip)
+{
+    pm_model m;
+    pm_term t;
+    pmtp_term named[PMTP_MAX_NAMED];
+    double v[8] = {0, 0, 0, 0, 0, 0, 0, 0}, worst = 0, phi = 47 * DEG;
+    static const char *const names[8] = {"IH", "ID", "NP", "CH", "MA", "ME", "TF", "TX"};
+    int n = 0, k, j, done = 0;
+    srand(seed);
+    ck_assert_int_eq(pm_model_init(&m, PM_MOUNT_EQUATORIAL, 0), PM_OK);
+    m.latitude = phi;
+    /* each of size/2..size, either sign (none negligible: the negative
+    ** control turns each one) */
+#define RANDOM_COEF() (size * AS * (0.5 + 0.5 * rand() / RAND_MAX) * (rand() % 2 ? 1.0 : -1.0))
+    for (k = 0; k < 6; ++k) m.coef[k] = RANDOM_COEF();
+    memset(&t, 0, sizeof t);
+    t.kind = PM_TERM_ZENITH;
+    t.l = 1;
+    ck_assert_int_eq(pm_model_add_term(&m, &t, RANDOM_COEF(), NULL), PM_OK);
+    t.l = 0;
+    ck_assert_int_eq(pm_model_add_term(&m, &t, RANDOM_COEF(), NULL), PM_OK);
+    ck_assert_int_eq(pm_model_prepare(&m), PM_OK);
+    ck_assert_int_eq(pmtp_terms(&m, NULL, named, &n), 0);
+    ck_assert_int_eq(n, 8);
+    for (k = 0; k < n; ++k) {
+        ck_assert_str_eq(named[k].name, names[k]);
+        v[k] = named[k].value_arcsec * AS;
+    }
+    if (flip >= 0) v[flip] = -v[flip];
+    while (done < 4000) {
+        double h = PI * (2.0 * rand() / RAND_MAX - 1.0), d = 75 * DEG * (2.0 * rand() / RAND_MAX - 1.0);
+        double el = asin(sin(phi) * sin(d) + cos(phi) * cos(d) * cos(h));
+        double eh = h, ed = d, ah, ad, th, td, s;
+        if (el < 20 * DEG) continue;
+        if (done % 2) { /* beyond the pole: the same place, the other side */
+            eh = remainder(h + PI, 2 * PI);
+            ed = PI - d;
+        }
+        ck_assert_int_eq(pm_model_apply(&m, NULL, eh, ed, &ah, &ad), PM_OK);
+        tpoint_true(v, phi, eh, ed, &th, &td);
+        s = sep(ah, ad, th, td) / AS;
+        if (s > worst) worst = s;
+        ++done;
+    }
+    (void)j;
+    return worst;
+}
+
+START_TEST(test_pmtp_terms_first_order_agree_with_pm)
+{
+    double big = worst_first_order(20.0, 11, -1), small = worst_first_order(2.0, 11, -1);
+    int k;
+    fprintf(stderr, "check_formats: TPOINT first-order formulas vs pm_model_apply: worst %.4f\" "
+                    "with 10-20\" terms, %.6f\" with 1-2\" terms\n",
+            big, small);
+    ck_assert_msg(big < TOL_FIRST_ORDER_AS, "TPOINT formulas vs pm: %.4g arcsec at 20\" terms", big);
+    /* the difference is second order: 10x smaller terms, ~100x smaller */
+    ck_assert_msg(big / small > 50, "not second order: %.4g\" at 20\", %.4g\" at 2\"", big, small);
+    /* and the test can fail: any one sign turned is off by tens of arcsec */
+    for (k = 0; k < 8; ++k) {
+        double w = worst_first_order(20.0, 11, k);
+        ck_assert_msg(w > 1.0, "term %d with its sign turned still agrees (%.3g\")", k, w);
+    }
+}
+END_TEST
+
+START_TEST(test_pmtp_terms_args_and_altaz)
+{
+    pm_model m;
+    pmtp_term named[PMTP_MAX_NAMED];
+    int n = -1;
+    char err[512];
+    ck_assert_int_eq(pm_model_init(&m, PM_MOUNT_ALTAZ, 0), PM_OK);
+    ck_assert_int_eq(pmtp_terms(&m, NULL, named, &n), -1);
+    ck_assert_int_eq(pmtp_terms(NULL, NULL, named, &n), -1);
+    ck_assert_int_eq(pmtp_write("/tmp/pm_formats_never.tpm", &m, NULL, NULL, err, sizeof err), -1);
+    ck_assert_ptr_nonnull(strstr(err, "TPOINT terms are written for equatorial models only"));
+    ck_assert_int_eq(access("/tmp/pm_formats_never.tpm", F_OK), -1);
+}
+END_TEST
+
+START_TEST(test_pmfit_tpoint_terms_file)
+{
+    char dir[64], file[128], cmd[4096], out[16384], path[2048], text[8192];
+    FILE *f;
+    size_t n;
+    double c, e, i_, a, b, d;
+    tu_tmpdir(dir, "pm_formats_");
+    snprintf(file, sizeof file, "%s/model.tpm", dir);
+    data_path(path, sizeof path, "formats_source_eq.dat");
+    snprintf(cmd, sizeof cmd, "%s fit %s --order 1 --tpoint-terms %s --json", tu_pmfit_path(), path,
+             file);
+    ck_assert_int_eq(tu_capture(cmd, out, sizeof out), 0);
+    f = fopen(file, "r");
+    ck_assert_ptr_nonnull(f);
+    n = fread(text, 1, sizeof text - 1, f);
+    text[n] = 0;
+    fclose(f);
+    c = term_value(out, "c'"), e = term_value(out, "e'"), i_ = term_value(out, "i");
+    a = term_value(out, "a"), b = term_value(out, "b"), d = term_value(out, "d");
+    {
+        const char *names[6] = {"IH", "ID", "NP", "CH", "MA", "ME"};
+        double want[6];
+        int k;
+        want[0] = -c, want[1] = e, want[2] = d, want[3] = -i_, want[4] = -a, want[5] = b;
+        for (k = 0; k < 6; ++k) {
+            char pat[16];
+            const char *p;
+            snprintf(pat, sizeof pat, "     %-4s ", names[k]);
+            p = strstr(text, pat);
+            ck_assert_msg(p != NULL, "no %s in %s", names[k], text);
+            ck_assert_msg(fabs(atof(p + strlen(pat)) - want[k]) < 1e-4, "%s %.5f, want %.5f",
+                          names[k], atof(p + strlen(pat)), want[k]);
+        }
+    }
+    ck_assert_ptr_nonnull(strstr(text, "\nEND\n"));
+    /* the order-1 harmonics: listed apart, and said so */
+    ck_assert_ptr_nonnull(strstr(text, "! Terms of the model with no TPOINT name"));
+    ck_assert_ptr_nonnull(strstr(text, "!   a*Y(1,-1) "));
+    unlink(file);
+    /* an alt-az run: the fit is reported, the file refused, exit 1 */
+    data_path(path, sizeof path, "mmt_log.dat");
+    snprintf(cmd, sizeof cmd, "%s fit %s --order 0 --tpoint-terms %s", tu_pmfit_path(), path, file);
+    ck_assert_int_eq(tu_capture(cmd, out, sizeof out), 1);
+    ck_assert_ptr_nonnull(strstr(out, "unbiased sigma"));
+    ck_assert_ptr_nonnull(strstr(out, "TPOINT terms are written for equatorial models only"));
+    ck_assert_int_eq(access(file, F_OK), -1);
+    rmdir(dir);
+}
+END_TEST
+
+/* ----------------------------------------------------------- realdata */
+
+static int mmt_paths(char *log, char *tp, size_t n)
+{
+    const char *d = getenv("PM_DATA_DIR");
+    snprintf(log, n, "%s/mmt/point_20210821.dat", d && *d ? d : "../shared/data");
+    snprintf(tp, n, "%s/mmt/k_and_e.dat", d && *d ? d : "../shared/data");
+    return access(log, R_OK) == 0 && access(tp, R_OK) == 0;
+}
+
+static void fit_file(const char *path, char *out, size_t len)
+{
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd, "%s fit %s --order 1 --json 2>/dev/null", tu_pmfit_path(), path);
+    ck_assert_int_eq(tu_capture(cmd, out, len), 0);
+}
+
+START_TEST(test_mmt_log_fits_as_its_tpoint_conversion)
+{
+    char log[4096], tp[4096], shifted[64], a[16384], b[16384], c[16384];
+    FILE *in, *out;
+    char line[512];
+    int k;
+    if (!mmt_paths(log, tp, sizeof log)) {
+        fprintf(stderr, "check_formats: skipped the MMT log test (no %s)\n", log);
+        return;
+    }
+    fit_file(log, a, sizeof a);
+    fit_file(tp, b, sizeof b);
+    /* the log with the conversion's -5.9" on the observed elevation */
+    snprintf(shifted, sizeof shifted, "/tmp/pm_formats_mmt_%d.dat", (int)getpid());
+    in = fopen(log, "r");
+    out = fopen(shifted, "w");
+    ck_assert(in && out);
+    while (fgets(line, sizeof line, in)) {
+        double el, az;
+        if (strncmp(line, "TAA:", 4) == 0 && sscanf(line + 4, "%lf %lf", &el, &az) == 2)
+            fprintf(out, "TAA: %.10f %.7f\n", el - 5.9 / 3600.0, az);
+        else
+            fputs(line, out);
+    }
+    fclose(in);
+    fclose(out);
+    fit_file(shifted, c, sizeof c);
+    unlink(shifted);
+    ck_assert_int_eq((int)tu_json_num(a, "n_obs"), 80);
+    for (k = 0; k < 6; ++k) {
+        double va = term_value(a, kIso[k]), vb = term_value(b, kIso[k]), vc = term_value(c, kIso[k]);
+        if (k == 4)
+            ck_assert_msg(fabs((va - vb) + 5.9) < TOL_MMT_EL_OFFSET_AS, "e': log %.4f, TPOINT %.4f", va,
+                          vb);
+        else
+            ck_assert_msg(fabs(va - vb) < TOL_MMT_SECOND_ORDER_AS, "%s: log %.4f, TPOINT %.4f",
+                          kIso[k], va, vb);
+        ck_assert_msg(fabs(vc - vb) < TOL_MMT_SAME_AS, "%s: shifted log %.5f, TPOINT %.5f", kIso[k],
+                      vc, vb);
+    }
+    ck_assert(fabs(tu_json_num(c, "sigma_arcsec") - tu_json_num(b, "sigma_arcsec")) < TOL_MMT_SAME_AS);
+}
+END_TEST
+
+static Suite *formats_suite(void)
+{
+    Suite *s = suite_create("formats");
+    TCase *tc = tcase_create("detect");
+    tcase_add_test(tc, test_pmrun_options_default_format_equinox);
+    tcase_add_test(tc, test_pmrun_format_names_round_trip);
+    tcase_add_test(tc, test_pmrun_read_detects_each_format);
+    tcase_add_test(tc, test_pmrun_read_forced_format_is_used);
+    tcase_add_test(tc, test_pmrun_read_forced_wrong_format_names_it);
+    tcase_add_test(tc, test_pmrun_read_wrong_guess_names_the_format);
+    suite_add_tcase(s, tc);
+    tc = tcase_create("samples");
+    tcase_add_test(tc, test_pmrun_read_rts2_same_as_source);
+    tcase_add_test(tc, test_pmrun_read_rts2_j2000_reduced_with_equinox_option);
+    tcase_add_test(tc, test_pmrun_read_mw4_same_as_source);
+    tcase_add_test(tc, test_pmrun_read_csv_same_as_source);
+    tcase_add_test(tc, test_pmrun_read_csv_equinox_option_overrides);
+    tcase_add_test(tc, test_pmrun_read_mmt_same_as_source);
+    suite_add_tcase(s, tc);
+    tc = tcase_create("fit");
+    tcase_set_timeout(tc, 120);
+    tcase_add_test(tc, test_sources_are_the_simulations_named);
+    tcase_add_test(tc, test_pmfit_fits_rts2);
+    tcase_add_test(tc, test_pmfit_fits_rts2_j2000);
+    tcase_add_test(tc, test_pmfit_fits_rts2_altaz);
+    tcase_add_test(tc, test_pmfit_fits_mw4);
+    tcase_add_test(tc, test_pmfit_fits_csv_j2000);
+    tcase_add_test(tc, test_pmfit_fits_csv_jnow);
+    tcase_add_test(tc, test_pmfit_fits_mmt);
+    tcase_add_test(tc, test_pmfit_format_option_errors);
+    suite_add_tcase(s, tc);
+    tc = tcase_create("errors");
+    tcase_add_test(tc, test_pmrun_read_bad_rts2);
+    tcase_add_test(tc, test_pmrun_read_bad_mw4);
+    tcase_add_test(tc, test_pmrun_read_bad_csv);
+    tcase_add_test(tc, test_pmrun_read_bad_mmt);
+    tcase_add_test(tc, test_pmrun_read_skip_bad_lists_skipped);
+    suite_add_tcase(s, tc);
+    tc = tcase_create("export");
+    tcase_set_timeout(tc, 120);
+    tcase_add_test(tc, test_pmtp_terms_first_order_agree_with_pm);
+    tcase_add_test(tc, test_pmtp_terms_args_and_altaz);
+    tcase_add_test(tc, test_pmfit_tpoint_terms_file);
+    suite_add_tcase(s, tc);
+    tc = tcase_create("realdata");
+    tcase_set_timeout(tc, 120);
+    tcase_add_test(tc, test_mmt_log_fits_as_its_tpoint_conversion);
+    suite_add_tcase(s, tc);
+    return s;
+}
+
+int main(void)
+{
+    SRunner *sr = srunner_create(formats_suite());
+    int failed;
+    srunner_run_all(sr, CK_NORMAL);
+    failed = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+}

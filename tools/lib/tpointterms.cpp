@@ -1,0 +1,120 @@
+// tpointterms.cpp - a fitted equatorial model as a TPOINT-style term list
+// (tpointterms.h; docs/formats.md, "TPOINT term export").
+#include "tpointterms.h"
+
+#include "fitrun.hpp"
+#include "hostutil.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <string>
+
+namespace {
+
+const double kAs = 206264.80624709636;   // arcsec per radian
+
+struct Map {
+    const char *name;
+    int k;          // base vector of an isotropic term (0: a zenith term)
+    int zenith_l;   // for zenith terms: 1 cos(el) (TF), 0 cot(el) (TX)
+    double sign;    // TPOINT value = sign * pm coefficient
+};
+
+// From the first-order forms (tpointterms.h): IH = -c', ID = e', NP = d,
+// CH = -i, MA = -a, ME = b, TF = tube flexure, TX = cot(el) term.
+const Map kMap[PMTP_MAX_NAMED] = {
+    {"IH", PM_BASE_C, -1, -1.0}, {"ID", PM_BASE_E, -1, 1.0}, {"NP", PM_BASE_D, -1, 1.0},
+    {"CH", PM_BASE_I, -1, -1.0}, {"MA", PM_BASE_A, -1, -1.0}, {"ME", PM_BASE_B, -1, 1.0},
+    {"TF", 0, 1, 1.0},           {"TX", 0, 0, 1.0}};
+
+// Index of the term a map entry names, -1 if the model has none.
+int find(const pm_model *m, const Map &e)
+{
+    for (int i = 0; i < m->n_terms; ++i) {
+        const pm_term &t = m->term[i];
+        if (e.k && i < m->n_base && t.kind == PM_TERM_SH && t.k == e.k && t.l == 0 && t.m == 0)
+            return i;
+        if (!e.k && t.kind == PM_TERM_ZENITH && t.l == e.zenith_l && t.side == 0) return i;
+    }
+    return -1;
+}
+
+}  // namespace
+
+extern "C" int pmtp_terms(const pm_model *m, const double *err_rad, pmtp_term *named, int *n_named)
+{
+    if (!m || !named || !n_named || m->mount != PM_MOUNT_EQUATORIAL) return -1;
+    int n = 0;
+    for (const Map &e : kMap) {
+        int i = find(m, e);
+        if (i < 0) continue;
+        pmtp_term &t = named[n++];
+        std::memset(&t, 0, sizeof t);
+        std::snprintf(t.name, sizeof t.name, "%s", e.name);
+        t.value_arcsec = e.sign * m->coef[i] * kAs;
+        t.error_arcsec = err_rad ? err_rad[i] * kAs : std::nan("");
+        t.pm_index = i;
+    }
+    *n_named = n;
+    return 0;
+}
+
+extern "C" int pmtp_write(const char *path, const pm_model *m, const double *err_rad,
+                          const char *caption, char *err, size_t errlen)
+{
+    if (!path || !m) {
+        if (err && errlen) std::snprintf(err, errlen, "pmtp_write: NULL argument");
+        return -1;
+    }
+    pmtp_term named[PMTP_MAX_NAMED];
+    int n = 0;
+    if (pmtp_terms(m, err_rad, named, &n) != 0) {
+        if (err && errlen)
+            std::snprintf(err, errlen, "%s: TPOINT terms are written for equatorial models only "
+                                       "(TPOINT's alt-az terms IA IE CA NPAE AN AW are not "
+                                       "exported; docs/formats.md)",
+                          path);
+        return -1;
+    }
+    std::string text =
+        "! TPOINT-style term list written by pmfit (docs/formats.md, \"TPOINT term export\").\n"
+        "! Values in arcsec; true = raw + (dh, dd) with h, d the raw hour angle and dec:\n"
+        "!   dh = -IH - CH sec d - NP tan d + MA cos h tan d - ME sin h tan d\n"
+        "!        - (TF + TX / sin el) cos phi sin h sec d\n"
+        "!   dd = -ID - MA sin h - ME cos h - (TF + TX / sin el) (cos phi cos h sin d - sin phi cos d)\n"
+        "! Check the signs against your TPOINT's own term definitions (docs/formats.md).\n";
+    std::string cap = caption ? caption : "pmfit model";
+    for (char &c : cap)
+        if (c == '\n' || c == '\r') c = ' ';
+    text += cap + "\n";
+    char buf[160];
+    for (int k = 0; k < n; ++k) {
+        if (std::isnan(named[k].error_arcsec))
+            std::snprintf(buf, sizeof buf, "     %-4.7s %14.4f\n", named[k].name, named[k].value_arcsec);
+        else
+            std::snprintf(buf, sizeof buf, "     %-4.7s %14.4f %10.4f\n", named[k].name,
+                          named[k].value_arcsec, named[k].error_arcsec);
+        text += buf;
+    }
+    text += "END\n";
+    std::string rest;
+    for (int i = 0; i < m->n_terms; ++i) {
+        bool is_named = false;
+        for (int k = 0; k < n; ++k) is_named = is_named || named[k].pm_index == i;
+        if (is_named) continue;
+        double e = err_rad ? err_rad[i] * kAs : std::nan("");
+        if (std::isnan(e))
+            std::snprintf(buf, sizeof buf, "!   %-22s %14.4f\n", pmhost::term_name(*m, i).c_str(),
+                          m->coef[i] * kAs);
+        else
+            std::snprintf(buf, sizeof buf, "!   %-22s %14.4f %10.4f\n",
+                          pmhost::term_name(*m, i).c_str(), m->coef[i] * kAs, e);
+        rest += buf;
+    }
+    if (!rest.empty())
+        text += "! Terms of the model with no TPOINT name (pm names, arcsec; docs/model.md). They\n"
+                "! are part of the fitted model: the TPOINT terms above alone are not the model.\n" +
+                rest;
+    return pmhost::write_atomic(path, text, err, errlen);
+}
