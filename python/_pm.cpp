@@ -25,6 +25,9 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <system_error>
+#include <thread>
+#include <utility>
 #include <vector>
 
 namespace py = pybind11;
@@ -202,6 +205,51 @@ template <class T> py::array_t<T> copy_out(const std::vector<T> &v)
     return a;
 }
 
+// Points per thread below which more threads do not pay for their start.
+const long MIN_POINTS_PER_THREAD = 1L << 15;
+
+// body(i) for every point i in [0, n), without the GIL, on up to `threads`
+// threads (0: as many as the machine has) in contiguous chunks; each chunk
+// stops at its first error (a negative status).  Returns the first failing
+// index of all (the lowest) and its status, or (-1, PM_OK).  The points are
+// independent, so the results do not depend on the number of threads.
+template <class F> std::pair<long, pm_status> for_points(long n, int threads, const F &body)
+{
+    py::gil_scoped_release nogil;
+    long t = threads > 0 ? threads : (long)std::thread::hardware_concurrency();
+    t = std::max(1L, std::min({t, n / MIN_POINTS_PER_THREAD, 64L}));
+    std::vector<long> bad((size_t)t, -1);
+    std::vector<pm_status> st((size_t)t, PM_OK);
+    auto chunk = [&](long k) {
+        long lo = n * k / t, hi = n * (k + 1) / t;
+        for (long i = lo; i < hi; i++) {
+            pm_status s = body(i);
+            if (s < 0) {
+                bad[(size_t)k] = i, st[(size_t)k] = s;
+                return;
+            }
+        }
+    };
+    std::vector<std::thread> pool;
+    std::vector<long> here; // chunks no thread could be started for
+    for (long k = 1; k < t; k++) {
+        try {
+            pool.emplace_back(chunk, k);
+        } catch (const std::system_error &) {
+            here.push_back(k);
+        }
+    }
+    chunk(0);
+    for (long k : here)
+        chunk(k);
+    for (std::thread &th : pool)
+        th.join();
+    for (long k = 0; k < t; k++)
+        if (bad[(size_t)k] >= 0)
+            return {bad[(size_t)k], st[(size_t)k]};
+    return {-1, PM_OK};
+}
+
 // ---------------------------------------------------------------------------
 // Model.
 
@@ -268,6 +316,27 @@ struct Model {
         m = t;
     }
 
+    // Which context inputs the terms read: (temp_c, time_h, dir, [aux j]).
+    py::tuple inputs_needed() const
+    {
+        bool temp = false, time = false, dir = false;
+        std::vector<int> aux;
+        for (int i = 0; i < m.n_terms; i++) {
+            const pm_term &t = m.term[i];
+            if (t.kind != PM_TERM_AUX)
+                continue;
+            if (t.aux == PM_AUX_TEMP)
+                temp = true;
+            else if (t.aux == PM_AUX_TIME)
+                time = true;
+            else if (t.aux == PM_AUX_DIR)
+                dir = true;
+            else if (std::find(aux.begin(), aux.end(), t.aux - PM_AUX_USER) == aux.end())
+                aux.push_back(t.aux - PM_AUX_USER);
+        }
+        return py::make_tuple(temp, time, dir, aux);
+    }
+
     py::list terms() const
     {
         py::list l;
@@ -314,7 +383,7 @@ struct Model {
     // Forward model over arrays; the first failing point raises.
     py::tuple apply(darr ha, darr dec, std::optional<iarr> pier, std::optional<darr> temp_c,
                     std::optional<darr> time_h, std::optional<iarr> dir,
-                    std::optional<darr> aux) const
+                    std::optional<darr> aux, int threads) const
     {
         long n = length_of(ha, "enc_ha");
         length_of(dec, "enc_dec", n);
@@ -322,24 +391,15 @@ struct Model {
         py::array_t<double> oa(n), od(n);
         const double *h = ha.data(), *d = dec.data();
         double *a = oa.mutable_data(), *b = od.mutable_data();
-        long bad = -1;
-        pm_status bs = PM_OK;
-        {
-            py::gil_scoped_release nogil;
+        const bool use_ctx = in.any();
+        auto bad = for_points(n, threads, [&](long i) {
             pm_context c;
-            const bool use_ctx = in.any();
-            for (long i = 0; i < n; i++) {
-                if (use_ctx)
-                    in.fill(i, c);
-                pm_status s = pm_model_apply(&m, use_ctx ? &c : nullptr, h[i], d[i], &a[i], &b[i]);
-                if (s != PM_OK) {
-                    bad = i, bs = s;
-                    break;
-                }
-            }
-        }
-        if (bad >= 0)
-            fail_status(bs, "apply, point " + std::to_string(bad));
+            if (use_ctx)
+                in.fill(i, c);
+            return pm_model_apply(&m, use_ctx ? &c : nullptr, h[i], d[i], &a[i], &b[i]);
+        });
+        if (bad.first >= 0)
+            fail_status(bad.second, "apply, point " + std::to_string(bad.first));
         return py::make_tuple(oa, od);
     }
 
@@ -367,7 +427,7 @@ struct Model {
     py::tuple invert(darr ha, darr dec, std::optional<iarr> side, std::optional<darr> start_ha,
                      std::optional<darr> start_dec, std::optional<iarr> pier,
                      std::optional<darr> temp_c, std::optional<darr> time_h,
-                     std::optional<iarr> dir, std::optional<darr> aux) const
+                     std::optional<iarr> dir, std::optional<darr> aux, int threads) const
     {
         long n = length_of(ha, "app_ha");
         length_of(dec, "app_dec", n);
@@ -388,33 +448,26 @@ struct Model {
         const double *s1 = start_dec ? start_dec->data() : nullptr;
         double *a = oa.mutable_data(), *b = od.mutable_data();
         signed char *st = os.mutable_data();
-        long bad = -1;
-        pm_status bs = PM_OK;
-        {
-            py::gil_scoped_release nogil;
+        const bool use_ctx = in.any();
+        auto bad = for_points(n, threads, [&](long i) {
             pm_context c;
-            const bool use_ctx = in.any();
-            for (long i = 0; i < n; i++) {
-                if (use_ctx)
-                    in.fill(i, c);
-                const pm_context *cp = use_ctx ? &c : nullptr;
-                pm_status s = s0 ? pm_model_invert_near(&m, cp, h[i], d[i], s0[i], s1[i], &a[i], &b[i])
-                                 : pm_model_invert(&m, cp, h[i], d[i], sd ? sd[i] : 0, &a[i], &b[i]);
-                if (s < 0) {
-                    bad = i, bs = s;
-                    break;
-                }
-                st[i] = (signed char)s;
-            }
-        }
-        if (bad >= 0)
-            fail_status(bs, "invert, point " + std::to_string(bad));
+            if (use_ctx)
+                in.fill(i, c);
+            const pm_context *cp = use_ctx ? &c : nullptr;
+            pm_status s = s0 ? pm_model_invert_near(&m, cp, h[i], d[i], s0[i], s1[i], &a[i], &b[i])
+                             : pm_model_invert(&m, cp, h[i], d[i], sd ? sd[i] : 0, &a[i], &b[i]);
+            st[i] = (signed char)s;
+            return s;
+        });
+        if (bad.first >= 0)
+            fail_status(bad.second, "invert, point " + std::to_string(bad.first));
         return py::make_tuple(oa, od, os);
     }
 
     py::array_t<double> residual(darr eh, darr ed, darr ah, darr ad, std::optional<iarr> pier,
                                  std::optional<darr> temp_c, std::optional<darr> time_h,
-                                 std::optional<iarr> dir, std::optional<darr> aux) const
+                                 std::optional<iarr> dir, std::optional<darr> aux,
+                                 int threads) const
     {
         long n = length_of(eh, "enc_ha");
         length_of(ed, "enc_dec", n);
@@ -424,25 +477,16 @@ struct Model {
         py::array_t<double> out({(py::ssize_t)n, (py::ssize_t)2});
         double *o = out.mutable_data();
         const double *p0 = eh.data(), *p1 = ed.data(), *p2 = ah.data(), *p3 = ad.data();
-        long bad = -1;
-        pm_status bs = PM_OK;
-        {
-            py::gil_scoped_release nogil;
+        const bool use_ctx = in.any();
+        auto bad = for_points(n, threads, [&](long i) {
             pm_context c;
-            const bool use_ctx = in.any();
-            for (long i = 0; i < n; i++) {
-                if (use_ctx)
-                    in.fill(i, c);
-                pm_status s = pm_model_residual(&m, use_ctx ? &c : nullptr, p0[i], p1[i], p2[i],
-                                                p3[i], o + 2 * i);
-                if (s != PM_OK) {
-                    bad = i, bs = s;
-                    break;
-                }
-            }
-        }
-        if (bad >= 0)
-            fail_status(bs, "residual, point " + std::to_string(bad));
+            if (use_ctx)
+                in.fill(i, c);
+            return pm_model_residual(&m, use_ctx ? &c : nullptr, p0[i], p1[i], p2[i], p3[i],
+                                     o + 2 * i);
+        });
+        if (bad.first >= 0)
+            fail_status(bad.second, "residual, point " + std::to_string(bad.first));
         return out;
     }
 
@@ -695,7 +739,7 @@ struct Fit {
     // Predicted 1-sigma pointing error per axis, and (v11, v12, v22), over arrays.
     py::tuple pointing_sigma(darr ha, darr dec, std::optional<iarr> pier, std::optional<darr> temp_c,
                              std::optional<darr> time_h, std::optional<iarr> dir,
-                             std::optional<darr> aux) const
+                             std::optional<darr> aux, int threads) const
     {
         long n = length_of(ha, "enc_ha");
         length_of(dec, "enc_dec", n);
@@ -704,26 +748,16 @@ struct Fit {
         py::array_t<double> cov({(py::ssize_t)n, (py::ssize_t)3});
         const double *h = ha.data(), *d = dec.data();
         double *s = sig.mutable_data(), *c3 = cov.mutable_data();
-        long bad = -1;
-        pm_status bs = PM_OK;
-        {
-            py::gil_scoped_release nogil;
+        const bool use_ctx = in.any();
+        auto bad = for_points(n, threads, [&](long i) {
             pm_context c;
-            const bool use_ctx = in.any();
-            for (long i = 0; i < n; i++) {
-                if (use_ctx)
-                    in.fill(i, c);
-                pm_status st = pm_fit_pointing_sigma(work.get(), &out.res, &out.model,
-                                                     use_ctx ? &c : nullptr, h[i], d[i], &s[i],
-                                                     c3 + 3 * i);
-                if (st != PM_OK) {
-                    bad = i, bs = st;
-                    break;
-                }
-            }
-        }
-        if (bad >= 0)
-            fail_status(bs, "pointing_sigma, point " + std::to_string(bad));
+            if (use_ctx)
+                in.fill(i, c);
+            return pm_fit_pointing_sigma(work.get(), &out.res, &out.model, use_ctx ? &c : nullptr,
+                                         h[i], d[i], &s[i], c3 + 3 * i);
+        });
+        if (bad.first >= 0)
+            fail_status(bad.second, "pointing_sigma, point " + std::to_string(bad.first));
         return py::make_tuple(sig, cov);
     }
 
@@ -801,6 +835,8 @@ py::tuple fit_run(const RunData &d, int order, std::vector<std::string> adds, bo
                              " (this build's PM_MAX_L)");
     if (max_iter < 1)
         fail(K_ARGUMENT, "max_iter: expected at least 1");
+    if (run.obs.empty())
+        throw Failure{K_FIT, PM_ERR_TOO_FEW, run.path + ": no observations to fit", ""};
     std::vector<std::unique_ptr<Fit>> fits;
     FTest ftest;
     {
@@ -915,6 +951,7 @@ PYBIND11_MODULE(_pm, mod)
     mod.attr("MAX_AUX") = PM_MAX_AUX;
     mod.attr("MODEL_DEFINITION") = PM_MODEL_DEFINITION;
     mod.attr("INVERT_TOL") = PM_INVERT_TOL;
+    mod.attr("START_MAX") = PM_START_MAX;
     mod.attr("RAD2AS") = RAD2AS;
     mod.def("status_name", &status_name);
     mod.def("status_text", &status_text);
@@ -933,6 +970,7 @@ PYBIND11_MODULE(_pm, mod)
         .def_property("coefficients", &Model::coefficients, &Model::set_coefficients)
         .def_property_readonly("names", &Model::names)
         .def_property_readonly("terms", &Model::terms)
+        .def_property_readonly("_inputs_needed", &Model::inputs_needed)
         .def("_add_term", &Model::add_term)
         .def("_apply", &Model::apply)
         .def("_invert", &Model::invert)

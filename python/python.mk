@@ -36,7 +36,7 @@ $(PY_DIR)/libpmhost_pic.a: $(PY_HOST_OBJ)
 
 $(PY_EXT): python/_pm.cpp $(PY_DIR)/libpmhost_pic.a $(B)/libpm.a $(wildcard include/*.h tools/lib/*.hpp tools/lib/*.h) | python-check-tools
 	@mkdir -p $(@D)
-	$(CXX) $(HOST_CXXFLAGS) -fPIC -fvisibility=hidden -shared $(PY_INCLUDES) $< -o $@ \
+	$(CXX) $(HOST_CXXFLAGS) -fPIC -pthread -fvisibility=hidden -shared $(PY_INCLUDES) $< -o $@ \
 	  $(PY_DIR)/libpmhost_pic.a $(B)/libpm.a -lerfa -lm
 
 $(PY_DIR)/pm/%.py: python/pm/%.py

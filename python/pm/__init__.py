@@ -19,6 +19,7 @@ numpy's.  Failures raise pm.Error subclasses carrying the library's message
 """
 
 import json as _json
+from math import isfinite as _isfinite
 import os as _os
 import warnings as _warnings
 
@@ -83,6 +84,7 @@ MAX_L = _pm.MAX_L
 MAX_TERMS = _pm.MAX_TERMS
 MAX_AUX = _pm.MAX_AUX
 INVERT_TOL = _pm.INVERT_TOL
+START_MAX = _pm.START_MAX
 WARN_NOT_CONVERGED = 1
 WARN_UNREACHABLE = 2
 
@@ -146,17 +148,12 @@ def _broadcast(named):
     return shape, [_np.ascontiguousarray(_np.broadcast_to(a, shape)).reshape(-1) for _, a in named]
 
 
-def _needed_inputs(terms):
+def _needed_inputs(model):
     """The context inputs a model's terms read: names in _AUX_INPUTS, and the
-    indices j of aux[j] (PM_TERM_AUX = 4; PM_AUX_USER = 3)."""
-    need, aux = set(), set()
-    for t in terms:
-        if t["kind"] == 4:
-            if t["aux"] < 3:
-                need.add(_AUX_INPUTS[t["aux"]])
-            else:
-                aux.add(t["aux"] - 3)
-    return need, aux
+    indices j of aux[j]."""
+    temp, time, dir_, aux = model._inputs_needed
+    need = {n for n, f in zip(_AUX_INPUTS, (temp, time, dir_)) if f}
+    return need, set(aux)
 
 
 def _points(model, named, pier=None, temp_c=None, time_h=None, dir=None, aux=None):
@@ -166,7 +163,7 @@ def _points(model, named, pier=None, temp_c=None, time_h=None, dir=None, aux=Non
     for n, a in arrays:
         if not _np.isfinite(a).all():
             raise _first_bad(n, a)
-    need, need_aux = _needed_inputs(model.terms)
+    need, need_aux = _needed_inputs(model)
     given = {"temp_c": temp_c, "time_h": time_h, "dir": dir}
     extra = []
     for n in _AUX_INPUTS:
@@ -207,8 +204,13 @@ def _points(model, named, pier=None, temp_c=None, time_h=None, dir=None, aux=Non
     return shape, flat[:n_pos], kw
 
 
-def _ctx_args(kw):
-    return (kw.get("pier"), kw.get("temp_c"), kw.get("time_h"), kw.get("dir"), kw.get("aux"))
+def _ctx_args(kw, threads=None):
+    if threads is None:
+        threads = 0
+    elif isinstance(threads, bool) or not isinstance(threads, (int, _np.integer)) or threads < 1:
+        raise ArgumentError("threads: expected a positive integer, or None for all cores")
+    return (kw.get("pier"), kw.get("temp_c"), kw.get("time_h"), kw.get("dir"), kw.get("aux"),
+            int(threads))
 
 
 def _shaped(shape, *arrays):
@@ -255,7 +257,10 @@ class Model(_pm.Model):
     """
 
     def __init__(self, order=1, mount="equatorial", latitude=0.0):
-        super().__init__(_mount_id(mount), _order(order), float(latitude))
+        lat = _as_float("latitude", latitude)
+        if lat.shape != () or not abs(float(lat)) <= _np.pi / 2:
+            raise ArgumentError("latitude: expected radians within +-pi/2, got %r" % (latitude,))
+        super().__init__(_mount_id(mount), _order(order), float(lat))
 
     @classmethod
     def _wrap(cls, c):
@@ -287,20 +292,25 @@ class Model(_pm.Model):
         return self._add_term(int(kind), int(k), int(l), int(m), int(side), int(aux),
                               float(param), float(value))
 
-    def apply(self, enc_ha, enc_dec, *, pier=None, temp_c=None, time_h=None, dir=None, aux=None):
+    def apply(self, enc_ha, enc_dec, *, pier=None, temp_c=None, time_h=None, dir=None, aux=None,
+              threads=None):
         """Apparent (ha, dec) of encoder positions (pm_model_apply, vectorised).
 
         Radians; arrays (or scalars) broadcast together.  The context inputs
         (pier side, temperature, time, slew direction, auxiliary columns) are
         needed only by models with such terms.  Raises NonFiniteError for a
         NaN or infinity, naming the element."""
+        if (isinstance(enc_ha, float) and isinstance(enc_dec, float) and _isfinite(enc_ha) and
+                _isfinite(enc_dec) and pier is None and not self.needs_context):
+            return self.apply_point(enc_ha, enc_dec)  # one point: the C call itself
         shape, (h, d), kw = _points(self, [("enc_ha", enc_ha), ("enc_dec", enc_dec)],
                                     pier, temp_c, time_h, dir, aux)
-        a, b = self._apply(h, d, *_ctx_args(kw))
+        a, b = self._apply(h, d, *_ctx_args(kw, threads))
         return _shaped(shape, a, b)
 
     def invert(self, app_ha, app_dec, side=0, *, start_ha=None, start_dec=None,
-               return_status=False, pier=None, temp_c=None, time_h=None, dir=None, aux=None):
+               return_status=False, pier=None, temp_c=None, time_h=None, dir=None, aux=None,
+               threads=None):
         """Encoder (ha, dec) that point at apparent positions (pm_model_invert,
         vectorised).
 
@@ -321,15 +331,23 @@ class Model(_pm.Model):
         if start_ha is not None:
             named += [("start_ha", start_ha), ("start_dec", start_dec)]
         shape, pos, kw = _points(self, named, pier, temp_c, time_h, dir, aux)
+        if (_np.abs(pos[1]) > _np.pi / 2).any():
+            i = int(_np.flatnonzero(_np.abs(pos[1]) > _np.pi / 2)[0])
+            raise ArgumentError("app_dec: point %d is %r, beyond +-pi/2 (an apparent "
+                                "declination or elevation)" % (i, float(pos[1][i])))
+        if start_ha is not None:
+            for n, a in (("start_ha", pos[2]), ("start_dec", pos[3])):
+                if (_np.abs(a) > START_MAX).any():
+                    raise ArgumentError("%s: |angle| beyond %g rad (PM_START_MAX)" % (n, START_MAX))
         s = _as_int("side", side, (0, 1))
         try:
             s = _np.ascontiguousarray(_np.broadcast_to(s, shape)).reshape(-1)
         except ValueError:
             raise ArgumentError("side: shape %s does not match %s" % (s.shape, shape)) from None
         if start_ha is not None:
-            a, b, st = self._invert(pos[0], pos[1], None, pos[2], pos[3], *_ctx_args(kw))
+            a, b, st = self._invert(pos[0], pos[1], None, pos[2], pos[3], *_ctx_args(kw, threads))
         else:
-            a, b, st = self._invert(pos[0], pos[1], s, None, None, *_ctx_args(kw))
+            a, b, st = self._invert(pos[0], pos[1], s, None, None, *_ctx_args(kw, threads))
         n_warn = int(_np.count_nonzero(st))
         if n_warn and not return_status:
             first = int(_np.flatnonzero(st)[0])
@@ -342,13 +360,13 @@ class Model(_pm.Model):
         return _shaped(shape, a, b)
 
     def residual(self, enc_ha, enc_dec, app_ha, app_dec, *, pier=None, temp_c=None,
-                 time_h=None, dir=None, aux=None):
+                 time_h=None, dir=None, aux=None, threads=None):
         """Observed minus model in the tangent plane (pm_model_residual):
         an array of shape (..., 2), radians (axis 1 on the sky, axis 2)."""
         shape, (a, b, c, d), kw = _points(
             self, [("enc_ha", enc_ha), ("enc_dec", enc_dec), ("app_ha", app_ha),
                    ("app_dec", app_dec)], pier, temp_c, time_h, dir, aux)
-        r = self._residual(a, b, c, d, *_ctx_args(kw))
+        r = self._residual(a, b, c, d, *_ctx_args(kw, threads))
         return r.reshape(shape + (2,))
 
     def save(self, path, comment=None):
@@ -529,13 +547,13 @@ class FitResult:
             self.title, self.n_obs, self.n_params, self.sigma * RAD2ARCSEC)
 
     def pointing_sigma(self, enc_ha, enc_dec, *, full=False, pier=None, temp_c=None,
-                       time_h=None, dir=None, aux=None):
+                       time_h=None, dir=None, aux=None, threads=None):
         """How well the model knows the pointing at encoder positions
         (pm_fit_pointing_sigma): 1-sigma per axis, radians; with ``full=True``
         also (v11, v12, v22) in rad^2, shape (..., 3)."""
         shape, (h, d), kw = _points(self.model, [("enc_ha", enc_ha), ("enc_dec", enc_dec)],
                                     pier, temp_c, time_h, dir, aux)
-        s, c = self._c._pointing_sigma(h, d, *_ctx_args(kw))
+        s, c = self._c._pointing_sigma(h, d, *_ctx_args(kw, threads))
         if shape == ():
             return (float(s[0]), tuple(c[0])) if full else float(s[0])
         return (s.reshape(shape), c.reshape(shape + (3,))) if full else s.reshape(shape)
