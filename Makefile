@@ -124,6 +124,7 @@ demo-run: all
 	    sed -E 's/.*"n_params": ([0-9]+).*"sigma_arcsec": ([0-9.]+).*/P = \1, sigma = \2 arcsec/'; \
 	  done; done; \
 	else echo "(no $(DATA): the real recorded runs are skipped)"; fi
+	@$(MAKE) --no-print-directory python-demo
 
 # The README's C example, compiled as strict C89 and run on a synthetic run.
 check-example: $(B)/libpm.a

@@ -49,7 +49,13 @@ $(PY_DIR)/pm_ref: python/tests/pm_ref.c $(B)/libpmhost.a $(B)/libpm.a
 	$(CC) $(TEST_CFLAGS) $< -o $@ $(B)/libpmhost.a $(B)/libpm.a -lerfa -lstdc++ -lm
 
 # make test builds the package before the suite that runs pytest on it.
-$(B)/tests/check_python: $(PY_EXT) $(PY_COPY) $(PY_DIR)/pm_ref
+$(B)/tests/check_python: $(PY_EXT) $(PY_COPY) $(PY_DIR)/pm_ref $(B)/pmfit
 
 bench-python: python $(B)/pmfit
 	PYTHONPATH=$(CURDIR)/$(PY_DIR) $(PYTHON) bench/bench_python.py
+
+# make demo ends with the package's example (examples/python_demo.py).
+.PHONY: python-demo
+python-demo: python
+	@echo; echo "== the Python package (docs/python.md): examples/python_demo.py"
+	PYTHONPATH=$(CURDIR)/$(PY_DIR) $(PYTHON) examples/python_demo.py

@@ -25,7 +25,11 @@ import warnings as _warnings
 
 import numpy as _np
 
-from . import _pm
+try:
+    from . import _pm
+except ImportError as _e:  # the source tree (python/pm) has no extension
+    raise ImportError("pm: the compiled extension is missing (%s): build the package with "
+                      "`make python` and put build/python on PYTHONPATH" % _e) from None
 
 __all__ = [
     "Error", "FileError", "FormatError", "ArgumentError", "NonFiniteError", "FitError",
