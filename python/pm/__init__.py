@@ -432,7 +432,8 @@ class Run:
         without ``dir`` the slew directions are derived from the sequence.
         ``aux``: a dict {name: column} (names for ``add=["aux:NAME"]``);
         ``latitude`` (radians) is needed by refraction/tube_flexure terms of
-        equatorial mounts; ``temp_c``, ``time_h`` may hold NaN (absent)."""
+        equatorial mounts; ``temp_c``, ``time_h`` may hold NaN (absent).
+        Messages call observation i (0-based) "line i+1"."""
         m = _mount_id(mount)
         named = [("enc_ha", enc_ha), ("enc_dec", enc_dec), ("app_ha", app_ha), ("app_dec", app_dec)]
         arrays = [(n, _np.atleast_1d(_as_float(n, v))) for n, v in named]
@@ -474,7 +475,13 @@ class Run:
         cols = dict(zip([n for n, _ in arrays + extra], flat))
         aux_arr = (_np.ascontiguousarray(_np.stack([cols["aux[%r]" % k] for k in names], axis=1))
                    if names else None)
-        lat = float("nan") if latitude is None else float(latitude)
+        lat = float("nan")
+        if latitude is not None:
+            la = _as_float("latitude", latitude)
+            if la.shape != () or not abs(float(la)) <= _np.pi / 2:
+                raise ArgumentError("latitude: expected radians within +-pi/2, got %r "
+                                    "(degrees? np.radians converts)" % (latitude,))
+            lat = float(la)
         data = _pm.run_from_arrays(
             cols["enc_ha"], cols["enc_dec"], cols["app_ha"], cols["app_dec"], m, lat,
             cols.get("pier"), cols.get("temp_c"), cols.get("time_h"), cols.get("dir"),

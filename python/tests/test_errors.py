@@ -171,6 +171,10 @@ def test_fit_failures_name_the_reason():
         pm.fit(ha, dec, ha, dec, add="wobble")
     with pytest.raises(pm.ArgumentError, match="latitude"):
         pm.fit(ha, dec, ha, dec, add="refraction")
+    with pytest.raises(pm.ArgumentError, match="degrees"):
+        pm.fit(ha, dec, ha, dec, latitude=47.0)
+    with pytest.raises(pm.ArgumentError, match="latitude"):
+        pm.Model(latitude=np.nan)
     with pytest.raises(pm.ArgumentError, match="no value for the observation at line 1"):
         pm.fit(ha, dec, ha, dec, add="temperature")
     with pytest.raises(pm.ArgumentError, match="order"):
