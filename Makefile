@@ -126,6 +126,7 @@ demo-run: all
 	    sed -E 's/.*"n_params": ([0-9]+).*"sigma_arcsec": ([0-9.]+).*/P = \1, sigma = \2 arcsec/'; \
 	  done; done; \
 	else echo "(no $(DATA): the real recorded runs are skipped)"; fi
+	@$(MAKE) --no-print-directory python-demo
 
 # The README's C example, compiled as strict C89 and run on a synthetic run.
 check-example: $(B)/libpm.a
@@ -177,7 +178,9 @@ test-run: all check-c89 check-freestanding check-example check-install $(TESTS)
 # check_bench are left out: they build and time separate programs (the ARM
 # firmware, the benchmark), not the sanitised library.  Needs build/ (the
 # emitted-C test links build/libpm.a), so the plain build runs first.
-SAN_SKIP  := check_firmware check_bench
+# check_python runs pytest in a Python interpreter, which would need the
+# ASan runtime preloaded into it and a sanitised build of the extension.
+SAN_SKIP  := check_firmware check_bench check_python
 SAN_TESTS  = $(filter-out $(SAN_SKIP:%=$(B)/tests/%),$(TESTS))
 ifneq ($(SAN),)
 SAN_FLAGS     := -fsanitize=$(SAN) -fno-sanitize-recover=all -fno-omit-frame-pointer
@@ -220,6 +223,9 @@ include bench/bench.mk
 # time; rules: fuzz/fuzz.mk) and make sanitize (the Check suite under ASan +
 # UBSan).
 -include fuzz/fuzz.mk
+# The Python package (docs/python.md): make python, make bench-python; make
+# test runs its pytest suite (rules: python/python.mk).
+include python/python.mk
 
 firmware: deps
 	@$(MAKE) --no-print-directory firmware-run

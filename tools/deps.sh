@@ -32,3 +32,6 @@ exit 0
 #pkg clang-14                 make sanitize, make fuzz
 #pkg libclang-rt-14-dev       make sanitize, make fuzz
 #pkg chromium                 pmfit report's browser test (tests/check_report.c)
+#pkg python3-dev              the Python package's extension (make python): Python.h
+#pkg python3-pybind11         the Python package's extension (pulls in pybind11-dev)
+#pkg python3-pytest           the Python package's tests (tests/check_python.c)

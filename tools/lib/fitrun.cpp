@@ -24,13 +24,17 @@ Run load_run(const std::string &path, bool refraction, bool skip_bad, int format
     if (pmrun_read(path.c_str(), &ro, &run, err, sizeof err) != 0)
         throw std::runtime_error(err);
     std::unique_ptr<pmrun, void (*)(pmrun *)> guard(run, pmrun_free);
+    return run_from_pmrun(run, path);
+}
+
+Run run_from_pmrun(const pmrun *run, const std::string &path)
+{
     Run r;
     r.path = path;
     r.mount = pmrun_mount(run) == PMRUN_MOUNT_ALTAZ ? PM_MOUNT_ALTAZ : PM_MOUNT_EQUATORIAL;
     r.latitude = pmrun_latitude_rad(run);
     for (int i = 0; i < pmrun_n_warnings(run); i++)
         r.notes.push_back(pmrun_warning(run, i));
-    bool have_dir = false;
     for (size_t i = 0; i < pmrun_count(run); i++) {
         const pmrun_obs *p = pmrun_get(run, i);
         Obs ob{p->enc_ha, p->enc_dec, p->app_ha, p->app_dec, p->pier, p->line, pm_context()};
@@ -39,11 +43,21 @@ Run load_run(const std::string &path, bool refraction, bool skip_bad, int format
         ob.ctx.time_h = p->time_h;
         ob.ctx.pier = p->pier;
         ob.ctx.dir = p->dir;
-        have_dir = have_dir || p->dir != 0;
         for (int j = 0; j < PM_MAX_AUX && j < PMRUN_MAX_AUX; j++)
             ob.ctx.aux[j] = p->aux[j];
         r.obs.push_back(ob);
     }
+    for (int j = 0; j < pmrun_n_aux(run); j++)
+        r.aux_names.push_back(pmrun_aux_name(run, j));
+    derive_directions(r);
+    return r;
+}
+
+void derive_directions(Run &r)
+{
+    bool have_dir = false;
+    for (const Obs &ob : r.obs)
+        have_dir = have_dir || ob.ctx.dir != 0;
     if (!have_dir) {
         r.dir_derived = true;
         for (size_t i = 1; i < r.obs.size(); i++) {
@@ -51,8 +65,6 @@ Run load_run(const std::string &path, bool refraction, bool skip_bad, int format
             r.obs[i].ctx.dir = dh > 0 ? 1 : (dh < 0 ? -1 : 0);
         }
     }
-    for (int j = 0; j < pmrun_n_aux(run); j++)
-        r.aux_names.push_back(pmrun_aux_name(run, j));
     // The slew direction on axis 2, likewise from the sequence, as the input
     // "dec_dir" (backlash of the declination/elevation drive), when the run
     // has no such column and a context slot is free.
@@ -68,7 +80,6 @@ Run load_run(const std::string &path, bool refraction, bool skip_bad, int format
             r.obs[i].ctx.aux[j] = dd > 0 ? 1 : (dd < 0 ? -1 : 0);
         }
     }
-    return r;
 }
 
 std::string term_name(const pm_model &m, int i)
@@ -225,6 +236,12 @@ FitOut do_fit(const std::vector<Obs> &obs, const std::vector<int> &use, const pm
               int max_passes)
 {
     static pm_fit fit; // large; not on the stack
+    return do_fit(fit, obs, use, start, max_passes);
+}
+
+FitOut do_fit(pm_fit &fit, const std::vector<Obs> &obs, const std::vector<int> &use,
+              const pm_model &start, int max_passes)
+{
     FitOut f;
     f.model = start;
     std::vector<double> eh, ed, ah, ad;

@@ -7,6 +7,7 @@
 #define PM_FITRUN_HPP
 
 #include "pm.h"
+#include "runfile.h"
 
 #include <string>
 #include <vector>
@@ -52,6 +53,12 @@ struct Run {
 // a PMRUN_EQUINOX_* id (0: as the file says) (tools/lib/runfile.h).
 Run load_run(const std::string &path, bool refraction, bool skip_bad, int format = -1,
              int equinox = 0);
+// The same from a run already read (pmrun_read), named path in messages.
+Run run_from_pmrun(const pmrun *run, const std::string &path);
+// What load_run derives from the sequence of the observations: the slew
+// direction on axis 1 where no observation has one, and the input "dec_dir"
+// where the run has no such column and a context slot is free.
+void derive_directions(Run &r);
 
 // Name and physical meaning of a model term.
 std::string term_name(const pm_model &m, int i);
@@ -71,6 +78,11 @@ pm_model without_side_terms(const pm_model &m);
 // correlated pair of terms (also after PM_ERR_DIVERGED).
 FitOut do_fit(const std::vector<Obs> &obs, const std::vector<int> &use, const pm_model &start,
               int max_passes = 100);
+// The same in a caller-owned workspace, which holds the last solve afterwards
+// (for pm_fit_pointing_sigma and pm_fit_covariance); do_fit above uses one
+// static workspace, so it is not reentrant.
+FitOut do_fit(pm_fit &work, const std::vector<Obs> &obs, const std::vector<int> &use,
+              const pm_model &start, int max_passes);
 void residuals(FitOut &f, const std::vector<Obs> &obs, const std::vector<int> &use);
 
 // The F distribution's upper tail (and its natural log, which does not

@@ -1,0 +1,1028 @@
+// _pm.cpp - the compiled half of the Python package `pm` (python/pm/):
+// pybind11 bindings of the core (include/pm.h) and the host library
+// (tools/lib: run files, model files, fits with physical terms, explain).
+//
+// The Python layer (python/pm/__init__.py) checks and broadcasts the arrays
+// and documents the API; this file does the loops over the C calls with the
+// GIL released, and turns every failure into a C++ exception (Failure) that
+// the translator below raises as the pm.* exception named by its kind, with
+// the library's message.  docs/python.md describes the package.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "pm.h"
+#include "explain.hpp"
+#include "fitrun.hpp"
+#include "modelfile.h"
+#include "runfile.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <system_error>
+#include <thread>
+#include <utility>
+#include <vector>
+
+namespace py = pybind11;
+using namespace pmhost;
+
+namespace {
+
+// ---------------------------------------------------------------------------
+// Errors.
+
+// Which pm.* exception a failure becomes (python/pm/_errors.py).
+enum Kind { K_ERROR, K_FILE, K_FORMAT, K_ARGUMENT, K_NONFINITE, K_FIT };
+const char *const KIND_NAMES[] = {"Error", "FileError", "FormatError", "ArgumentError",
+                                  "NonFiniteError", "FitError"};
+
+struct Failure {
+    Kind kind;
+    int status;          // pm_status, pmrun status, or 0
+    std::string message;
+    std::string bad_term; // FitError after PM_ERR_SINGULAR: the term's name
+};
+
+// The exception classes, handed over by python/pm/__init__.py (_set_errors).
+py::object *g_errors[6];
+
+const char *status_name(int s)
+{
+    switch (s) {
+    case PM_OK: return "PM_OK";
+    case PM_WARN_NOT_CONVERGED: return "PM_WARN_NOT_CONVERGED";
+    case PM_WARN_UNREACHABLE: return "PM_WARN_UNREACHABLE";
+    case PM_ERR_ARG: return "PM_ERR_ARG";
+    case PM_ERR_NONFINITE: return "PM_ERR_NONFINITE";
+    case PM_ERR_CAPACITY: return "PM_ERR_CAPACITY";
+    case PM_ERR_TOO_FEW: return "PM_ERR_TOO_FEW";
+    case PM_ERR_SINGULAR: return "PM_ERR_SINGULAR";
+    case PM_ERR_STATE: return "PM_ERR_STATE";
+    case PM_ERR_CONFIG: return "PM_ERR_CONFIG";
+    case PM_ERR_DIVERGED: return "PM_ERR_DIVERGED";
+    }
+    return "unknown status";
+}
+
+// The words of pm.h's status enum (as pmfit prints them).
+const char *status_text(int s)
+{
+    switch (s) {
+    case PM_OK: return "ok";
+    case PM_WARN_NOT_CONVERGED: return "iteration bound reached";
+    case PM_WARN_UNREACHABLE: return "target unreachable";
+    case PM_ERR_ARG: return "invalid argument";
+    case PM_ERR_NONFINITE: return "non-finite input, or an evaluation overflowed";
+    case PM_ERR_CAPACITY: return "beyond the compiled capacity";
+    case PM_ERR_TOO_FEW: return "too few observations for the number of terms";
+    case PM_ERR_SINGULAR: return "a term cannot be determined from these observations";
+    case PM_ERR_STATE: return "call out of order (model not prepared, or changed since)";
+    case PM_ERR_CONFIG: return "library built with other capacities";
+    case PM_ERR_DIVERGED: return "the fit did not converge";
+    }
+    return "unknown status";
+}
+
+// A failure of a core call: "what: PM_ERR_X (words)".
+[[noreturn]] void fail_status(pm_status s, const std::string &what)
+{
+    Kind k = s == PM_ERR_NONFINITE ? K_NONFINITE : (s == PM_ERR_ARG ? K_ARGUMENT : K_ERROR);
+    throw Failure{k, (int)s, what + ": " + status_name(s) + " (" + status_text(s) + ")", ""};
+}
+
+[[noreturn]] void fail(Kind k, const std::string &msg) { throw Failure{k, 0, msg, ""}; }
+
+void translate(std::exception_ptr p)
+{
+    try {
+        if (p)
+            std::rethrow_exception(p);
+    } catch (const Failure &f) {
+        py::object cls = g_errors[f.kind] ? *g_errors[f.kind] : py::reinterpret_borrow<py::object>(PyExc_RuntimeError);
+        py::object e = cls(f.message);
+        if (g_errors[f.kind]) {
+            e.attr("status") = f.status ? py::cast(f.status) : py::none();
+            if (f.kind == K_FIT)
+                e.attr("bad_term") = f.bad_term.empty() ? py::none() : py::cast(f.bad_term);
+        }
+        PyErr_SetObject(cls.ptr(), e.ptr());
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Arrays.
+
+using darr = py::array_t<double, py::array::c_style | py::array::forcecast>;
+using iarr = py::array_t<int, py::array::c_style | py::array::forcecast>;
+
+// The Python layer passes 1-D contiguous arrays of one length n; this checks
+// it again (a caller of _pm itself gets an error, not a read past the end).
+long length_of(const py::array &a, const char *name, long n = -1)
+{
+    if (a.ndim() != 1)
+        fail(K_ARGUMENT, std::string(name) + ": expected a 1-D array");
+    long len = (long)a.shape(0);
+    if (n >= 0 && len != n)
+        fail(K_ARGUMENT, std::string(name) + ": length " + std::to_string(len) + ", expected " +
+                             std::to_string(n));
+    return len;
+}
+
+// Per-observation inputs of the physical terms: optional columns.
+struct Inputs {
+    std::optional<iarr> pier, dir;
+    std::optional<darr> temp_c, time_h;
+    std::optional<darr> aux; // (n, k) with k <= PM_MAX_AUX
+    const int *p_pier = nullptr, *p_dir = nullptr;
+    const double *p_temp = nullptr, *p_time = nullptr, *p_aux = nullptr;
+    long n_aux = 0;
+
+    bool any() const { return p_pier || p_dir || p_temp || p_time || p_aux; }
+
+    void check(long n)
+    {
+        if (pier)
+            length_of(*pier, "pier", n), p_pier = pier->data();
+        if (dir)
+            length_of(*dir, "dir", n), p_dir = dir->data();
+        if (temp_c)
+            length_of(*temp_c, "temp_c", n), p_temp = temp_c->data();
+        if (time_h)
+            length_of(*time_h, "time_h", n), p_time = time_h->data();
+        if (aux) {
+            if (aux->ndim() != 2 || aux->shape(0) != n || aux->shape(1) > PM_MAX_AUX)
+                fail(K_ARGUMENT, "aux: expected an array of shape (n, k), k <= " +
+                                     std::to_string(PM_MAX_AUX));
+            n_aux = (long)aux->shape(1);
+            p_aux = aux->data();
+        }
+    }
+
+    // The context of observation i (absent inputs are 0: they are read only
+    // by terms that need them, which the Python layer checks).
+    void fill(long i, pm_context &c) const
+    {
+        std::memset(&c, 0, sizeof c);
+        if (p_pier)
+            c.pier = p_pier[i];
+        if (p_dir)
+            c.dir = p_dir[i];
+        if (p_temp)
+            c.temp_c = p_temp[i];
+        if (p_time)
+            c.time_h = p_time[i];
+        for (long j = 0; j < n_aux; j++)
+            c.aux[j] = p_aux[i * n_aux + j];
+    }
+};
+
+Inputs make_inputs(std::optional<iarr> pier, std::optional<darr> temp_c,
+                   std::optional<darr> time_h, std::optional<iarr> dir, std::optional<darr> aux,
+                   long n)
+{
+    Inputs in;
+    in.pier = std::move(pier);
+    in.temp_c = std::move(temp_c);
+    in.time_h = std::move(time_h);
+    in.dir = std::move(dir);
+    in.aux = std::move(aux);
+    in.check(n);
+    return in;
+}
+
+template <class T> py::array_t<T> copy_out(const std::vector<T> &v)
+{
+    py::array_t<T> a((py::ssize_t)v.size());
+    if (!v.empty())
+        std::memcpy(a.mutable_data(), v.data(), v.size() * sizeof(T));
+    return a;
+}
+
+// Points per thread below which more threads do not pay for their start.
+const long MIN_POINTS_PER_THREAD = 1L << 15;
+
+// body(i) for every point i in [0, n), without the GIL, on up to `threads`
+// threads (0: as many as the machine has) in contiguous chunks; each chunk
+// stops at its first error (a negative status).  Returns the first failing
+// index of all (the lowest) and its status, or (-1, PM_OK).  The points are
+// independent, so the results do not depend on the number of threads.
+template <class F> std::pair<long, pm_status> for_points(long n, int threads, const F &body)
+{
+    py::gil_scoped_release nogil;
+    long t = threads > 0 ? threads : (long)std::thread::hardware_concurrency();
+    t = std::max(1L, std::min({t, n / MIN_POINTS_PER_THREAD, 64L}));
+    std::vector<long> bad((size_t)t, -1);
+    std::vector<pm_status> st((size_t)t, PM_OK);
+    auto chunk = [&](long k) {
+        long lo = n * k / t, hi = n * (k + 1) / t;
+        for (long i = lo; i < hi; i++) {
+            pm_status s = body(i);
+            if (s < 0) {
+                bad[(size_t)k] = i, st[(size_t)k] = s;
+                return;
+            }
+        }
+    };
+    std::vector<std::thread> pool;
+    std::vector<long> here; // chunks no thread could be started for
+    for (long k = 1; k < t; k++) {
+        try {
+            pool.emplace_back(chunk, k);
+        } catch (const std::system_error &) {
+            here.push_back(k);
+        }
+    }
+    chunk(0);
+    for (long k : here)
+        chunk(k);
+    for (std::thread &th : pool)
+        th.join();
+    for (long k = 0; k < t; k++)
+        if (bad[(size_t)k] >= 0)
+            return {bad[(size_t)k], st[(size_t)k]};
+    return {-1, PM_OK};
+}
+
+// ---------------------------------------------------------------------------
+// Model.
+
+struct Model {
+    pm_model m;
+
+    Model() { std::memset(&m, 0, sizeof m); }
+
+    static Model make(int mount, int order, double latitude)
+    {
+        Model r;
+        pm_status s = pm_model_init(&r.m, mount, order);
+        if (s == PM_ERR_CAPACITY)
+            fail(K_ARGUMENT, "order " + std::to_string(order) + " is beyond this build's PM_MAX_L = " +
+                                 std::to_string(PM_MAX_L));
+        if (s != PM_OK)
+            fail_status(s, "pm_model_init");
+        r.m.latitude = latitude;
+        s = pm_model_prepare(&r.m);
+        if (s != PM_OK)
+            fail_status(s, "pm_model_prepare");
+        return r;
+    }
+
+    std::string name(int i) const
+    {
+        char buf[64];
+        pm_term_name(&m, i, buf, sizeof buf);
+        return buf;
+    }
+
+    std::vector<std::string> names() const
+    {
+        std::vector<std::string> v;
+        for (int i = 0; i < m.n_terms; i++)
+            v.push_back(name(i));
+        return v;
+    }
+
+    py::array_t<double> coefficients() const
+    {
+        return copy_out(std::vector<double>(m.coef, m.coef + m.n_terms));
+    }
+
+    // New coefficients (radians), prepared; on error the model is unchanged.
+    void set_coefficients(darr c)
+    {
+        length_of(c, "coefficients", m.n_terms);
+        pm_model t = m;
+        std::memcpy(t.coef, c.data(), sizeof(double) * (size_t)m.n_terms);
+        pm_status s = pm_model_prepare(&t);
+        if (s != PM_OK)
+            fail_status(s, "coefficients");
+        m = t;
+    }
+
+    void set_latitude(double lat)
+    {
+        pm_model t = m;
+        t.latitude = lat;
+        pm_status s = pm_model_prepare(&t);
+        if (s != PM_OK)
+            fail_status(s, "latitude");
+        m = t;
+    }
+
+    // Which context inputs the terms read: (temp_c, time_h, dir, [aux j]).
+    py::tuple inputs_needed() const
+    {
+        bool temp = false, time = false, dir = false;
+        std::vector<int> aux;
+        for (int i = 0; i < m.n_terms; i++) {
+            const pm_term &t = m.term[i];
+            if (t.kind != PM_TERM_AUX)
+                continue;
+            if (t.aux == PM_AUX_TEMP)
+                temp = true;
+            else if (t.aux == PM_AUX_TIME)
+                time = true;
+            else if (t.aux == PM_AUX_DIR)
+                dir = true;
+            else if (std::find(aux.begin(), aux.end(), t.aux - PM_AUX_USER) == aux.end())
+                aux.push_back(t.aux - PM_AUX_USER);
+        }
+        return py::make_tuple(temp, time, dir, aux);
+    }
+
+    py::list terms() const
+    {
+        py::list l;
+        for (int i = 0; i < m.n_terms; i++) {
+            const pm_term &t = m.term[i];
+            py::dict d;
+            d["name"] = name(i);
+            d["kind"] = (int)t.kind;
+            d["k"] = (int)t.k;
+            d["l"] = (int)t.l;
+            d["m"] = (int)t.m;
+            d["side"] = (int)t.side;
+            d["aux"] = (int)t.aux;
+            d["param"] = t.param;
+            d["meaning"] = meaning(m, i);
+            l.append(d);
+        }
+        return l;
+    }
+
+    int add_term(int kind, int k, int l, int mm, int side, int aux, double param, double value)
+    {
+        if (kind < 0 || kind > 255 || k < 0 || k > 255 || l < -128 || l > 127 || mm < -128 ||
+            mm > 127 || side < -1 || side > 1 || aux < 0 || aux > 255)
+            fail(K_ARGUMENT, "add_term: a field is out of its range (docs/model.md, pm_term)");
+        pm_term t;
+        std::memset(&t, 0, sizeof t);
+        t.kind = (unsigned char)kind;
+        t.k = (unsigned char)k;
+        t.l = (signed char)l;
+        t.m = (signed char)mm;
+        t.side = (signed char)side;
+        t.aux = (unsigned char)aux;
+        t.param = param;
+        pm_model c = m;
+        int index = -1;
+        pm_status s = pm_model_add_term(&c, &t, value, &index);
+        if (s != PM_OK)
+            fail_status(s, "add_term");
+        m = c;
+        return index;
+    }
+
+    // Forward model over arrays; the first failing point raises.
+    py::tuple apply(darr ha, darr dec, std::optional<iarr> pier, std::optional<darr> temp_c,
+                    std::optional<darr> time_h, std::optional<iarr> dir,
+                    std::optional<darr> aux, int threads) const
+    {
+        long n = length_of(ha, "enc_ha");
+        length_of(dec, "enc_dec", n);
+        Inputs in = make_inputs(pier, temp_c, time_h, dir, aux, n);
+        py::array_t<double> oa(n), od(n);
+        const double *h = ha.data(), *d = dec.data();
+        double *a = oa.mutable_data(), *b = od.mutable_data();
+        const bool use_ctx = in.any();
+        auto bad = for_points(n, threads, [&](long i) {
+            pm_context c;
+            if (use_ctx)
+                in.fill(i, c);
+            return pm_model_apply(&m, use_ctx ? &c : nullptr, h[i], d[i], &a[i], &b[i]);
+        });
+        if (bad.first >= 0)
+            fail_status(bad.second, "apply, point " + std::to_string(bad.first));
+        return py::make_tuple(oa, od);
+    }
+
+    // The per-point C call itself (no arrays): what a Python loop would call.
+    py::tuple apply_point(double ha, double dec) const
+    {
+        double a, b;
+        pm_status s = pm_model_apply(&m, nullptr, ha, dec, &a, &b);
+        if (s != PM_OK)
+            fail_status(s, "apply");
+        return py::make_tuple(a, b);
+    }
+
+    py::tuple invert_point(double ha, double dec, int side) const
+    {
+        double a, b;
+        pm_status s = pm_model_invert(&m, nullptr, ha, dec, side, &a, &b);
+        if (s < 0)
+            fail_status(s, "invert");
+        return py::make_tuple(a, b, (int)s);
+    }
+
+    // Inverse over arrays: side per point (0/1), or start positions
+    // (pm_model_invert_near).  Warnings come back in the status array.
+    py::tuple invert(darr ha, darr dec, std::optional<iarr> side, std::optional<darr> start_ha,
+                     std::optional<darr> start_dec, std::optional<iarr> pier,
+                     std::optional<darr> temp_c, std::optional<darr> time_h,
+                     std::optional<iarr> dir, std::optional<darr> aux, int threads) const
+    {
+        long n = length_of(ha, "app_ha");
+        length_of(dec, "app_dec", n);
+        if (side)
+            length_of(*side, "side", n);
+        if (start_ha.has_value() != start_dec.has_value())
+            fail(K_ARGUMENT, "invert: give both start_ha and start_dec, or neither");
+        if (start_ha) {
+            length_of(*start_ha, "start_ha", n);
+            length_of(*start_dec, "start_dec", n);
+        }
+        Inputs in = make_inputs(pier, temp_c, time_h, dir, aux, n);
+        py::array_t<double> oa(n), od(n);
+        py::array_t<signed char> os(n);
+        const double *h = ha.data(), *d = dec.data();
+        const int *sd = side ? side->data() : nullptr;
+        const double *s0 = start_ha ? start_ha->data() : nullptr;
+        const double *s1 = start_dec ? start_dec->data() : nullptr;
+        double *a = oa.mutable_data(), *b = od.mutable_data();
+        signed char *st = os.mutable_data();
+        const bool use_ctx = in.any();
+        auto bad = for_points(n, threads, [&](long i) {
+            pm_context c;
+            if (use_ctx)
+                in.fill(i, c);
+            const pm_context *cp = use_ctx ? &c : nullptr;
+            pm_status s = s0 ? pm_model_invert_near(&m, cp, h[i], d[i], s0[i], s1[i], &a[i], &b[i])
+                             : pm_model_invert(&m, cp, h[i], d[i], sd ? sd[i] : 0, &a[i], &b[i]);
+            st[i] = (signed char)s;
+            return s;
+        });
+        if (bad.first >= 0)
+            fail_status(bad.second, "invert, point " + std::to_string(bad.first));
+        return py::make_tuple(oa, od, os);
+    }
+
+    py::array_t<double> residual(darr eh, darr ed, darr ah, darr ad, std::optional<iarr> pier,
+                                 std::optional<darr> temp_c, std::optional<darr> time_h,
+                                 std::optional<iarr> dir, std::optional<darr> aux,
+                                 int threads) const
+    {
+        long n = length_of(eh, "enc_ha");
+        length_of(ed, "enc_dec", n);
+        length_of(ah, "app_ha", n);
+        length_of(ad, "app_dec", n);
+        Inputs in = make_inputs(pier, temp_c, time_h, dir, aux, n);
+        py::array_t<double> out({(py::ssize_t)n, (py::ssize_t)2});
+        double *o = out.mutable_data();
+        const double *p0 = eh.data(), *p1 = ed.data(), *p2 = ah.data(), *p3 = ad.data();
+        const bool use_ctx = in.any();
+        auto bad = for_points(n, threads, [&](long i) {
+            pm_context c;
+            if (use_ctx)
+                in.fill(i, c);
+            return pm_model_residual(&m, use_ctx ? &c : nullptr, p0[i], p1[i], p2[i], p3[i],
+                                     o + 2 * i);
+        });
+        if (bad.first >= 0)
+            fail_status(bad.second, "residual, point " + std::to_string(bad.first));
+        return out;
+    }
+
+    void save(const std::string &path, std::optional<std::string> comment) const
+    {
+        char err[1024];
+        if (pmmodel_save(path.c_str(), &m, comment ? comment->c_str() : nullptr, err, sizeof err) != 0)
+            fail(K_FILE, err);
+    }
+
+    void emit_c(const std::string &path, const std::string &prefix,
+                std::optional<std::string> comment) const
+    {
+        char err[1024];
+        if (pmmodel_emit_c(path.c_str(), &m, prefix.c_str(), comment ? comment->c_str() : nullptr,
+                           err, sizeof err) != 0)
+            fail(K_FILE, err);
+    }
+
+    static Model load(const std::string &path)
+    {
+        Model r;
+        char err[1024];
+        if (pmmodel_load(path.c_str(), &r.m, err, sizeof err) != 0) {
+            // a file that cannot be opened is an OSError, its content a ValueError
+            FILE *f = std::fopen(path.c_str(), "rb");
+            if (!f)
+                fail(K_FILE, err);
+            std::fclose(f);
+            fail(K_FORMAT, err);
+        }
+        return r;
+    }
+};
+
+// ---------------------------------------------------------------------------
+// Runs.
+
+struct RunData {
+    Run run;          // as pmfit fits it: contexts, derived slew directions
+    int format = -1;  // PMRUN_FORMAT_*, -1 for a run made from arrays
+    pmrun_site site;
+    std::vector<std::string> skipped;
+    std::vector<std::string> file_aux_names; // the file's own auxiliary columns
+    std::vector<double> file_aux;            // n x file_aux_names.size()
+    std::vector<double> enc_raw;             // n x 2
+};
+
+std::shared_ptr<RunData> read_run(const std::string &path, bool refraction, bool skip_bad,
+                                  const std::string &format, const std::string &equinox)
+{
+    pmrun_options ro;
+    pmrun_options_default(&ro);
+    ro.refraction = refraction ? 1 : 0;
+    ro.skip_bad = skip_bad ? 1 : 0;
+    ro.format = pmrun_format_from_name(format.c_str());
+    if (ro.format == -2)
+        throw Failure{K_ARGUMENT, PMRUN_ERR_ARG,
+                      "format: expected auto, four-column, named, tpoint, rts2, mw4, csv or mmt, "
+                      "got '" + format + "'", ""};
+    if (equinox == "J2000" || equinox == "j2000")
+        ro.equinox = PMRUN_EQUINOX_J2000;
+    else if (equinox == "JNow" || equinox == "jnow" || equinox == "JNOW")
+        ro.equinox = PMRUN_EQUINOX_JNOW;
+    else if (!equinox.empty())
+        throw Failure{K_ARGUMENT, PMRUN_ERR_ARG,
+                      "equinox: expected 'J2000' or 'JNow', got '" + equinox + "'", ""};
+    pmrun *raw = nullptr;
+    char err[1024];
+    int st;
+    {
+        py::gil_scoped_release nogil;
+        st = pmrun_read(path.c_str(), &ro, &raw, err, sizeof err);
+    }
+    if (st != PMRUN_OK) {
+        Kind k = st == PMRUN_ERR_IO ? K_FILE : (st == PMRUN_ERR_FORMAT ? K_FORMAT : K_ERROR);
+        throw Failure{k, st, err, ""};
+    }
+    std::unique_ptr<pmrun, void (*)(pmrun *)> guard(raw, pmrun_free);
+    auto r = std::make_shared<RunData>();
+    r->run = run_from_pmrun(raw, path);
+    r->format = pmrun_format(raw);
+    pmrun_get_site(raw, &r->site);
+    for (int i = 0; i < pmrun_n_skipped(raw); i++) {
+        const char *s = pmrun_skipped(raw, i);
+        if (s)
+            r->skipped.push_back(s);
+    }
+    int na = pmrun_n_aux(raw);
+    for (int j = 0; j < na; j++)
+        r->file_aux_names.push_back(pmrun_aux_name(raw, j));
+    for (size_t i = 0; i < pmrun_count(raw); i++) {
+        const pmrun_obs *p = pmrun_get(raw, i);
+        for (int j = 0; j < na; j++)
+            r->file_aux.push_back(p->aux[j]);
+        r->enc_raw.push_back(p->enc_raw[0]);
+        r->enc_raw.push_back(p->enc_raw[1]);
+    }
+    return r;
+}
+
+// A run from arrays (the Python layer checked finiteness and lengths).
+std::shared_ptr<RunData> run_from_arrays(darr eh, darr ed, darr ah, darr ad, int mount,
+                                         double latitude, std::optional<iarr> pier,
+                                         std::optional<darr> temp_c, std::optional<darr> time_h,
+                                         std::optional<iarr> dir, std::optional<darr> aux,
+                                         std::vector<std::string> aux_names)
+{
+    long n = length_of(eh, "enc_ha");
+    length_of(ed, "enc_dec", n);
+    length_of(ah, "app_ha", n);
+    length_of(ad, "app_dec", n);
+    if (mount != PM_MOUNT_EQUATORIAL && mount != PM_MOUNT_ALTAZ)
+        fail(K_ARGUMENT, "mount: expected equatorial or altaz");
+    Inputs in = make_inputs(pier, temp_c, time_h, dir, aux, n);
+    if ((long)aux_names.size() != in.n_aux)
+        fail(K_ARGUMENT, "aux: as many names as columns");
+    auto r = std::make_shared<RunData>();
+    std::memset(&r->site, 0, sizeof r->site);
+    r->run.path = "<arrays>";
+    r->run.mount = mount;
+    r->run.latitude = latitude;
+    r->run.aux_names = aux_names;
+    r->file_aux_names = aux_names;
+    for (long i = 0; i < n; i++) {
+        Obs ob{eh.data()[i], ed.data()[i], ah.data()[i], ad.data()[i], 0, (int)(i + 1), pm_context()};
+        in.fill(i, ob.ctx);
+        if (!in.p_temp)
+            ob.ctx.temp_c = NAN;
+        if (!in.p_time)
+            ob.ctx.time_h = NAN;
+        if (!in.p_pier) // as the readers do for a file without a pier column
+            ob.ctx.pier = mount == PM_MOUNT_EQUATORIAL ? (std::cos(ob.ed) < 0 ? -1 : 1) : 0;
+        ob.pier = ob.ctx.pier;
+        r->run.obs.push_back(ob);
+        for (long j = 0; j < in.n_aux; j++)
+            r->file_aux.push_back(ob.ctx.aux[j]);
+        r->enc_raw.push_back(ob.eh);
+        r->enc_raw.push_back(ob.ed);
+    }
+    derive_directions(r->run);
+    return r;
+}
+
+py::dict run_columns(const RunData &d)
+{
+    const std::vector<Obs> &o = d.run.obs;
+    size_t n = o.size();
+    std::vector<double> eh(n), ed(n), ah(n), ad(n), tc(n), th(n);
+    std::vector<int> pier(n), dir(n), line(n);
+    for (size_t i = 0; i < n; i++) {
+        eh[i] = o[i].eh, ed[i] = o[i].ed, ah[i] = o[i].ah, ad[i] = o[i].ad;
+        tc[i] = o[i].ctx.temp_c, th[i] = o[i].ctx.time_h;
+        pier[i] = o[i].pier, dir[i] = o[i].ctx.dir, line[i] = o[i].line;
+    }
+    py::dict c;
+    c["enc_ha"] = copy_out(eh);
+    c["enc_dec"] = copy_out(ed);
+    c["app_ha"] = copy_out(ah);
+    c["app_dec"] = copy_out(ad);
+    c["pier"] = copy_out(pier);
+    c["dir"] = copy_out(dir);
+    c["line"] = copy_out(line);
+    c["temp_c"] = copy_out(tc);
+    c["time_h"] = copy_out(th);
+    py::dict aux;
+    size_t nf = d.file_aux_names.size();
+    for (size_t j = 0; j < nf; j++) {
+        std::vector<double> col(n);
+        for (size_t i = 0; i < n; i++)
+            col[i] = d.file_aux[i * nf + j];
+        aux[py::str(d.file_aux_names[j])] = copy_out(col);
+    }
+    // inputs derived from the sequence (dec_dir), as pmfit uses them
+    for (size_t j = 0; j < d.run.aux_names.size() && j < (size_t)PM_MAX_AUX; j++) {
+        const std::string &nm = d.run.aux_names[j];
+        if (aux.contains(py::str(nm)))
+            continue;
+        std::vector<double> col(n);
+        for (size_t i = 0; i < n; i++)
+            col[i] = o[i].ctx.aux[j];
+        aux[py::str(nm)] = copy_out(col);
+    }
+    c["aux"] = aux;
+    py::array_t<double> raw({(py::ssize_t)n, (py::ssize_t)2});
+    if (n)
+        std::memcpy(raw.mutable_data(), d.enc_raw.data(), sizeof(double) * 2 * n);
+    c["enc_raw"] = raw;
+    return c;
+}
+
+py::dict run_info(const RunData &d)
+{
+    py::dict i;
+    i["path"] = d.run.path;
+    i["mount"] = d.run.mount == PM_MOUNT_ALTAZ ? "altaz" : "equatorial";
+    i["latitude"] = d.run.latitude;
+    i["format"] = d.format == PMRUN_FORMAT_FOUR_COLUMN ? py::object(py::str("four-column"))
+                  : d.format == PMRUN_FORMAT_NAMED     ? py::object(py::str("named"))
+                  : d.format == PMRUN_FORMAT_TPOINT    ? py::object(py::str("tpoint"))
+                                                       : py::object(py::none());
+    i["warnings"] = d.run.notes;
+    i["skipped"] = d.skipped;
+    i["aux_names"] = d.run.aux_names;
+    i["dir_derived"] = d.run.dir_derived;
+    py::dict s;
+    if (d.format >= 0) {
+        s["latitude_rad"] = d.site.latitude_rad;
+        s["height_m"] = d.site.height_m;
+        s["pressure_hpa"] = d.site.pressure_hpa;
+        s["temp_c"] = d.site.temp_c;
+        s["humidity"] = d.site.humidity;
+        s["wavelength_um"] = d.site.wavelength_um;
+        s["lapse_k_per_m"] = d.site.lapse_k_per_m;
+        s["date"] = d.site.year ? py::object(py::make_tuple(d.site.year, d.site.month, d.site.day))
+                                : py::object(py::none());
+    }
+    i["site"] = s;
+    return i;
+}
+
+// ---------------------------------------------------------------------------
+// Fits.
+
+struct Fit {
+    std::unique_ptr<pm_fit> work; // the last solve (covariance, pointing sigma)
+    FitOut out;
+    std::string title;
+    std::vector<int> lines;       // file line of each fitted observation
+
+    Model model() const
+    {
+        Model r;
+        r.m = out.model;
+        return r;
+    }
+    py::array_t<double> coefficients() const
+    {
+        return copy_out(std::vector<double>(out.model.coef, out.model.coef + out.model.n_terms));
+    }
+    py::array_t<double> errors() const
+    {
+        return copy_out(std::vector<double>(out.res.err, out.res.err + out.model.n_terms));
+    }
+    py::array_t<double> covariance() const
+    {
+        py::ssize_t p = out.model.n_terms;
+        py::array_t<double> c({p, p});
+        if (p)
+            std::memcpy(c.mutable_data(), out.cov.data(), sizeof(double) * (size_t)(p * p));
+        return c;
+    }
+    py::array_t<double> residuals() const
+    {
+        size_t n = out.r0.size();
+        py::array_t<double> r({(py::ssize_t)n, (py::ssize_t)2});
+        double *p = r.mutable_data();
+        for (size_t i = 0; i < n; i++)
+            p[2 * i] = out.r0[i], p[2 * i + 1] = out.r1[i];
+        return r;
+    }
+
+    // Predicted 1-sigma pointing error per axis, and (v11, v12, v22), over arrays.
+    py::tuple pointing_sigma(darr ha, darr dec, std::optional<iarr> pier, std::optional<darr> temp_c,
+                             std::optional<darr> time_h, std::optional<iarr> dir,
+                             std::optional<darr> aux, int threads) const
+    {
+        long n = length_of(ha, "enc_ha");
+        length_of(dec, "enc_dec", n);
+        Inputs in = make_inputs(pier, temp_c, time_h, dir, aux, n);
+        py::array_t<double> sig(n);
+        py::array_t<double> cov({(py::ssize_t)n, (py::ssize_t)3});
+        const double *h = ha.data(), *d = dec.data();
+        double *s = sig.mutable_data(), *c3 = cov.mutable_data();
+        const bool use_ctx = in.any();
+        auto bad = for_points(n, threads, [&](long i) {
+            pm_context c;
+            if (use_ctx)
+                in.fill(i, c);
+            return pm_fit_pointing_sigma(work.get(), &out.res, &out.model, use_ctx ? &c : nullptr,
+                                         h[i], d[i], &s[i], c3 + 3 * i);
+        });
+        if (bad.first >= 0)
+            fail_status(bad.second, "pointing_sigma, point " + std::to_string(bad.first));
+        return py::make_tuple(sig, cov);
+    }
+
+    py::object max_correlation() const
+    {
+        if (out.corr_i < 0)
+            return py::none();
+        return py::make_tuple(term_name(out.model, out.corr_j), term_name(out.model, out.corr_i),
+                              out.corr);
+    }
+};
+
+// Why a fit failed, in the words pmfit fit uses.
+[[noreturn]] void fail_fit(const FitOut &f, const std::string &what, int max_iter)
+{
+    const pm_model &m = f.model;
+    std::string msg = what + ": " + status_name(f.status) + " (" + status_text(f.status) + ")";
+    std::string bad;
+    if (f.status == PM_ERR_SINGULAR && f.bad_term >= 0) {
+        bad = term_name(m, f.bad_term);
+        msg += ": term " + bad + ", " + meaning(m, f.bad_term) +
+               ", is a combination of the terms before it for this sky coverage" +
+               (f.bad_term >= m.n_base ? std::string(" and model") : std::string()) +
+               "; lower the order, drop the term or add points";
+    }
+    if (f.status == PM_ERR_DIVERGED && f.corr_i >= 0) {
+        char buf[64];
+        std::snprintf(buf, sizeof buf, "%.6f", f.corr);
+        msg += " in " + std::to_string(max_iter) + " passes: the sky coverage hardly separates " +
+               term_name(m, f.corr_j) + " from " + term_name(m, f.corr_i) + " (correlation " + buf +
+               "); lower the order or use both pier sides";
+    }
+    if (f.status == PM_ERR_TOO_FEW)
+        msg += ": P = " + std::to_string(m.n_terms) + " terms need at least " +
+               std::to_string(m.n_terms / 2 + 1) + " observations (2N > P); there are " +
+               std::to_string(f.res.n_obs);
+    throw Failure{f.status == PM_ERR_NONFINITE ? K_NONFINITE : K_FIT, (int)f.status, msg, bad};
+}
+
+std::unique_ptr<Fit> fit_points(const Run &run, const std::vector<int> &use, const pm_model &start,
+                                int max_iter, const std::string &what, const std::string &title)
+{
+    auto f = std::make_unique<Fit>();
+    f->work.reset(new pm_fit);
+    f->out = do_fit(*f->work, run.obs, use, start, max_iter);
+    if (f->out.status != PM_OK)
+        fail_fit(f->out, what, max_iter);
+    f->title = title;
+    for (int i : f->out.idx)
+        f->lines.push_back(run.obs[i].line);
+    return f;
+}
+
+py::object f_test_dict(const FTest &t)
+{
+    if (!t.done)
+        return py::none();
+    py::dict d;
+    d["test"] = t.what;
+    d["f"] = t.f;
+    d["dof1"] = t.d1;
+    d["dof2"] = t.d2;
+    d["p"] = t.p;
+    return d;
+}
+
+// pmfit fit RUN [--order L] [--add ...] [--pier split]: one fit (joint) or
+// two (east, west), and the pier F-test where pmfit makes one.
+py::tuple fit_run(const RunData &d, int order, std::vector<std::string> adds, bool split,
+                  int max_iter)
+{
+    const Run &run = d.run;
+    if (order < 0 || order > PM_MAX_L)
+        fail(K_ARGUMENT, "order " + std::to_string(order) + ": expected 0.." + std::to_string(PM_MAX_L) +
+                             " (this build's PM_MAX_L)");
+    if (max_iter < 1)
+        fail(K_ARGUMENT, "max_iter: expected at least 1");
+    if (run.obs.empty())
+        throw Failure{K_FIT, PM_ERR_TOO_FEW, run.path + ": no observations to fit", ""};
+    std::vector<std::unique_ptr<Fit>> fits;
+    FTest ftest;
+    {
+        py::gil_scoped_release nogil;
+        pm_model start;
+        try {
+            start = build_model(order, adds, run.obs, run.mount, run.latitude, run.aux_names);
+        } catch (const std::runtime_error &e) {
+            fail(K_ARGUMENT, e.what());
+        }
+        bool side_terms = false;
+        for (int i = start.n_base; i < start.n_terms; i++)
+            side_terms = side_terms || start.term[i].side != 0;
+        if (split && side_terms)
+            fail(K_ARGUMENT, "split: the pier sides are fitted independently; side-specific terms "
+                             "(@E, @W) belong to a joint fit");
+        std::vector<int> all(run.obs.size());
+        for (size_t i = 0; i < all.size(); i++)
+            all[i] = (int)i;
+        if (!split) {
+            fits.push_back(fit_points(run, all, start, max_iter, run.path, "joint fit, both pier sides"));
+            if (side_terms) {
+                std::unique_ptr<pm_fit> w(new pm_fit);
+                FitOut g = do_fit(*w, run.obs, all, without_side_terms(start), 100);
+                const FitOut &f = fits[0]->out;
+                if (g.status == PM_OK)
+                    ftest = f_test(g.res.chi2, g.res.n_par, f.res.chi2, f.res.n_par, f.res.n_obs,
+                                   "side-specific terms vs shared only");
+            }
+        } else {
+            std::vector<int> kept; // the observations of either side, in order
+            for (int side : {1, -1}) {
+                std::vector<int> use;
+                for (size_t i = 0; i < run.obs.size(); i++)
+                    if (run.obs[i].pier == side)
+                        use.push_back((int)i);
+                std::string t = side > 0 ? "pier side east (normal)" : "pier side west (beyond the pole)";
+                if (use.empty())
+                    throw Failure{K_FIT, 0, run.path + ": split: no observations on the " + t, ""};
+                fits.push_back(fit_points(run, use, start, max_iter, run.path + " (" + t + ")", t));
+                kept.insert(kept.end(), use.begin(), use.end());
+            }
+            std::sort(kept.begin(), kept.end());
+            std::unique_ptr<pm_fit> w(new pm_fit);
+            FitOut g = do_fit(*w, run.obs, kept, start, 100);
+            if (g.status == PM_OK)
+                ftest = f_test(g.res.chi2, g.res.n_par, fits[0]->out.res.chi2 + fits[1]->out.res.chi2,
+                               fits[0]->out.res.n_par + fits[1]->out.res.n_par, g.res.n_obs,
+                               "split (independent sides) vs joint");
+        }
+    }
+    py::list l;
+    for (auto &f : fits)
+        l.append(py::cast(std::move(f)));
+    return py::make_tuple(l, f_test_dict(ftest));
+}
+
+// pmfit explain RUN --json, as the same JSON text (json.loads in Python).
+std::string explain_run(const RunData &d, int order, std::vector<std::string> adds, double alpha,
+                        std::vector<double> gears_ha, std::vector<double> gears_dec, bool pairs,
+                        int folds)
+{
+    if (order < 0 || order > PM_MAX_L)
+        fail(K_ARGUMENT, "order " + std::to_string(order) + ": expected 0.." + std::to_string(PM_MAX_L));
+    if (!(alpha > 0 && alpha < 1))
+        fail(K_ARGUMENT, "alpha: expected a false-alarm probability in (0, 1)");
+    if (folds < 2 || folds > (int)d.run.obs.size())
+        fail(K_ARGUMENT, "folds: expected 2 .. the number of observations");
+    for (double g : gears_ha)
+        if (!(g > 0 && g <= 1e6))
+            fail(K_ARGUMENT, "gears_ha: a gear period must be in (0, 1e6] cycles per revolution");
+    for (double g : gears_dec)
+        if (!(g > 0 && g <= 1e6))
+            fail(K_ARGUMENT, "gears_dec: a gear period must be in (0, 1e6] cycles per revolution");
+    ExplainOptions eo;
+    eo.order = order;
+    eo.adds = adds;
+    eo.alpha = alpha;
+    eo.gears_ha = gears_ha;
+    eo.gears_dec = gears_dec;
+    eo.pairs = pairs;
+    eo.folds = folds;
+    // explain() fits through pmhost::do_fit's one static workspace: the GIL
+    // is kept, so that two Python threads never explain at once.
+    Explanation ex;
+    try {
+        ex = explain(d.run, eo);
+    } catch (const std::runtime_error &e) {
+        std::string w = e.what();
+        fail(w.rfind("--add", 0) == 0 ? K_ARGUMENT : K_ERROR, w);
+    }
+    return "{\"n_obs\": " + std::to_string(d.run.obs.size()) + ", " + explain_json(d.run, ex, order) + "}";
+}
+
+} // namespace
+
+PYBIND11_MODULE(_pm, mod)
+{
+    mod.doc() = "compiled core of the pm package (use `import pm`)";
+    if (PM_CHECK_CONFIG() != PM_OK)
+        throw std::runtime_error("pm: library and extension built with different PM_MAX_L/PM_MAX_EXTRA");
+    py::register_exception_translator(translate);
+
+    mod.def("_set_errors", [](py::dict d) {
+        for (int k = 0; k < 6; k++) {
+            delete g_errors[k];
+            g_errors[k] = new py::object(d[KIND_NAMES[k]]);
+        }
+    });
+    mod.attr("MAX_L") = PM_MAX_L;
+    mod.attr("MAX_TERMS") = PM_MAX_TERMS;
+    mod.attr("MAX_AUX") = PM_MAX_AUX;
+    mod.attr("MODEL_DEFINITION") = PM_MODEL_DEFINITION;
+    mod.attr("INVERT_TOL") = PM_INVERT_TOL;
+    mod.attr("START_MAX") = PM_START_MAX;
+    mod.attr("RAD2AS") = RAD2AS;
+    mod.def("status_name", &status_name);
+    mod.def("status_text", &status_text);
+
+    py::class_<Model>(mod, "Model")
+        .def(py::init([](int mount, int order, double lat) { return Model::make(mount, order, lat); }),
+             py::arg("mount"), py::arg("order"), py::arg("latitude") = 0.0)
+        .def(py::init([](const Model &o) { return Model(o); }))
+        .def_static("_load", &Model::load)
+        .def_property_readonly("_mount", [](const Model &m) { return m.m.mount; })
+        .def_property_readonly("order", [](const Model &m) { return m.m.order; })
+        .def_property_readonly("n_terms", [](const Model &m) { return m.m.n_terms; })
+        .def_property_readonly("n_base", [](const Model &m) { return m.m.n_base; })
+        .def_property_readonly("needs_context", [](const Model &m) { return m.m.needs_ctx != 0; })
+        .def_property("latitude", [](const Model &m) { return m.m.latitude; }, &Model::set_latitude)
+        .def_property("coefficients", &Model::coefficients, &Model::set_coefficients)
+        .def_property_readonly("names", &Model::names)
+        .def_property_readonly("terms", &Model::terms)
+        .def_property_readonly("_inputs_needed", &Model::inputs_needed)
+        .def("_add_term", &Model::add_term)
+        .def("_apply", &Model::apply)
+        .def("_invert", &Model::invert)
+        .def("_residual", &Model::residual)
+        .def("apply_point", &Model::apply_point, py::arg("enc_ha"), py::arg("enc_dec"),
+             "apparent (ha, dec) of one encoder position: the per-point C call "
+             "pm_model_apply (radians; models without context inputs)")
+        .def("invert_point", &Model::invert_point, py::arg("app_ha"), py::arg("app_dec"),
+             py::arg("side") = 0,
+             "encoder (ha, dec, status) pointing at one apparent position: the per-point C "
+             "call pm_model_invert (status 0, or a warning 1/2)")
+        .def("_save", &Model::save)
+        .def("_emit_c", &Model::emit_c);
+
+    py::class_<RunData, std::shared_ptr<RunData>>(mod, "RunData")
+        .def("columns", &run_columns)
+        .def("info", &run_info);
+    mod.def("read_run", &read_run);
+    mod.def("run_from_arrays", &run_from_arrays);
+
+    py::class_<Fit>(mod, "Fit")
+        .def_property_readonly("model", &Fit::model)
+        .def_property_readonly("coefficients", &Fit::coefficients)
+        .def_property_readonly("errors", &Fit::errors)
+        .def_property_readonly("covariance", &Fit::covariance)
+        .def_property_readonly("names", [](const Fit &f) { return f.model().names(); })
+        .def_property_readonly("residuals", &Fit::residuals)
+        .def_property_readonly("index", [](const Fit &f) { return copy_out(f.out.idx); })
+        .def_property_readonly("lines", [](const Fit &f) { return copy_out(f.lines); })
+        .def_property_readonly("sigma", [](const Fit &f) { return f.out.res.sigma; })
+        .def_property_readonly("chi2", [](const Fit &f) { return f.out.res.chi2; })
+        .def_property_readonly("rms", [](const Fit &f) { return f.out.rms; })
+        .def_property_readonly("n_obs", [](const Fit &f) { return f.out.res.n_obs; })
+        .def_property_readonly("n_params", [](const Fit &f) { return f.out.res.n_par; })
+        .def_property_readonly("iterations", [](const Fit &f) { return f.out.res.iterations; })
+        .def_property_readonly("converged", [](const Fit &f) { return f.out.res.converged != 0; })
+        .def_property_readonly("title", [](const Fit &f) { return f.title; })
+        .def_property_readonly("max_correlation", &Fit::max_correlation)
+        .def("_pointing_sigma", &Fit::pointing_sigma);
+    mod.def("fit_run", &fit_run);
+    mod.def("explain_run", &explain_run);
+}

@@ -1,0 +1,266 @@
+"""Bad input fails cleanly: a named pm.Error subclass carrying the library's
+message (file:line for files), nothing crashes, nothing already computed or
+held is changed."""
+import glob
+import os
+
+import numpy as np
+import pytest
+
+import pm
+from conftest import PMFIT, TOP, run_cmd
+
+BAD_RUNS = sorted(glob.glob(os.path.join(TOP, "tests", "data", "bad_*.dat")) +
+                  glob.glob(os.path.join(TOP, "tests", "data", "bad_*.csv")) +
+                  glob.glob(os.path.join(TOP, "tests", "data", "bad_*.json")))
+
+
+def test_exception_classes():
+    assert issubclass(pm.FileError, pm.Error) and issubclass(pm.FileError, OSError)
+    assert issubclass(pm.FormatError, pm.Error) and issubclass(pm.FormatError, ValueError)
+    assert issubclass(pm.ArgumentError, ValueError)
+    assert issubclass(pm.NonFiniteError, pm.ArgumentError)
+    assert issubclass(pm.FitError, pm.Error)
+
+
+@pytest.mark.parametrize("path", BAD_RUNS, ids=os.path.basename)
+def test_bad_run_file_is_format_error_with_pmfit_message(path):
+    """Every malformed run of tests/data: FormatError, the message pmfit
+    prints for the same file ("path:LINE: what, expected what")."""
+    with pytest.raises(pm.FormatError) as e:
+        pm.read_run(path)
+    p = run_cmd(PMFIT, "fit", path, check=False)
+    assert p.returncode == 1
+    assert p.stderr.strip() == "pmfit: " + str(e.value)
+    assert str(e.value).startswith(path + ":")
+    assert e.value.status == -3  # PMRUN_ERR_FORMAT
+
+
+def test_forced_format_and_equinox():
+    """format= and equinox= are pmfit's --format and --equinox: the same
+    run, the same message when the forced reader fails, a clear error for
+    an unknown name."""
+    d = os.path.join(TOP, "tests", "data")
+    mw4 = os.path.join(d, "mw4_model.json")
+    auto, forced = pm.read_run(mw4), pm.read_run(mw4, format="mw4")
+    assert auto.format == forced.format
+    for col in ("enc_ha", "enc_dec", "app_ha", "app_dec"):
+        assert np.array_equal(getattr(auto, col), getattr(forced, col))
+    csv = os.path.join(d, "nina_j2000.csv")
+    with pytest.raises(pm.FormatError) as e:
+        pm.read_run(csv, format="mw4")
+    p = run_cmd(PMFIT, "fit", csv, "--format", "mw4", check=False)
+    assert p.returncode == 1 and p.stderr.strip().endswith(str(e.value))
+    assert "read as a MountWizzard4 model file" in str(e.value)
+    with pytest.raises(pm.ArgumentError):
+        pm.read_run(mw4, format="lx200")
+    with pytest.raises(pm.ArgumentError):
+        pm.read_run(csv, equinox="B1950")
+    assert len(pm.read_run(csv, equinox="J2000")) > 0
+
+
+def test_missing_and_unreadable_files(tmp_path):
+    with pytest.raises(pm.FileError) as e:
+        pm.read_run(tmp_path / "nothing.dat")
+    assert isinstance(e.value, OSError)
+    assert str(e.value) == "%s: cannot open: No such file or directory" % (tmp_path / "nothing.dat")
+    with pytest.raises(pm.FileError):
+        pm.read_run(tmp_path)  # a directory
+    with pytest.raises(pm.FileError):
+        pm.load_model(tmp_path / "nothing.pm")
+    with pytest.raises(pm.FileError):
+        pm.fit_run(tmp_path / "nothing.dat")
+    with pytest.raises(pm.ArgumentError):
+        pm.read_run(3.5)
+
+
+BAD_MODELS = {
+    "nan": ("pm-model 2\nmount equatorial\norder 0\nterms 6\nterm a 1 0 0 nan\n", 5),
+    "version": ("pm-model 9\nmount equatorial\n", 1),
+    "mount": ("pm-model 2\nmount fork\n", 2),
+    "order": ("pm-model 2\nmount equatorial\norder 9\n", 3),
+    "no_end": ("pm-model 2\nmount equatorial\norder 0\nterms 6\n" +
+               "".join("term %s %d 0 0 0\n" % (n, k + 1)
+                       for k, n in enumerate(["a", "b", "c'", "d", "e'", "i"])), 10),
+    "binary": ("pm-model 2\n\x00\x01\x02\n", 2),
+}
+
+
+@pytest.mark.parametrize("kind", sorted(BAD_MODELS))
+def test_bad_model_file_is_format_error_with_line(kind, tmp_path, sim_dir):
+    text, line = BAD_MODELS[kind]
+    f = tmp_path / ("bad_%s.pm" % kind)
+    f.write_text(text)
+    with pytest.raises(pm.FormatError) as e:
+        pm.load_model(f)
+    msg = str(e.value)
+    assert msg.startswith("%s:" % f), msg
+    # the same message pmfit eval gives (the library's)
+    p = run_cmd(PMFIT, "eval", f, os.path.join(TOP, "examples", "sim_gem.dat"), check=False)
+    assert p.returncode == 1 and p.stderr.strip() == "pmfit: " + msg
+    if kind != "no_end":
+        assert msg.startswith("%s:%d:" % (f, line)), msg
+
+
+def test_save_failure_leaves_nothing(tmp_path):
+    m = pm.Model(order=1)
+    with pytest.raises(pm.FileError) as e:
+        m.save(tmp_path / "no" / "such" / "dir.pm")
+    assert "cannot write" in str(e.value)
+    with pytest.raises(pm.FileError):
+        m.save(tmp_path)  # a directory
+    assert os.listdir(tmp_path) == []
+
+
+def test_arrays_shape_and_type_errors():
+    m = pm.Model(order=1)
+    with pytest.raises(pm.ArgumentError, match="shapes do not match"):
+        m.apply([0.1, 0.2], [0.1, 0.2, 0.3])
+    with pytest.raises(pm.ArgumentError, match="expected numbers"):
+        m.apply("north", 0.1)
+    with pytest.raises(pm.NonFiniteError, match=r"enc_ha\[1\] is nan"):
+        m.apply([0.1, None], [0.1, 0.2])  # None reads as NaN
+    with pytest.raises(pm.ArgumentError):
+        m.apply([1j], [0.1])
+    with pytest.raises(pm.ArgumentError, match="side"):
+        m.invert(0.1, 0.2, side=2)
+    with pytest.raises(pm.ArgumentError, match="side"):
+        m.invert([0.1, 0.2], [0.2, 0.3], side=[0, 1, 1])
+    with pytest.raises(pm.ArgumentError, match="both start_ha and start_dec"):
+        m.invert(0.1, 0.2, start_ha=0.1)
+    with pytest.raises(pm.ArgumentError, match="beyond"):
+        m.invert([0.1, 0.2], [0.2, 1.6])
+    with pytest.raises(pm.ArgumentError, match="mount"):
+        pm.Model(mount="fork")
+    with pytest.raises(pm.ArgumentError, match="PM_MAX_L"):
+        pm.Model(order=pm.MAX_L + 1)
+    with pytest.raises(pm.ArgumentError):
+        pm.Model(order=1.5)
+    with pytest.raises(pm.ArgumentError, match="like enc_ha"):
+        pm.fit(np.zeros(10), np.zeros(9), np.zeros(10), np.zeros(10))
+    with pytest.raises(pm.ArgumentError, match="1-D"):
+        pm.fit(np.zeros((5, 2)), np.zeros((5, 2)), np.zeros((5, 2)), np.zeros((5, 2)))
+    with pytest.raises(pm.ArgumentError, match="pier"):
+        pm.fit(np.zeros(10), np.zeros(10), np.zeros(10), np.zeros(10), pier=np.full(10, 2))
+
+
+def test_non_finite_inputs_are_named():
+    m = pm.Model(order=1)
+    ha = np.linspace(-1, 1, 12).reshape(3, 4)
+    dec = np.full((3, 4), 0.3)
+    dec[1, 2] = np.nan
+    with pytest.raises(pm.NonFiniteError, match=r"enc_dec\[1, 2\] is nan"):
+        m.apply(ha, dec)
+    with pytest.raises(pm.NonFiniteError, match=r"app_ha\[0\] is inf"):
+        m.invert([np.inf], [0.1])
+    with pytest.raises(pm.NonFiniteError, match=r"app_dec\[3\] is nan"):
+        pm.fit(np.zeros(5), np.zeros(5), np.zeros(5), [0, 0, 0, np.nan, 0])
+    with pytest.raises(pm.NonFiniteError):
+        m.residual(0.1, 0.2, 0.1, -np.inf)
+
+
+def test_context_inputs_the_model_needs(sim_dir):
+    r = pm.read_run(sim_dir / "eq.dat")
+    m = pm.fit_run(r, add=["temperature", "hysteresis"]).model
+    with pytest.raises(pm.ArgumentError, match="pass temp_c="):
+        m.apply(r.enc_ha, r.enc_dec)
+    with pytest.raises(pm.ArgumentError, match="pass dir="):
+        m.apply(r.enc_ha, r.enc_dec, temp_c=r.temp_c)
+    with pytest.raises(pm.ArgumentError, match="dir"):
+        m.apply(0.1, 0.2, temp_c=3.0, dir=0.5)
+    t = np.array(r.temp_c)
+    t[7] = np.nan
+    with pytest.raises(pm.NonFiniteError, match=r"temp_c\[7\]"):
+        m.apply(r.enc_ha, r.enc_dec, temp_c=t, dir=r.dir)
+    a = m.apply(r.enc_ha, r.enc_dec, temp_c=r.temp_c, dir=r.dir)  # and with them it works
+    assert np.isfinite(a).all()
+
+
+def test_fit_failures_name_the_reason():
+    with pytest.raises(pm.FitError) as e:
+        pm.fit([], [], [], [])
+    assert e.value.status == -4 and "no observations" in str(e.value)
+    z = np.linspace(0, 1, 5)
+    with pytest.raises(pm.FitError) as e:
+        pm.fit(z, z, z, z, order=1)
+    assert e.value.status == -4  # PM_ERR_TOO_FEW
+    assert "P = 22 terms need at least 12 observations" in str(e.value)
+    one = np.full(40, 0.2)
+    with pytest.raises(pm.FitError) as e:
+        pm.fit(one, one, one + 1e-5, one)
+    assert e.value.status == -5 and e.value.bad_term is not None  # PM_ERR_SINGULAR
+    assert "term %s" % e.value.bad_term in str(e.value)
+    rng = np.random.default_rng(1)
+    ha, dec = rng.uniform(-3, 3, 80), rng.uniform(-1, 1.4, 80)
+    with pytest.raises(pm.ArgumentError, match="unknown effect"):
+        pm.fit(ha, dec, ha, dec, add="wobble")
+    with pytest.raises(pm.ArgumentError, match="latitude"):
+        pm.fit(ha, dec, ha, dec, add="refraction")
+    with pytest.raises(pm.ArgumentError, match="degrees"):
+        pm.fit(ha, dec, ha, dec, latitude=47.0)
+    with pytest.raises(pm.ArgumentError, match="latitude"):
+        pm.Model(latitude=np.nan)
+    with pytest.raises(pm.ArgumentError, match="no value for the observation at line 1"):
+        pm.fit(ha, dec, ha, dec, add="temperature")
+    with pytest.raises(pm.ArgumentError, match="order"):
+        pm.fit(ha, dec, ha, dec, order=-1)
+    with pytest.raises(pm.ArgumentError, match="add"):
+        pm.fit(ha, dec, ha, dec, add=[3])
+    with pytest.raises(pm.FitError, match="no observations on the pier side west"):
+        pm.fit(ha, np.clip(dec, -1, 1), ha, np.clip(dec, -1, 1), split=True)
+    with pytest.raises(pm.ArgumentError, match="joint fit"):
+        pm.fit(ha, dec, ha, dec, split=True, add="i@W")
+
+
+def test_bad_coefficients_leave_the_model_unchanged():
+    m = pm.Model(order=1)
+    c = np.arange(m.n_terms) * 1e-6
+    m.coefficients = c
+    before = m.apply(0.3, 0.4)
+    for bad in (np.full(m.n_terms, np.nan), np.full(m.n_terms, 1e200), np.ones(3), "x"):
+        with pytest.raises((pm.ArgumentError, TypeError)):
+            m.coefficients = bad
+        assert (m.coefficients == c).all()
+        assert m.apply(0.3, 0.4) == before
+
+
+def test_explain_errors(tmp_path):
+    run = os.path.join(TOP, "examples", "sim_gem.dat")
+    with pytest.raises(pm.FileError):
+        pm.explain(tmp_path / "none.dat")
+    with pytest.raises(pm.ArgumentError, match="alpha"):
+        pm.explain(run, alpha=2)
+    with pytest.raises(pm.ArgumentError, match="gear"):
+        pm.explain(run, gears=[-1])
+    with pytest.raises(pm.ArgumentError, match="folds"):
+        pm.explain(run, folds=1)
+    with pytest.raises(pm.ArgumentError, match="unknown effect"):
+        pm.explain(run, add="wobble")
+
+
+@pytest.mark.filterwarnings("ignore::pm.PointingWarning")
+def test_nasty_values_do_not_crash():
+    """Extreme but finite inputs: a result or a pm.Error, never a crash."""
+    m = pm.Model(order=2)
+    m.coefficients = np.full(m.n_terms, 1e-3)
+    for ha, dec in ((1e300, 0.1), (0.1, 1e300), (-1e308, 1e-320), (5e-324, -5e-324),
+                    (np.pi / 2, np.pi / 2), (0.0, -np.pi / 2)):
+        try:
+            a, b = m.apply(ha, dec)
+            assert np.isfinite(a) and np.isfinite(b)
+        except pm.Error:
+            pass
+        try:
+            m.invert(0.1, np.clip(dec, -np.pi / 2, np.pi / 2), start_ha=ha % 7, start_dec=0.0)
+        except pm.Error:
+            pass
+    with pytest.raises(pm.ArgumentError, match="PM_START_MAX"):
+        m.invert(0.1, 0.2, start_ha=1e300, start_dec=0.0)
+    big = pm.Model(order=1)
+    big.coefficients = np.full(big.n_terms, 1e150)
+    try:
+        assert np.isfinite(big.apply(0.3, 0.4)).all()
+    except pm.Error:
+        pass
+    m.apply(np.zeros(0), np.zeros(0))
+    assert m.apply(np.zeros((0, 3)), 0.1)[0].shape == (0, 3)
