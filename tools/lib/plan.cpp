@@ -477,6 +477,28 @@ pm_context mean_context(const Run &run)
     return c;
 }
 
+// Can any set of points on this sky determine the model?  A noise-free fit
+// at every place of the sky names the first term that cannot be.
+void check_determinable(const pm_model &m, const std::vector<SkyPlace> &sky)
+{
+    std::vector<Obs> obs;
+    for (const SkyPlace &p : sky) {
+        Obs o;
+        o.eh = p.d.eh, o.ed = p.d.ed, o.ctx = p.d.ctx, o.pier = p.side, o.line = 0;
+        if (pm_model_apply(&m, &o.ctx, o.eh, o.ed, &o.ah, &o.ad) == PM_OK)
+            obs.push_back(o);
+    }
+    std::vector<int> all(obs.size());
+    for (size_t i = 0; i < all.size(); i++)
+        all[i] = (int)i;
+    FitOut f = do_fit(obs, all, m, 3);
+    if (f.status == PM_ERR_SINGULAR && f.bad_term >= 0)
+        throw std::runtime_error("plan: no set of points on this sky can determine the model: term " +
+                                 term_name(m, f.bad_term) +
+                                 " is a combination of the terms before it (tube_flexure, for "
+                                 "one, is part of the order-1 terms; docs/explain.md)");
+}
+
 std::string horizon_text(const PlanOptions &o)
 {
     std::string s = "above " + std::to_string((int)std::lround(o.min_el_deg)) + " deg elevation";
@@ -511,6 +533,7 @@ Plan plan_targets(const Run &taken, const PlanOptions &o)
     std::vector<SkyPlace> sky = sky_places(o, 4, done, ctx);
     if (sky.empty())
         throw std::runtime_error("plan: no usable sky " + horizon_text(o) + " at this latitude");
+    check_determinable(m, sky);
     std::vector<SkyPlace> cand = o.stars.empty() ? sky_places(o, o.grid_deg, done, ctx)
                                                  : star_places(o, done, ctx);
     plan.n_catalogue = (int)o.stars.size();
