@@ -429,7 +429,8 @@ void simulated(const Setting &st, int order, const std::vector<int> &refs,
                          "\"reference\": \"%s\", \"n\": %d, \"heldout_arcsec\": %.4f, "
                          "\"predicted_arcsec\": %.4f, \"plan_needs\": %s, \"dplan_needs\": %s, "
                          "\"random_needs\": %s, \"plan_needs_predicted\": %s}\n",
-                         st.name.c_str(), order, taken.size(), name.c_str(), n, e, pe,
+                         json_escape(st.name).c_str(), order, taken.size(), name.c_str(), n,
+                         std::isfinite(e) ? e : -1.0, pe,
                          fmt_needed(np) == ">max" ? "null" : fmt_needed(np).c_str(),
                          fmt_needed(nd) == ">max" ? "null" : fmt_needed(nd).c_str(),
                          fmt_needed(nr) == ">max" ? "null" : fmt_needed(nr).c_str(),
@@ -593,7 +594,8 @@ void real_run(const std::string &path, const std::string &label)
                              "{\"kind\": \"real\", \"run\": \"%s\", \"order\": %d, \"n\": %d, "
                              "\"spread_cv_arcsec\": %.4f, \"random_cv_arcsec\": %.4f, "
                              "\"plan_cv_arcsec\": %.4f, \"plan_needs\": %s, \"random_needs\": %s}\n",
-                             label.c_str(), order, nref, e, cr[i], cp[i],
+                             label.c_str(), order, nref, std::isfinite(e) ? e : -1.0,
+                             std::isfinite(cr[i]) ? cr[i] : -1.0, std::isfinite(cp[i]) ? cp[i] : -1.0,
                              std::isnan(np) ? "null" : fmt_needed(np).c_str(),
                              std::isnan(nr) ? "null" : fmt_needed(nr).c_str());
             if (nref == ns.back())
