@@ -28,6 +28,9 @@
 // below the reference's error (curves sampled every ~5%; linear between
 // samples).
 //
+// JSON lines (--out): one per reference; an error that could not be
+// computed (a fit failed) is -1, a count not reached null.
+//
 //   build/bench/pmbench_plan [--quick] [--data DIR] [--out FILE.jsonl]
 #include "fitrun.hpp"
 #include "plan.hpp"

@@ -788,7 +788,7 @@ END_TEST
 
 /* A degenerate run (every point at one place): the plan says the run does
 ** not determine the model and plans from the ideal mount; its first target
-** is elsewhere. */
+** is elsewhere; the run's side is used only near the meridian. */
 START_TEST(test_plan_degenerate_run)
 {
     static char text[1 << 13];
@@ -806,6 +806,21 @@ START_TEST(test_plan_degenerate_run)
     ck_assert_ptr_nonnull(strstr(out, "\"before_arcsec\": null"));
     ck_assert_int_eq(parse_targets(out, t, 5), 5);
     ck_assert(fabs(t[0].x + 30) > 10 || fabs(t[0].y - 40) > 10);
+    /* the run used the normal side only; beyond the meridian limit (15 deg)
+    ** west of the meridian the targets are beyond the pole all the same */
+    {
+        static cli_target u[40];
+        int n, west = 0;
+        snprintf(args, sizeof args, "'%s' --next 40 --json", write_file("degenerate.dat", text));
+        ck_assert_msg(plan_cli(args) == 0, "%s", out);
+        n = parse_targets(out, u, 40);
+        for (i = 0; i < n; i++) {
+            if (fabs(u[i].x) > 15)
+                ck_assert_int_eq(u[i].side, u[i].x > 0 ? -1 : 1);
+            west += u[i].x > 15;
+        }
+        ck_assert_int_gt(west, 0);
+    }
 }
 END_TEST
 

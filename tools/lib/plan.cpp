@@ -99,7 +99,10 @@ struct Design {
 };
 
 // A from the rows of `taken` plus a ridge, W from the sky (weighted mean).
-Design design(const std::vector<Rowed> &taken, const std::vector<Rowed> &sky, int P)
+// The ridge keeps A invertible before the points determine the model: a
+// direction they leave free gets a variance of 1/ridge.
+Design design(const std::vector<Rowed> &taken, const std::vector<Rowed> &sky, int P,
+              double ridge = 1e-8)
 {
     Design d;
     d.P = P;
@@ -118,7 +121,7 @@ Design design(const std::vector<Rowed> &taken, const std::vector<Rowed> &sky, in
     for (const Rowed &p : sky)
         add(d.w, p, p.p.weight / wsum);
     for (int i = 0; i < P; i++)
-        a[(size_t)(i * P + i)] += 1e-8; // a ridge: the first points of a run
+        a[(size_t)(i * P + i)] += ridge;
     if (!spd_inverse(a, P))
         throw std::runtime_error("plan: the design is singular");
     d.ainv = a;
@@ -216,6 +219,23 @@ double design_criterion(const pm_model &m, const std::vector<DesignPlace> &pts,
         throw std::runtime_error("plan: no place of the sky can be evaluated");
     return design(t, s, m.n_terms).f;
 }
+
+namespace {
+
+// Do the places determine the model over the sky?  The criterion with the
+// ridge a hundred times larger: unchanged where they do, a hundred times
+// smaller where a direction the sky needs is left free.
+bool determines(const pm_model &m, const std::vector<DesignPlace> &pts,
+                const std::vector<DesignPlace> &sky)
+{
+    if (2 * (long)pts.size() < m.n_terms)
+        return false;
+    std::vector<Rowed> t = with_rows(m, pts), s = with_rows(m, sky);
+    double f1 = design(t, s, m.n_terms, 1e-8).f, f2 = design(t, s, m.n_terms, 1e-6).f;
+    return std::isfinite(f1) && f1 < 1.5 * f2;
+}
+
+} // namespace
 
 std::vector<int> greedy_design(const pm_model &m, const std::vector<DesignPlace> &taken,
                                const std::vector<DesignPlace> &cand,
@@ -348,6 +368,9 @@ std::vector<int> sides_for(const PlanOptions &o, const std::vector<SkyPlace> &ta
         return {meridian};
     case SIDES_RUN:
     default:
+        // beyond the meridian limit only one side reaches the place
+        if (std::fabs(x) > o.meridian_limit_deg)
+            return {meridian};
         return {nearest_side(taken, x, y, meridian)};
     }
 }
@@ -554,20 +577,38 @@ Plan plan_targets(const Run &taken, const PlanOptions &o)
     plan.n_candidates = (int)cand.size();
     plan.n_sky = (int)sky.size();
     double f0 = design_criterion(m, dt, ds);
-    auto determined = [&](size_t n, double f) { return 2 * (long)n >= m.n_terms && f < 1e4; };
-    plan.before_arcsec = determined(dt.size(), f0) ? o.noise_arcsec * std::sqrt(std::max(0.0, f0))
-                                                   : NAN;
+    plan.before_arcsec =
+        determines(m, dt, ds) ? o.noise_arcsec * std::sqrt(std::max(0.0, f0)) : NAN;
     std::vector<double> crit, secs;
     const DesignPlace *start = dt.empty() ? nullptr : &dt.back();
     std::vector<int> order =
         greedy_design(m, dt, dc, ds, o.next, o.d_optimal, o.slew, start, &crit, &secs);
+    // the first step from which the points determine the model (taking more
+    // points keeps it determined): bisection
+    auto with_first = [&](size_t k) {
+        std::vector<DesignPlace> v = dt;
+        for (size_t i = 0; i < k; i++)
+            v.push_back(dc[(size_t)order[i]]);
+        return v;
+    };
+    size_t lo = 0, hi = order.size() + 1; // determined from step hi on (hi > size: never)
+    if (std::isfinite(plan.before_arcsec))
+        hi = 0;
+    else if (!order.empty() && determines(m, with_first(order.size()), ds)) {
+        hi = order.size();
+        while (hi - lo > 1) {
+            size_t mid = (lo + hi) / 2;
+            if (determines(m, with_first(mid), ds))
+                hi = mid;
+            else
+                lo = mid;
+        }
+    }
     for (size_t k = 0; k < order.size(); k++) {
         const SkyPlace &p = cand[(size_t)order[k]];
         Target t;
         t.x_deg = p.x, t.y_deg = p.y, t.el_deg = p.el, t.side = p.side;
-        t.after_arcsec = determined(dt.size() + k + 1, crit[k])
-                             ? o.noise_arcsec * std::sqrt(std::max(0.0, crit[k]))
-                             : NAN;
+        t.after_arcsec = k + 1 >= hi ? o.noise_arcsec * std::sqrt(std::max(0.0, crit[k])) : NAN;
         if (p.star >= 0) {
             const CatalogueStar &s = o.stars[(size_t)p.star];
             t.name = s.name, t.ra_h = s.ra_h, t.dec_deg = s.dec_deg;

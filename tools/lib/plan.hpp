@@ -18,7 +18,8 @@ namespace pmhost {
 
 // Which pier side a German mount takes a place on.
 enum PlanSides {
-    SIDES_RUN,      // the side the run used nearby (the meridian rule when nothing is taken)
+    SIDES_RUN,      // within meridian_limit_deg of the meridian the side the run used
+                    // nearby (the meridian rule when nothing is taken); beyond, the meridian rule
     SIDES_MERIDIAN, // east of the meridian the normal side, west of it beyond the pole
     SIDES_BOTH      // within meridian_limit_deg of the meridian either side (the plan chooses)
 };
@@ -46,7 +47,7 @@ struct PlanOptions {
     SkyTime when;                  // where the catalogue's stars are
     bool gem = true;               // equatorial: a German mount (flips west of the meridian)
     PlanSides sides = SIDES_RUN;
-    double meridian_limit_deg = 15; // SIDES_BOTH: how far past the meridian either side reaches
+    double meridian_limit_deg = 15; // how far past the meridian either side reaches
     bool d_optimal = false;        // maximise det(A) instead of minimising the mean variance
     SlewModel slew;
 };
