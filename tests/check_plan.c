@@ -672,7 +672,7 @@ static double log_det_cov(const pm_fit_result *res, int P)
 
 START_TEST(test_plan_d_score)
 {
-    static double eh[41], ed[41], ah[41], ad[41], cand[2];
+    static double eh[41], ed[41], ah[41], ad[41], cand[2], pairs[80];
     unsigned char taken[1] = {0};
     pm_model truth, m, m2;
     pm_fit_result res, res2;
@@ -683,11 +683,10 @@ START_TEST(test_plan_d_score)
     truth.coef[2] = 600 * ARCSEC;
     ck_assert_int_eq(pm_model_prepare(&truth), PM_OK);
     tu_seed(&r, 12);
-    encoder_places(&r, 40, eh); /* pairs into eh: unpack below */
-    for (i = 39; i >= 0; i--) {
-        double t = eh[2 * i], d = eh[2 * i + 1];
-        ed[i] = d;
-        eh[i] = t;
+    encoder_places(&r, 40, pairs);
+    for (i = 0; i < 40; i++) {
+        eh[i] = pairs[2 * i];
+        ed[i] = pairs[2 * i + 1];
     }
     for (i = 0; i < 40; i++) {
         ck_assert_int_eq(pm_model_apply(&truth, NULL, eh[i], ed[i], &ah[i], &ad[i]), PM_OK);
