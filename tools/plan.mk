@@ -14,7 +14,8 @@ $(B)/bench/pmbench_plan: bench/bench_plan.cpp $(B)/libpmhost.a $(B)/libpm.a $(wi
 	$(CXX) $(HOST_CXXFLAGS) $< -o $@ $(B)/libpmhost.a $(B)/libpm.a -lerfa -lm
 
 bench-plan: $(B)/bench/pmbench_plan
-	$(B)/bench/pmbench_plan --data $(DATA) --out $(B)/bench/plan.jsonl | tee $(B)/bench/plan.txt
+	$(B)/bench/pmbench_plan --data $(DATA) --out $(B)/bench/plan.jsonl > $(B)/bench/plan.txt
+	@cat $(B)/bench/plan.txt
 
 bench-run: bench-plan
 
