@@ -763,6 +763,10 @@ pm_status pm_fit_covariance(const pm_fit *fit, const pm_fit_result *res,
 **  2) The scatter of a corrected telescope at a new star is about
 **     sqrt(res->sigma^2 + sigma^2) per axis: the noise of one measurement
 **     plus this (tests/check_errormap.c compares it with held-out points).
+**  3) The D-optimal score of a candidate star (the rise of log det of the
+**     information if it were taken, noise s = res->sigma) follows from cov:
+**     log((1 + v11/s^2)(1 + v22/s^2) - v12^2/s^4) (examples/next_star.c;
+**     tests/check_plan.c checks it against the refit).
 */
 pm_status pm_fit_pointing_sigma(const pm_fit *fit, const pm_fit_result *res,
                                 const pm_model *m, const pm_context *ctx, double enc_ha,

@@ -9,8 +9,15 @@
 **  - an order-1 term moved by 15": that term moved, a re-zero does not
 **    help, a refit is advised;
 **  with OLD given as a saved model and as a run (then both fits' errors
-**  count).  The real runs of ../shared/data: first half against second
-**  half (printed for docs/model.md; skipped without the data).
+**  count).  The real runs of ../shared/data (skipped without the data):
+**  first half against second half -- a refit predicts the second half
+**  better than the first half's model, and where the first half's model
+**  extrapolates (the amateur runs visit the sky in order) its predicted
+**  error at the second half is many times that at its own stars and the
+**  advice says so; and the even points against the odd points of the same
+**  night (the same sky, no drift) -- no term moved, "the model still
+**  holds": no false alarm on real data.  A degenerate new run is a clear
+**  error naming the term.
 */
 #define _POSIX_C_SOURCE 200809L
 #include <check.h>
@@ -115,8 +122,9 @@ START_TEST(test_compare_simulated_nights)
 }
 END_TEST
 
-/* A run's first half against its second half. */
-static void halves(const char *data, const char *name)
+/* A run's first half against its second half (interleaved: its even
+** points against its odd ones). */
+static void halves(const char *data, const char *name, int interleaved)
 {
     char src[512], cmd[2048], a[600], b[600];
     FILE *in, *fa, *fb;
@@ -145,7 +153,8 @@ static void halves(const char *data, const char *name)
             fputs(line, fa);
             fputs(line, fb);
         } else {
-            fputs(line, k++ < n / 2 ? fa : fb);
+            fputs(line, (interleaved ? k % 2 == 0 : k < n / 2) ? fa : fb);
+            k++;
         }
     }
     fclose(in);
@@ -155,13 +164,26 @@ static void halves(const char *data, const char *name)
     {
         const char *cv = strstr(out, "\"cv_rms_arcsec\"");
         ck_assert_ptr_nonnull(cv);
-        printf("check_compare: %s, first half vs second half: as is %.3f\", re-zero %.3f\", "
-               "refit %.3f\" (cross-validated); the old fit's predicted error at the second "
-               "half %.3f\", at the first %.3f\"; %d terms moved; %s\n", name,
-               tu_json_num(cv, "as_is"), tu_json_num(cv, "rezero"), tu_json_num(cv, "refit"),
-               tu_json_num(out, "at_new_points"), tu_json_num(out, "at_old_points"), moved_count(),
+        double as_is = tu_json_num(cv, "as_is"), refit = tu_json_num(cv, "refit");
+        double at_new = tu_json_num(out, "at_new_points"), at_old = tu_json_num(out, "at_old_points");
+        printf("check_compare: %s, %s: as is %.3f\", re-zero %.3f\", "
+               "refit %.3f\" (cross-validated); the old fit's predicted error at the new "
+               "points %.3f\", at its own %.3f\"; %d terms moved; %s\n", name,
+               interleaved ? "even points vs odd points" : "first half vs second half", as_is,
+               tu_json_num(cv, "rezero"), refit, at_new, at_old, moved_count(),
                strstr(out, "\"advice\""));
-        ck_assert(tu_json_num(cv, "refit") > 0);
+        if (interleaved) {
+            /* the same night, the same sky: nothing moved, the model holds */
+            ck_assert_int_eq(moved_count(), 0);
+            ck_assert_ptr_nonnull(strstr(out, "still holds"));
+            ck_assert(at_new < 1.2 * at_old);
+        } else {
+            /* the second half is better predicted by a refit */
+            ck_assert(refit < 0.7 * as_is);
+            ck_assert_ptr_nonnull(strstr(out, "\"advice\": \"refit"));
+            if (at_new > 10 * at_old) /* the amateur runs: extrapolation, said so */
+                ck_assert_ptr_nonnull(strstr(out, "extrapolates"));
+        }
     }
 }
 
@@ -174,9 +196,12 @@ START_TEST(test_compare_real_halves)
     }
     if (!dir[0])
         tu_tmpdir(dir, "pm_compare_");
-    halves(d, "mmt/k_and_e.dat");
-    halves(d, "celestial/gem-28.dat");
-    halves(d, "celestial/cgx-l-data.dat");
+    halves(d, "mmt/k_and_e.dat", 0);
+    halves(d, "celestial/gem-28.dat", 0);
+    halves(d, "celestial/cgx-l-data.dat", 0);
+    halves(d, "mmt/k_and_e.dat", 1);
+    halves(d, "celestial/gem-28.dat", 1);
+    halves(d, "celestial/cgx-l-data.dat", 1);
 }
 END_TEST
 
@@ -187,12 +212,29 @@ START_TEST(test_compare_misuse)
         {"compare only_one.dat", "compare needs OLD"},
         {"compare /nonexistent.pm RUN", "/nonexistent"},
         {"compare a.dat b.dat --save m.pm", "compare takes OLD RUN"},
+        {"compare RUN DEGENERATE", "cannot be refitted with the model's terms: term d"},
     };
     char cmd[1024];
     size_t k;
     for (k = 0; k < sizeof bad / sizeof bad[0]; k++) {
         const char *top = getenv("PM_TOP"), *r = strstr(bad[k][0], "RUN");
-        if (r)
+        if (strstr(bad[k][0], "DEGENERATE")) {
+            /* every point at one place: the new run cannot determine the model */
+            char path[128];
+            FILE *f;
+            int i;
+            if (!dir[0])
+                tu_tmpdir(dir, "pm_compare_");
+            snprintf(path, sizeof path, "%s/degenerate.dat", dir);
+            f = fopen(path, "w");
+            ck_assert_ptr_nonnull(f);
+            fprintf(f, "# latitude: 47\n# tau delta T D pier\n");
+            for (i = 0; i < 30; i++)
+                fprintf(f, "-30.0 40.0 -30.01 40.0%d E\n", i % 3);
+            fclose(f);
+            snprintf(cmd, sizeof cmd, "%s compare %s/examples/sim_gem.dat %s", tu_pmfit_path(),
+                     top ? top : ".", path);
+        } else if (r)
             snprintf(cmd, sizeof cmd, "%s %.*s%s/tests/data/flip_gem_pm180.dat", tu_pmfit_path(),
                      (int)(r - bad[k][0]), bad[k][0], top ? top : ".");
         else

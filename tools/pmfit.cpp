@@ -82,6 +82,13 @@ struct Options {
     std::string error_map;           // fit --error-map FILE.svg
     int next = 5;                    // plan --next K
     double min_el = 15, grid = 6;    // plan --min-el, --grid
+    std::string horizon, catalogue;  // plan --horizon FILE, --catalog FILE
+    double lst = -1, lon = NAN;      // plan --lst HOURS, --lon DEG (with --utc)
+    std::string utc;                 // plan --utc YYYY-MM-DDTHH:MM[:SS]
+    bool d_optimal = false;          // plan --criterion D
+    double slew_rate = 0, settle = 5, point_time = 30, flip_time = 60; // plan --slew ...
+    std::string sides = "run";       // plan --sides run|meridian|both
+    double meridian_limit = 15;      // plan --meridian-limit DEG
     bool min_el_given = false, lat_given = false, noise_given = false, mount_given = false;
     std::vector<std::string> inject; // simulate --inject EFFECT[=SIZE] --into RUN
     std::string into;
@@ -166,12 +173,29 @@ void usage(FILE *f)
         "\n"
         "usage: pmfit plan [RUN] [--next K] [--order L] [--add EFFECT ...] [--lat DEG]\n"
         "                  [--mount equatorial|altaz] [--fork] [--min-el DEG] [--grid DEG]\n"
-        "                  [--noise ARCSEC] [--json]\n"
+        "                  [--noise ARCSEC] [--json] [--horizon FILE] [--criterion I|D]\n"
+        "                  [--catalog FILE (--lst HOURS | --utc YYYY-MM-DDTHH:MM --lon DEG)]\n"
+        "                  [--sides run|meridian|both] [--meridian-limit DEG]\n"
+        "                  [--slew DEG_PER_S [--settle S] [--point-time S] [--flip-time S]]\n"
         "\n"
         "  which star next: the K targets (default 5) that most reduce the model's predicted\n"
         "  pointing error averaged over the sky above --min-el (default 15 deg), given the\n"
         "  points of RUN taken so far (none: the first points of a run); candidates on a grid\n"
         "  of --grid deg (6); a German mount takes each on the side the run used nearby\n"
+        "  --horizon F      azimuth-dependent horizon: 'azimuth elevation' lines (N.I.N.A.,\n"
+        "                   APCC .hrz, Cartes du Ciel) or MountWizzard4 .hpts (docs/formats.md)\n"
+        "  --catalog F      candidates are the stars of F ('RA Dec [name]' lines), placed on\n"
+        "                   the sky at --lst (local sidereal time, hours) or --utc with --lon\n"
+        "                   (east longitude; J2000 places reduced with ERFA)\n"
+        "  --criterion D    D-optimal (maximise the information's determinant) instead of the\n"
+        "                   default I-optimal (minimise the mean predicted error over the sky)\n"
+        "  --sides S        German mount, within --meridian-limit DEG (15) of the meridian:\n"
+        "                   run (default: the side the run used nearby), meridian (flip at\n"
+        "                   the meridian), both (either side: the plan chooses); beyond the\n"
+        "                   limit always the side that reaches the place\n"
+        "  --slew R         weigh the time: the gain per second, a slew at R deg/s per axis\n"
+        "                   plus --settle S (5) and --point-time S (30, exposure and solve) per\n"
+        "                   point and --flip-time S (60) for a change of pier side\n"
         "\n"
         "usage: pmfit compare OLD RUN [--order L] [--add EFFECT ...] [--json] [--no-refraction]\n"
         "                     [--skip-bad]\n"
@@ -420,6 +444,36 @@ Options parse_args(int argc, char **argv)
             o.min_el_given = true;
         } else if (pln && a == "--grid") {
             o.grid = number(a, need("degrees"), 1, 30);
+        } else if (pln && a == "--horizon") {
+            o.horizon = need("a horizon file");
+        } else if (pln && (a == "--catalog" || a == "--catalogue")) {
+            o.catalogue = need("a star catalogue file");
+        } else if (pln && a == "--lst") {
+            o.lst = number(a, need("hours"), 0, 23.999999999);
+        } else if (pln && a == "--utc") {
+            o.utc = need("a UTC time YYYY-MM-DDTHH:MM[:SS]");
+        } else if (pln && a == "--lon") {
+            o.lon = number(a, need("degrees (east)"), -180, 360);
+        } else if (pln && a == "--criterion") {
+            std::string v = need("I or D");
+            if (v != "I" && v != "D" && v != "i" && v != "d")
+                die("--criterion: expected I (mean predicted error) or D (determinant), got '" + v +
+                    "'");
+            o.d_optimal = v == "D" || v == "d";
+        } else if (pln && a == "--slew") {
+            o.slew_rate = number(a, need("the slew rate in deg/s"), 0.01, 100);
+        } else if (pln && a == "--settle") {
+            o.settle = number(a, need("seconds"), 0, 3600);
+        } else if (pln && a == "--point-time") {
+            o.point_time = number(a, need("seconds"), 0, 36000);
+        } else if (pln && a == "--flip-time") {
+            o.flip_time = number(a, need("seconds"), 0, 3600);
+        } else if (pln && a == "--sides") {
+            o.sides = need("run, meridian or both");
+            if (o.sides != "run" && o.sides != "meridian" && o.sides != "both")
+                die("--sides: expected run, meridian or both, got '" + o.sides + "'");
+        } else if (pln && a == "--meridian-limit") {
+            o.meridian_limit = number(a, need("degrees"), 0, 90);
         } else if (sim && a == "--inject") {
             o.inject.push_back(need("EFFECT[=SIZE]"));
         } else if (sim && a == "--into") {
@@ -511,7 +565,22 @@ Options parse_args(int argc, char **argv)
     if (pln && (o.split || !o.save.empty() || !o.emit_c.empty() || !o.error_map.empty() ||
                 o.robust || !o.residuals.empty()))
         die("plan takes [RUN] [--next K] [--order L] [--add EFFECT ...] [--lat DEG] [--mount M] "
-            "[--fork] [--min-el DEG] [--grid DEG] [--noise ARCSEC] [--json]; see pmfit --help");
+            "[--fork] [--min-el DEG] [--grid DEG] [--noise ARCSEC] [--json] and the options of "
+            "pmfit --help; see there");
+    if (pln && o.catalogue.empty() && (o.lst >= 0 || !o.utc.empty() || std::isfinite(o.lon)))
+        die("--lst, --utc and --lon place the stars of a catalogue; add --catalog FILE");
+    if (pln && !o.catalogue.empty() && (o.lst >= 0) == !o.utc.empty())
+        die("--catalog needs the time: --lst HOURS (local sidereal time) or --utc "
+            "YYYY-MM-DDTHH:MM with --lon DEG (one of them)");
+    if (pln && !o.utc.empty() && !std::isfinite(o.lon))
+        die("--utc needs the site's east longitude: --lon DEG");
+    if (pln && o.slew_rate <= 0) {
+        for (int i = 2; i < argc; i++) {
+            std::string a = argv[i];
+            if (a == "--settle" || a == "--point-time" || a == "--flip-time")
+                die(a + " belongs to the slew model; add --slew DEG_PER_S");
+        }
+    }
     for (int i = 2; i < argc; i++) {
         std::string a = argv[i];
         o.lat_given = o.lat_given || a == "--lat";
@@ -809,30 +878,63 @@ int cmd_plan(const Options &o)
                 po.noise_arcsec = f.res.sigma * RAD2AS;
         }
     }
+    po.d_optimal = o.d_optimal;
+    po.sides = o.sides == "both" ? SIDES_BOTH : o.sides == "meridian" ? SIDES_MERIDIAN : SIDES_RUN;
+    po.meridian_limit_deg = o.meridian_limit;
+    po.slew.rate_deg_s = o.slew_rate;
+    po.slew.settle_s = o.settle;
+    po.slew.point_s = o.point_time;
+    po.slew.flip_s = o.flip_time;
     Plan p;
     try {
+        if (!o.horizon.empty())
+            po.horizon = read_horizon(o.horizon);
+        if (!o.catalogue.empty()) {
+            po.stars = read_catalogue(o.catalogue);
+            po.when.lst_h = o.lst;
+            po.when.utc = o.utc;
+            po.when.lon_rad = o.lon * PI / 180;
+            po.when.lat_rad = po.latitude;
+            if (!o.utc.empty() && !std::isfinite(po.latitude))
+                throw std::runtime_error("--utc needs the site latitude (--lat, or the run's)");
+        }
         p = plan_targets(run, po);
     } catch (const std::exception &x) {
         die(x.what(), 1);
     }
     bool az = po.mount == PM_MOUNT_ALTAZ;
+    auto num = [](double v) { return std::isfinite(v) ? std::to_string(v) : std::string("null"); };
     if (o.json) {
         std::printf("{\"taken\": %zu, \"order\": %d, \"noise_arcsec\": %.6g, \"before_arcsec\": %s, "
-                    "\"targets\": [", run.obs.size(), o.order, po.noise_arcsec,
-                    std::isfinite(p.before_arcsec) ? std::to_string(p.before_arcsec).c_str() : "null");
+                    "\"criterion\": \"%s\", \"candidates\": %d, \"catalogue_stars\": %d, "
+                    "\"note\": \"%s\", \"targets\": [", run.obs.size(), o.order, po.noise_arcsec,
+                    num(p.before_arcsec).c_str(), po.d_optimal ? "D" : "I", p.n_candidates,
+                    p.n_catalogue, json_escape(p.note).c_str());
         for (size_t k = 0; k < p.targets.size(); k++) {
             const Target &t = p.targets[k];
             std::printf("%s{\"%s\": %.4f, \"%s\": %.4f, \"elevation_deg\": %.4f, \"side\": %d, "
-                        "\"after_arcsec\": %s}", k ? ", " : "", az ? "azimuth_deg" : "ha_deg",
+                        "\"after_arcsec\": %s", k ? ", " : "", az ? "azimuth_deg" : "ha_deg",
                         t.x_deg, az ? "el_deg" : "dec_deg", t.y_deg, t.el_deg, t.side,
-                        std::isfinite(t.after_arcsec) ? std::to_string(t.after_arcsec).c_str() : "null");
+                        num(t.after_arcsec).c_str());
+            if (!t.name.empty())
+                std::printf(", \"name\": \"%s\", \"ra_h\": %.6f, \"catalogue_dec_deg\": %.5f",
+                            json_escape(t.name).c_str(), t.ra_h, t.dec_deg);
+            if (po.slew.on())
+                std::printf(", \"time_s\": %s", num(t.slew_s).c_str());
+            std::printf("}");
         }
         std::printf("]}\n");
         return 0;
     }
     std::printf("pmfit plan: %zu points taken, order %d%s, noise %.3g\" per axis; %d candidates "
-                "above %.0f deg elevation\n", run.obs.size(), o.order, o.adds.empty() ? "" : " + terms",
-                po.noise_arcsec, p.n_candidates, po.min_el_deg);
+                "above %.0f deg elevation%s%s%s\n", run.obs.size(), o.order,
+                o.adds.empty() ? "" : " + terms", po.noise_arcsec, p.n_candidates, po.min_el_deg,
+                o.horizon.empty() ? "" : (" and the horizon of " + o.horizon).c_str(),
+                o.catalogue.empty() ? "" : (" (stars of " + o.catalogue + ": " +
+                                            std::to_string(p.n_catalogue) + ")").c_str(),
+                po.d_optimal ? "; D-optimal" : "");
+    if (!p.note.empty())
+        std::printf("  note: %s\n", p.note.c_str());
     if (std::isfinite(p.before_arcsec))
         std::printf("  predicted error over the sky now: %.3f\" (1 sigma per axis, mean)\n",
                     p.before_arcsec);
@@ -841,15 +943,25 @@ int cmd_plan(const Options &o)
     std::printf("  next targets (in this order):\n");
     for (size_t k = 0; k < p.targets.size(); k++) {
         const Target &t = p.targets[k];
-        char after[64] = "not yet determined";
+        char after[96] = "not yet determined";
         if (std::isfinite(t.after_arcsec))
             std::snprintf(after, sizeof after, "%.3f\"", t.after_arcsec);
+        if (po.slew.on())
+            std::snprintf(after + std::strlen(after), sizeof after - std::strlen(after),
+                          "  (%.0f s)", t.slew_s);
+        char num_s[32];
+        std::snprintf(num_s, sizeof num_s, "%2zu.", k + 1);
+        if (!t.name.empty()) {
+            std::printf("    %s %s (RA %.4f h, Dec %+.3f deg)\n", num_s, t.name.c_str(), t.ra_h,
+                        t.dec_deg);
+            std::snprintf(num_s, sizeof num_s, "   ");
+        }
         if (az)
-            std::printf("    %2zu. az %7.2f deg  el %6.2f deg  -> predicted %s\n", k + 1, t.x_deg,
+            std::printf("    %s az %7.2f deg  el %6.2f deg  -> predicted %s\n", num_s, t.x_deg,
                         t.y_deg, after);
         else
-            std::printf("    %2zu. HA %+6.2f h  Dec %+7.2f deg  (el %5.1f, %s)  -> predicted %s\n",
-                        k + 1, t.x_deg / 15, t.y_deg, t.el_deg,
+            std::printf("    %s HA %+6.2f h  Dec %+7.2f deg  (el %5.1f, %s)  -> predicted %s\n",
+                        num_s, t.x_deg / 15, t.y_deg, t.el_deg,
                         t.side < 0 ? "beyond the pole" : "normal side", after);
     }
     return 0;

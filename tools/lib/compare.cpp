@@ -154,9 +154,17 @@ Comparison compare_models(const pm_model &old_model, const std::vector<double> &
     c.rms_as_is = rms_of(old_model, run, all) * RAD2AS;
     FitOut f = do_fit(run.obs, all, old_model);
     if (f.status != PM_OK)
-        throw std::runtime_error("the new run cannot be refitted with the model's terms (" +
-                                 std::to_string((int)f.status) +
-                                 "): too few points or too little sky for them");
+        throw std::runtime_error(
+            "the new run cannot be refitted with the model's terms: " +
+            (f.status == PM_ERR_SINGULAR && f.bad_term >= 0
+                 ? "term " + term_name(old_model, f.bad_term) + " (" +
+                       meaning(old_model, f.bad_term) +
+                       ") cannot be determined from its points (too little sky for it)"
+             : f.status == PM_ERR_TOO_FEW
+                 ? std::to_string(all.size()) + " points are too few for " +
+                       std::to_string(old_model.n_terms) + " terms"
+                 : "the fit does not converge (status " + std::to_string((int)f.status) + ")") +
+            "; compare needs a run that determines the model (or a lower --order)");
     c.refit = f.model;
     c.sigma_refit = f.res.sigma * RAD2AS;
     for (int i = 0; i < old_model.n_terms; i++) {

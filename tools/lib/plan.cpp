@@ -4,14 +4,17 @@
 // points taken (two rows J per point, pm_fit_row at the model's own
 // prediction); its predicted variance at a place g is sigma^2 tr(J_g A^-1
 // J_g^T) / 2 per axis.  The I-optimal criterion is the mean of that over
-// the usable sky, sigma^2 tr(W A^-1) / 2 with W the mean of J_g^T J_g.
-// Taking a point x (rows J) changes A^-1 by -M S^-1 M^T (M = A^-1 J^T,
-// S = I + J M: Woodbury), so the criterion falls by tr(S^-1 M^T W M) / 2:
-// greedy, the best candidate, update, repeat.
+// the usable sky, sigma^2 tr(W A^-1) / 2 with W the (weighted) mean of
+// J_g^T J_g.  Taking a point x (rows J) changes A^-1 by -M S^-1 M^T
+// (M = A^-1 J^T, S = I + J M: Woodbury), so the criterion falls by
+// tr(S^-1 M^T W M) / 2, and log det A rises by log det S (the D-optimal
+// criterion): greedy, the best candidate (per second of slewing and
+// observing when the slew time is weighed), update, repeat.
 #include "plan.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 namespace pmhost {
@@ -20,72 +23,31 @@ namespace {
 
 const double DEG = PI / 180;
 
-struct Place {
-    double x, y, el; // degrees
-    int side;
+// A design place with its two rows.
+struct Rowed {
+    DesignPlace p;
     double row[2][PM_MAX_TERMS];
 };
 
-double elevation_deg(const PlanOptions &o, double x, double y)
+bool eval_rows(const pm_model &m, Rowed &r)
 {
-    if (o.mount == PM_MOUNT_ALTAZ)
-        return y;
-    return std::asin(std::sin(o.latitude) * std::sin(y * DEG) +
-                     std::cos(o.latitude) * std::cos(y * DEG) * std::cos(x * DEG)) / DEG;
+    double T, D, res[2];
+    return pm_model_apply(&m, &r.p.ctx, r.p.eh, r.p.ed, &T, &D) == PM_OK &&
+           pm_fit_row(&m, &r.p.ctx, r.p.eh, r.p.ed, T, D, r.row[0], r.row[1], res) == PM_OK;
 }
 
-// The model's two rows at sky place (x, y) on `side`; false where it
-// cannot be evaluated.
-bool rows_at(const pm_model &m, const PlanOptions &o, Place &p)
+std::vector<Rowed> with_rows(const pm_model &m, const std::vector<DesignPlace> &v,
+                             std::vector<int> *kept = nullptr)
 {
-    double t = p.x * DEG, d = p.y * DEG;
-    if (o.mount != PM_MOUNT_ALTAZ && p.side < 0)
-        t += PI, d = PI - d;
-    pm_context ctx = pm_context();
-    ctx.pier = p.side;
-    double T, D, r[2];
-    return pm_model_apply(&m, &ctx, t, d, &T, &D) == PM_OK &&
-           pm_fit_row(&m, &ctx, t, d, T, D, p.row[0], p.row[1], r) == PM_OK;
-}
-
-// The pier side of the taken point nearest to (x, y) on the sky (a run's own
-// convention of when to flip), or the German mount's usual one (beyond the
-// pole west of the meridian) when nothing is taken.
-int side_for(const PlanOptions &o, const std::vector<Place> &taken, double x, double y)
-{
-    if (o.mount == PM_MOUNT_ALTAZ)
-        return 0;
-    if (!o.gem)
-        return 1;
-    double best = -2;
-    int side = x > 0 ? -1 : 1;
-    for (const Place &p : taken) {
-        double c = std::sin(y * DEG) * std::sin(p.y * DEG) +
-                   std::cos(y * DEG) * std::cos(p.y * DEG) * std::cos((x - p.x) * DEG);
-        if (c > best)
-            best = c, side = p.side;
-    }
-    return side;
-}
-
-// Places over the usable sky on a grid of `step` degrees (equal area).
-std::vector<Place> sky_places(const pm_model &m, const PlanOptions &o, double step,
-                              const std::vector<Place> &taken)
-{
-    std::vector<Place> out;
-    bool az = o.mount == PM_MOUNT_ALTAZ;
-    for (double y = -90 + step / 2; y < 90; y += step) {
-        int nx = std::max(1, (int)std::lround(360 / step * std::cos(y * DEG)));
-        for (int k = 0; k < nx; k++) {
-            Place p;
-            p.x = (az ? 0 : -180) + 360.0 / nx * (k + 0.5);
-            p.y = y;
-            p.el = elevation_deg(o, p.x, p.y);
-            if (p.el < o.min_el_deg)
-                continue;
-            p.side = side_for(o, taken, p.x, p.y);
-            if (rows_at(m, o, p))
-                out.push_back(p);
+    std::vector<Rowed> out;
+    out.reserve(v.size());
+    for (size_t i = 0; i < v.size(); i++) {
+        Rowed r;
+        r.p = v[i];
+        if (eval_rows(m, r)) {
+            out.push_back(r);
+            if (kept)
+                kept->push_back((int)i);
         }
     }
     return out;
@@ -136,24 +98,30 @@ struct Design {
     double f = 0;                // tr(W A^-1) / 2
 };
 
-// A from the rows of `taken` places plus a ridge, W from the sky.
-Design design(const std::vector<Place> &taken, const std::vector<Place> &sky, int P)
+// A from the rows of `taken` plus a ridge, W from the sky (weighted mean).
+// The ridge keeps A invertible before the points determine the model: a
+// direction they leave free gets a variance of 1/ridge.
+Design design(const std::vector<Rowed> &taken, const std::vector<Rowed> &sky, int P,
+              double ridge = 1e-8)
 {
     Design d;
     d.P = P;
     std::vector<double> a((size_t)(P * P), 0.0);
     d.w.assign((size_t)(P * P), 0.0);
-    auto add = [&](std::vector<double> &m, const Place &p, double wt) {
+    auto add = [&](std::vector<double> &m, const Rowed &p, double wt) {
         for (int i = 0; i < P; i++)
             for (int j = 0; j < P; j++)
                 m[(size_t)(i * P + j)] += wt * (p.row[0][i] * p.row[0][j] + p.row[1][i] * p.row[1][j]);
     };
-    for (const Place &p : taken)
+    double wsum = 0;
+    for (const Rowed &p : sky)
+        wsum += p.p.weight;
+    for (const Rowed &p : taken)
         add(a, p, 1.0);
-    for (const Place &p : sky)
-        add(d.w, p, 1.0 / (double)sky.size());
+    for (const Rowed &p : sky)
+        add(d.w, p, p.p.weight / wsum);
     for (int i = 0; i < P; i++)
-        a[(size_t)(i * P + i)] += 1e-8; // a ridge: the first points of a run
+        a[(size_t)(i * P + i)] += ridge;
     if (!spd_inverse(a, P))
         throw std::runtime_error("plan: the design is singular");
     d.ainv = a;
@@ -163,17 +131,30 @@ Design design(const std::vector<Place> &taken, const std::vector<Place> &sky, in
     return d;
 }
 
-// The fall of the criterion by taking place p; M = A^-1 J^T, S^-1 returned.
-double gain(const Design &d, const Place &p, std::vector<double> &M, double si[4])
+// Scratch of the gain computation (no allocation per candidate).
+struct Scratch {
+    std::vector<double> M, wm;
+    double si[4];
+    double logdet;
+};
+
+// The fall of the I criterion by taking place p; M = A^-1 J^T and S^-1 in
+// sc, and log det S (the rise of log det A).
+double gain(const Design &d, const Rowed &p, Scratch &sc)
 {
     int P = d.P;
+    std::vector<double> &M = sc.M, &wm = sc.wm;
     M.assign((size_t)(2 * P), 0.0);
-    for (int i = 0; i < P; i++)
+    for (int i = 0; i < P; i++) {
+        const double *ar = &d.ainv[(size_t)(i * P)];
+        double m0 = 0, m1 = 0;
         for (int j = 0; j < P; j++) {
-            double a = d.ainv[(size_t)(i * P + j)];
-            M[(size_t)(2 * i)] += a * p.row[0][j];
-            M[(size_t)(2 * i + 1)] += a * p.row[1][j];
+            m0 += ar[j] * p.row[0][j];
+            m1 += ar[j] * p.row[1][j];
         }
+        M[(size_t)(2 * i)] = m0;
+        M[(size_t)(2 * i + 1)] = m1;
+    }
     double s[4] = {1, 0, 0, 1};
     for (int i = 0; i < P; i++) {
         s[0] += p.row[0][i] * M[(size_t)(2 * i)];
@@ -182,15 +163,21 @@ double gain(const Design &d, const Place &p, std::vector<double> &M, double si[4
         s[3] += p.row[1][i] * M[(size_t)(2 * i + 1)];
     }
     double det = s[0] * s[3] - s[1] * s[2];
+    double *si = sc.si;
     si[0] = s[3] / det, si[1] = -s[1] / det, si[2] = -s[2] / det, si[3] = s[0] / det;
+    sc.logdet = det > 0 ? std::log(det) : -INFINITY;
     double t[4] = {0, 0, 0, 0}; // M^T W M
-    std::vector<double> wm((size_t)(2 * P), 0.0);
-    for (int i = 0; i < P; i++)
+    wm.assign((size_t)(2 * P), 0.0);
+    for (int i = 0; i < P; i++) {
+        const double *wr = &d.w[(size_t)(i * P)];
+        double a0 = 0, a1 = 0;
         for (int j = 0; j < P; j++) {
-            double w = d.w[(size_t)(i * P + j)];
-            wm[(size_t)(2 * i)] += w * M[(size_t)(2 * j)];
-            wm[(size_t)(2 * i + 1)] += w * M[(size_t)(2 * j + 1)];
+            a0 += wr[j] * M[(size_t)(2 * j)];
+            a1 += wr[j] * M[(size_t)(2 * j + 1)];
         }
+        wm[(size_t)(2 * i)] = a0;
+        wm[(size_t)(2 * i + 1)] = a1;
+    }
     for (int i = 0; i < P; i++) {
         t[0] += M[(size_t)(2 * i)] * wm[(size_t)(2 * i)];
         t[1] += M[(size_t)(2 * i)] * wm[(size_t)(2 * i + 1)];
@@ -212,11 +199,248 @@ void take(Design &d, const std::vector<double> &M, const double si[4], double g)
     d.f -= g;
 }
 
-pm_model planning_model(const Run &taken, const PlanOptions &o)
+} // namespace
+
+double slew_time(const SlewModel &s, int mount, const DesignPlace &a, const DesignPlace &b)
+{
+    double d1 = std::fabs(std::remainder(a.eh - b.eh, 2 * PI)) / DEG;
+    double d2 = std::fabs(a.ed - b.ed) / DEG;
+    double t = (s.rate_deg_s > 0 ? std::max(d1, d2) / s.rate_deg_s : 0) + s.settle_s + s.point_s;
+    if (mount != PM_MOUNT_ALTAZ && a.ctx.pier != 0 && b.ctx.pier != 0 && a.ctx.pier != b.ctx.pier)
+        t += s.flip_s;
+    return t;
+}
+
+double design_criterion(const pm_model &m, const std::vector<DesignPlace> &pts,
+                        const std::vector<DesignPlace> &sky)
+{
+    std::vector<Rowed> t = with_rows(m, pts), s = with_rows(m, sky);
+    if (s.empty())
+        throw std::runtime_error("plan: no place of the sky can be evaluated");
+    return design(t, s, m.n_terms).f;
+}
+
+namespace {
+
+// Do the places determine the model over the sky?  The criterion with the
+// ridge a hundred times larger: unchanged where they do, a hundred times
+// smaller where a direction the sky needs is left free.
+bool determines(const pm_model &m, const std::vector<DesignPlace> &pts,
+                const std::vector<DesignPlace> &sky)
+{
+    if (2 * (long)pts.size() < m.n_terms)
+        return false;
+    std::vector<Rowed> t = with_rows(m, pts), s = with_rows(m, sky);
+    double f1 = design(t, s, m.n_terms, 1e-8).f, f2 = design(t, s, m.n_terms, 1e-6).f;
+    return std::isfinite(f1) && f1 < 1.5 * f2;
+}
+
+} // namespace
+
+std::vector<int> greedy_design(const pm_model &m, const std::vector<DesignPlace> &taken,
+                               const std::vector<DesignPlace> &cand,
+                               const std::vector<DesignPlace> &sky, int k, bool d_optimal,
+                               const SlewModel &slew, const DesignPlace *start,
+                               std::vector<double> *crit, std::vector<double> *slew_s)
+{
+    std::vector<int> kept;
+    std::vector<Rowed> t = with_rows(m, taken), s = with_rows(m, sky),
+                       c = with_rows(m, cand, &kept);
+    if (s.empty())
+        throw std::runtime_error("plan: no place of the sky can be evaluated");
+    Design d = design(t, s, m.n_terms);
+    std::vector<char> used(c.size(), 0);
+    std::vector<int> order;
+    if (crit)
+        crit->clear();
+    if (slew_s)
+        slew_s->clear();
+    Scratch sc, best_sc;
+    DesignPlace here = start ? *start : DesignPlace();
+    bool have_here = start != nullptr;
+    for (int step = 0; step < k; step++) {
+        int best = -1;
+        double best_score = -INFINITY, best_gain = 0, best_time = NAN;
+        for (size_t q = 0; q < c.size(); q++) {
+            if (used[q])
+                continue;
+            double g = gain(d, c[q], sc);
+            double score = d_optimal ? sc.logdet : g;
+            double time = NAN;
+            if (slew.on()) {
+                time = have_here ? slew_time(slew, m.mount, here, c[q].p)
+                                 : slew.settle_s + slew.point_s;
+                score /= time;
+            }
+            if (std::isfinite(score) && score > best_score) {
+                best_score = score, best = (int)q, best_gain = g, best_time = time;
+                best_sc.M = sc.M;
+                std::copy(sc.si, sc.si + 4, best_sc.si);
+            }
+        }
+        if (best < 0)
+            break;
+        take(d, best_sc.M, best_sc.si, best_gain);
+        used[(size_t)best] = 1;
+        order.push_back(kept[(size_t)best]);
+        if (crit)
+            crit->push_back(d.f);
+        if (slew_s)
+            slew_s->push_back(best_time);
+        here = c[(size_t)best].p;
+        have_here = true;
+    }
+    return order;
+}
+
+namespace {
+
+// A place of the sky in the plan: sky position (degrees), elevation,
+// azimuth, side, and the design place.
+struct SkyPlace {
+    double x, y, el, az;
+    int side;
+    DesignPlace d;
+    int star = -1; // the catalogue star
+};
+
+void el_az(const PlanOptions &o, double x, double y, double &el, double &az)
+{
+    if (o.mount == PM_MOUNT_ALTAZ) {
+        el = y, az = x;
+        return;
+    }
+    double h = x * DEG, dd = y * DEG, f = o.latitude;
+    el = std::asin(std::sin(f) * std::sin(dd) + std::cos(f) * std::cos(dd) * std::cos(h)) / DEG;
+    az = std::atan2(-std::sin(h) * std::cos(dd),
+                    std::sin(dd) * std::cos(f) - std::cos(dd) * std::cos(h) * std::sin(f)) / DEG;
+    if (az < 0)
+        az += 360;
+}
+
+bool usable(const PlanOptions &o, double el, double az)
+{
+    return el >= o.min_el_deg && (o.horizon.empty() || el >= o.horizon.at(az));
+}
+
+// The encoder position of sky place (x, y) on `side`.
+void encoder_of(const PlanOptions &o, SkyPlace &p, const pm_context &ctx)
+{
+    double t = p.x * DEG, d = p.y * DEG;
+    if (o.mount != PM_MOUNT_ALTAZ && p.side < 0)
+        t += PI, d = PI - d;
+    p.d.eh = t;
+    p.d.ed = d;
+    p.d.ctx = ctx;
+    p.d.ctx.pier = p.side;
+}
+
+// The pier side of the taken point nearest to (x, y) on the sky (a run's own
+// convention of when to flip).
+int nearest_side(const std::vector<SkyPlace> &taken, double x, double y, int dflt)
+{
+    double best = -2;
+    int side = dflt;
+    for (const SkyPlace &p : taken) {
+        double c = std::sin(y * DEG) * std::sin(p.y * DEG) +
+                   std::cos(y * DEG) * std::cos(p.y * DEG) * std::cos((x - p.x) * DEG);
+        if (c > best)
+            best = c, side = p.side;
+    }
+    return side;
+}
+
+// The sides a place is taken on under the options' rules (one or two).
+std::vector<int> sides_for(const PlanOptions &o, const std::vector<SkyPlace> &taken, double x,
+                           double y)
+{
+    if (o.mount == PM_MOUNT_ALTAZ)
+        return {0};
+    if (!o.gem)
+        return {1};
+    int meridian = x > 0 ? -1 : 1;
+    switch (o.sides) {
+    case SIDES_MERIDIAN:
+        return {meridian};
+    case SIDES_BOTH:
+        if (std::fabs(x) <= o.meridian_limit_deg)
+            return {1, -1};
+        return {meridian};
+    case SIDES_RUN:
+    default:
+        // beyond the meridian limit only one side reaches the place
+        if (std::fabs(x) > o.meridian_limit_deg)
+            return {meridian};
+        return {nearest_side(taken, x, y, meridian)};
+    }
+}
+
+// Places over the usable sky on a grid of `step` degrees (equal area); a
+// place taken on two sides counts half on each.
+std::vector<SkyPlace> sky_places(const PlanOptions &o, double step,
+                                 const std::vector<SkyPlace> &taken, const pm_context &ctx)
+{
+    std::vector<SkyPlace> out;
+    bool az = o.mount == PM_MOUNT_ALTAZ;
+    for (double y = -90 + step / 2; y < 90; y += step) {
+        int nx = std::max(1, (int)std::lround(360 / step * std::cos(y * DEG)));
+        for (int k = 0; k < nx; k++) {
+            SkyPlace p;
+            p.x = (az ? 0 : -180) + 360.0 / nx * (k + 0.5);
+            p.y = y;
+            el_az(o, p.x, p.y, p.el, p.az);
+            if (!usable(o, p.el, p.az))
+                continue;
+            std::vector<int> sides = sides_for(o, taken, p.x, p.y);
+            for (int s : sides) {
+                p.side = s;
+                encoder_of(o, p, ctx);
+                p.d.weight = 1.0 / (double)sides.size();
+                out.push_back(p);
+            }
+        }
+    }
+    return out;
+}
+
+// The catalogue's stars above the horizon now, on their sides.
+std::vector<SkyPlace> star_places(const PlanOptions &o, const std::vector<SkyPlace> &taken,
+                                  const pm_context &ctx)
+{
+    std::vector<SkyPlace> out;
+    for (size_t i = 0; i < o.stars.size(); i++) {
+        double ha, dec;
+        place_star(o.stars[i], o.when, ha, dec);
+        SkyPlace p;
+        p.star = (int)i;
+        if (o.mount == PM_MOUNT_ALTAZ) {
+            PlanOptions eq = o;
+            eq.mount = PM_MOUNT_EQUATORIAL;
+            el_az(eq, ha, dec, p.el, p.az);
+            p.x = p.az, p.y = p.el;
+        } else {
+            p.x = ha, p.y = dec;
+            el_az(o, p.x, p.y, p.el, p.az);
+        }
+        if (!usable(o, p.el, p.az))
+            continue;
+        for (int s : sides_for(o, taken, p.x, p.y)) {
+            p.side = s;
+            encoder_of(o, p, ctx);
+            out.push_back(p);
+        }
+    }
+    return out;
+}
+
+// The planning model and whether the run's points determine it.
+pm_model planning_model(const Run &taken, const PlanOptions &o, std::string &note)
 {
     std::vector<Obs> none;
     pm_model m = build_model(o.order, o.adds, taken.obs.empty() ? none : taken.obs, o.mount,
                              o.latitude, taken.aux_names);
+    if (taken.obs.empty())
+        return m;
     std::vector<int> all(taken.obs.size());
     for (size_t i = 0; i < all.size(); i++)
         all[i] = (int)i;
@@ -224,6 +448,14 @@ pm_model planning_model(const Run &taken, const PlanOptions &o)
         FitOut f = do_fit(taken.obs, all, m);
         if (f.status == PM_OK)
             return f.model;
+        note = "the run's " + std::to_string(taken.obs.size()) + " points do not determine the model (" +
+               (f.status == PM_ERR_SINGULAR && f.bad_term >= 0
+                    ? "term " + term_name(m, f.bad_term) + " cannot be determined"
+                    : std::string("the fit fails")) +
+               "): planned at the ideal mount";
+    } else {
+        note = "the run's " + std::to_string(taken.obs.size()) + " points are too few for the " +
+               std::to_string(m.n_terms) + "-term model: planned at the ideal mount";
     }
     return m;
 }
@@ -233,10 +465,69 @@ void check_options(const PlanOptions &o)
     if (o.mount != PM_MOUNT_ALTAZ && !std::isfinite(o.latitude))
         throw std::runtime_error("plan: an equatorial mount needs the site latitude (--lat, or a "
                                  "'# latitude:' line in the run)");
+    if (o.mount == PM_MOUNT_ALTAZ && !o.stars.empty() && !std::isfinite(o.latitude))
+        throw std::runtime_error("plan: placing catalogue stars on an alt-az mount's sky needs the "
+                                 "site latitude (--lat)");
     if (!(o.next >= 1 && o.next <= 1000))
         throw std::runtime_error("plan: --next must be 1..1000");
     if (!(o.grid_deg >= 1 && o.grid_deg <= 30))
         throw std::runtime_error("plan: the candidate grid must be 1..30 deg");
+    if (!(o.meridian_limit_deg >= 0 && o.meridian_limit_deg <= 90))
+        throw std::runtime_error("plan: --meridian-limit must be 0..90 deg");
+    if (o.slew.on() && !(o.slew.settle_s >= 0 && o.slew.point_s >= 0 && o.slew.flip_s >= 0 &&
+                         o.slew.settle_s + o.slew.point_s > 0))
+        throw std::runtime_error("plan: the slew model's settle, point and flip times must be >= 0 "
+                                 "and settle + point > 0");
+    if (!o.stars.empty())
+        check_sky_time(o.when);
+}
+
+// The mean inputs of the run's physical terms (their planned places use
+// them: temperature, time and the like cannot be chosen by slewing).
+pm_context mean_context(const Run &run)
+{
+    pm_context c = pm_context();
+    if (run.obs.empty())
+        return c;
+    double n = (double)run.obs.size();
+    for (const Obs &ob : run.obs) {
+        c.temp_c += ob.ctx.temp_c / n;
+        c.time_h += ob.ctx.time_h / n;
+        for (int j = 0; j < PM_MAX_AUX; j++)
+            c.aux[j] += ob.ctx.aux[j] / n;
+    }
+    c.dir = 0;
+    return c;
+}
+
+// Can any set of points on this sky determine the model?  A noise-free fit
+// at every place of the sky names the first term that cannot be.
+void check_determinable(const pm_model &m, const std::vector<SkyPlace> &sky)
+{
+    std::vector<Obs> obs;
+    for (const SkyPlace &p : sky) {
+        Obs o;
+        o.eh = p.d.eh, o.ed = p.d.ed, o.ctx = p.d.ctx, o.pier = p.side, o.line = 0;
+        if (pm_model_apply(&m, &o.ctx, o.eh, o.ed, &o.ah, &o.ad) == PM_OK)
+            obs.push_back(o);
+    }
+    std::vector<int> all(obs.size());
+    for (size_t i = 0; i < all.size(); i++)
+        all[i] = (int)i;
+    FitOut f = do_fit(obs, all, m, 3);
+    if (f.status == PM_ERR_SINGULAR && f.bad_term >= 0)
+        throw std::runtime_error("plan: no set of points on this sky can determine the model: term " +
+                                 term_name(m, f.bad_term) +
+                                 " is a combination of the terms before it (tube_flexure, for "
+                                 "one, is part of the order-1 terms; docs/explain.md)");
+}
+
+std::string horizon_text(const PlanOptions &o)
+{
+    std::string s = "above " + std::to_string((int)std::lround(o.min_el_deg)) + " deg elevation";
+    if (!o.horizon.empty())
+        s += " and the horizon of " + o.horizon.path;
+    return s;
 }
 
 } // namespace
@@ -244,52 +535,86 @@ void check_options(const PlanOptions &o)
 Plan plan_targets(const Run &taken, const PlanOptions &o)
 {
     check_options(o);
-    pm_model m = planning_model(taken, o);
-    std::vector<Place> done;
+    Plan plan;
+    pm_model m = planning_model(taken, o, plan.note);
+    pm_context ctx = mean_context(taken);
+    std::vector<SkyPlace> done;
     for (const Obs &ob : taken.obs) {
-        Place p;
+        SkyPlace p;
         p.x = std::remainder(ob.ah, 2 * PI) / DEG;
         if (o.mount == PM_MOUNT_ALTAZ && p.x < 0)
             p.x += 360;
         p.y = ob.ad / DEG;
-        p.el = elevation_deg(o, p.x, p.y);
+        el_az(o, p.x, p.y, p.el, p.az);
         p.side = o.mount == PM_MOUNT_ALTAZ ? 0 : (ob.pier < 0 ? -1 : 1);
-        pm_context ctx = ob.ctx;
-        double T, D, r[2];
-        if (pm_model_apply(&m, &ctx, ob.eh, ob.ed, &T, &D) == PM_OK &&
-            pm_fit_row(&m, &ctx, ob.eh, ob.ed, T, D, p.row[0], p.row[1], r) == PM_OK)
-            done.push_back(p);
+        p.d.eh = ob.eh;
+        p.d.ed = ob.ed;
+        p.d.ctx = ob.ctx;
+        p.d.ctx.pier = p.side;
+        done.push_back(p);
     }
-    std::vector<Place> sky = sky_places(m, o, 4, done), cand = sky_places(m, o, o.grid_deg, done);
-    if (sky.empty() || cand.empty())
-        throw std::runtime_error("plan: no usable sky above " + std::to_string(o.min_el_deg) +
-                                 " deg elevation at this latitude");
-    Design d = design(done, sky, m.n_terms);
-    Plan plan;
+    std::vector<SkyPlace> sky = sky_places(o, 4, done, ctx);
+    if (sky.empty())
+        throw std::runtime_error("plan: no usable sky " + horizon_text(o) + " at this latitude");
+    check_determinable(m, sky);
+    std::vector<SkyPlace> cand = o.stars.empty() ? sky_places(o, o.grid_deg, done, ctx)
+                                                 : star_places(o, done, ctx);
+    plan.n_catalogue = (int)o.stars.size();
+    if (cand.empty())
+        throw std::runtime_error(
+            o.stars.empty() ? "plan: no candidate on the " + std::to_string(o.grid_deg) +
+                                  " deg grid is " + horizon_text(o)
+                            : "plan: none of the " + std::to_string(o.stars.size()) +
+                                  " catalogue stars is " + horizon_text(o) +
+                                  " at this time (--lst/--utc) and latitude");
+    std::vector<DesignPlace> dt, ds, dc;
+    for (const SkyPlace &p : done)
+        dt.push_back(p.d);
+    for (const SkyPlace &p : sky)
+        ds.push_back(p.d);
+    for (const SkyPlace &p : cand)
+        dc.push_back(p.d);
     plan.n_candidates = (int)cand.size();
     plan.n_sky = (int)sky.size();
-    bool determined = 2 * (long)done.size() >= m.n_terms;
-    plan.before_arcsec = determined ? o.noise_arcsec * std::sqrt(std::max(0.0, d.f)) : NAN;
-    std::vector<double> M, best_m;
-    for (int k = 0; k < o.next; k++) {
-        int best = -1;
-        double bg = -1, si[4], best_si[4];
-        for (size_t c = 0; c < cand.size(); c++) {
-            double g = gain(d, cand[c], M, si);
-            if (g > bg) {
-                bg = g, best = (int)c, best_m = M;
-                std::copy(si, si + 4, best_si);
-            }
+    double f0 = design_criterion(m, dt, ds);
+    plan.before_arcsec =
+        determines(m, dt, ds) ? o.noise_arcsec * std::sqrt(std::max(0.0, f0)) : NAN;
+    std::vector<double> crit, secs;
+    const DesignPlace *start = dt.empty() ? nullptr : &dt.back();
+    std::vector<int> order =
+        greedy_design(m, dt, dc, ds, o.next, o.d_optimal, o.slew, start, &crit, &secs);
+    // the first step from which the points determine the model (taking more
+    // points keeps it determined): bisection
+    auto with_first = [&](size_t k) {
+        std::vector<DesignPlace> v = dt;
+        for (size_t i = 0; i < k; i++)
+            v.push_back(dc[(size_t)order[i]]);
+        return v;
+    };
+    size_t lo = 0, hi = order.size() + 1; // determined from step hi on (hi > size: never)
+    if (std::isfinite(plan.before_arcsec))
+        hi = 0;
+    else if (!order.empty() && determines(m, with_first(order.size()), ds)) {
+        hi = order.size();
+        while (hi - lo > 1) {
+            size_t mid = (lo + hi) / 2;
+            if (determines(m, with_first(mid), ds))
+                hi = mid;
+            else
+                lo = mid;
         }
-        if (best < 0)
-            break;
-        take(d, best_m, best_si, bg);
-        done.push_back(cand[(size_t)best]);
-        const Place p = cand[(size_t)best];
-        cand.erase(cand.begin() + best); // a star once: the next best is elsewhere
-        bool det = 2 * (long)done.size() >= m.n_terms;
-        plan.targets.push_back({p.x, p.y, p.el, p.side,
-                                det ? o.noise_arcsec * std::sqrt(std::max(0.0, d.f)) : NAN});
+    }
+    for (size_t k = 0; k < order.size(); k++) {
+        const SkyPlace &p = cand[(size_t)order[k]];
+        Target t;
+        t.x_deg = p.x, t.y_deg = p.y, t.el_deg = p.el, t.side = p.side;
+        t.after_arcsec = k + 1 >= hi ? o.noise_arcsec * std::sqrt(std::max(0.0, crit[k])) : NAN;
+        if (p.star >= 0) {
+            const CatalogueStar &s = o.stars[(size_t)p.star];
+            t.name = s.name, t.ra_h = s.ra_h, t.dec_deg = s.dec_deg;
+        }
+        t.slew_s = secs[k];
+        plan.targets.push_back(t);
     }
     return plan;
 }
@@ -300,16 +625,22 @@ double predicted_mean_error(const std::vector<Target> &points, const PlanOptions
     Run none;
     none.mount = o.mount;
     none.latitude = o.latitude;
-    pm_model m = planning_model(none, o);
-    std::vector<Place> sky = sky_places(m, o, 4, {}), pts;
+    std::string note;
+    pm_model m = planning_model(none, o, note);
+    pm_context ctx = pm_context();
+    std::vector<SkyPlace> sky = sky_places(o, 4, {}, ctx);
+    if (sky.empty())
+        throw std::runtime_error("plan: no usable sky " + horizon_text(o) + " at this latitude");
+    std::vector<DesignPlace> pts, ds;
     for (const Target &t : points) {
-        Place p;
-        p.x = t.x_deg, p.y = t.y_deg, p.el = t.el_deg, p.side = t.side;
-        if (rows_at(m, o, p))
-            pts.push_back(p);
+        SkyPlace p;
+        p.x = t.x_deg, p.y = t.y_deg, p.side = t.side;
+        encoder_of(o, p, ctx);
+        pts.push_back(p.d);
     }
-    Design d = design(pts, sky, m.n_terms);
-    return o.noise_arcsec * std::sqrt(std::max(0.0, d.f));
+    for (const SkyPlace &p : sky)
+        ds.push_back(p.d);
+    return o.noise_arcsec * std::sqrt(std::max(0.0, design_criterion(m, pts, ds)));
 }
 
 } // namespace pmhost
@@ -318,6 +649,8 @@ double predicted_mean_error(const std::vector<Target> &points, const PlanOptions
 
 #include "hostutil.hpp"
 #include "plan.h"
+
+#include <cstring>
 
 namespace {
 
@@ -331,6 +664,30 @@ pmhost::PlanOptions from_c(const pmplan_options *c)
     o.min_el_deg = c->min_el_deg;
     o.grid_deg = c->grid_deg;
     o.noise_arcsec = c->noise_arcsec;
+    if (c->adds) {
+        std::string s = c->adds;
+        size_t pos = 0, comma;
+        while ((comma = s.find(',', pos)) != std::string::npos) {
+            o.adds.push_back(s.substr(pos, comma - pos));
+            pos = comma + 1;
+        }
+        if (pos < s.size())
+            o.adds.push_back(s.substr(pos));
+    }
+    if (c->horizon_path)
+        o.horizon = pmhost::read_horizon(c->horizon_path);
+    if (c->catalogue_path)
+        o.stars = pmhost::read_catalogue(c->catalogue_path);
+    o.when.lst_h = c->lst_h;
+    o.d_optimal = c->d_optimal != 0;
+    if (c->sides < PMPLAN_SIDES_RUN || c->sides > PMPLAN_SIDES_BOTH)
+        throw std::runtime_error("plan: sides must be PMPLAN_SIDES_RUN, _MERIDIAN or _BOTH");
+    o.sides = (pmhost::PlanSides)c->sides;
+    o.meridian_limit_deg = c->meridian_limit_deg;
+    o.slew.rate_deg_s = c->slew_rate_deg_s;
+    o.slew.settle_s = c->settle_s;
+    o.slew.point_s = c->point_s;
+    o.slew.flip_s = c->flip_s;
     return o;
 }
 
@@ -338,6 +695,7 @@ pmhost::PlanOptions from_c(const pmplan_options *c)
 
 extern "C" void pmplan_options_default(pmplan_options *o)
 {
+    std::memset(o, 0, sizeof *o);
     o->order = 1;
     o->altaz = 0;
     o->gem = 1;
@@ -345,6 +703,13 @@ extern "C" void pmplan_options_default(pmplan_options *o)
     o->min_el_deg = 15;
     o->grid_deg = 6;
     o->noise_arcsec = 1;
+    o->lst_h = -1;
+    o->sides = PMPLAN_SIDES_RUN;
+    o->meridian_limit_deg = 15;
+    o->slew_rate_deg_s = 0;
+    o->settle_s = 5;
+    o->point_s = 30;
+    o->flip_s = 60;
 }
 
 extern "C" int pmplan_next(const char *run_path, const pmplan_options *c, int k, pmplan_target *out,
@@ -370,7 +735,12 @@ extern "C" int pmplan_next(const char *run_path, const pmplan_options *c, int k,
             *before = p.before_arcsec;
         for (size_t i = 0; i < p.targets.size(); i++) {
             const Target &t = p.targets[i];
-            out[i] = {t.x_deg, t.y_deg, t.el_deg, t.side, t.after_arcsec};
+            pmplan_target &q = out[i];
+            std::memset(&q, 0, sizeof q);
+            q.x_deg = t.x_deg, q.y_deg = t.y_deg, q.el_deg = t.el_deg, q.side = t.side;
+            q.after_arcsec = t.after_arcsec;
+            std::snprintf(q.name, sizeof q.name, "%s", t.name.c_str());
+            q.slew_s = t.slew_s;
         }
         return (int)p.targets.size();
     } catch (const std::exception &x) {
@@ -389,8 +759,12 @@ extern "C" int pmplan_predicted(const pmplan_options *c, const pmplan_target *pt
     }
     try {
         std::vector<Target> v;
-        for (int i = 0; i < n; i++)
-            v.push_back({pts[i].x_deg, pts[i].y_deg, pts[i].el_deg, pts[i].side, 0});
+        for (int i = 0; i < n; i++) {
+            Target t;
+            t.x_deg = pts[i].x_deg, t.y_deg = pts[i].y_deg, t.el_deg = pts[i].el_deg;
+            t.side = pts[i].side, t.after_arcsec = 0;
+            v.push_back(t);
+        }
         *mean_arcsec = predicted_mean_error(v, from_c(c));
         return 0;
     } catch (const std::exception &x) {
