@@ -62,6 +62,92 @@ def callgrind(dirname):
     return out
 
 
+def stats(v):
+    """median, p99 (the smallest value >= 99% of them), worst, as dist.c."""
+    v = sorted(v)
+    n = len(v)
+    med = v[n // 2] if n % 2 else 0.5 * (v[n // 2 - 1] + v[n // 2])
+    k = max(0, -(-99 * n // 100) - 1)
+    return med, v[k], v[-1]
+
+
+def dist_rows(D, targets):
+    """The inverse's cost per situation (bench/dist.h): rows name, prec,
+    measure, n, median, p99, worst (+ bound, statuses where measured)."""
+    rows = read_jsonl(os.path.join(D, "dist_evals.jsonl"))
+    rows += read_jsonl(os.path.join(D, "dist_host.jsonl"))
+    for t in targets:
+        rows += read_jsonl(os.path.join(D, t + "_dist.out"))
+    per = {}
+    for path in glob.glob(os.path.join(D, "callgrind_dist", "cg.out*")):
+        name, total = None, None
+        with open(path) as f:
+            for line in f:
+                m = re.match(r"desc: Trigger: Client Request: dist/(\w+)/(\w+)/(\d+)", line)
+                if m:
+                    name = (m.group(2), m.group(1))
+                # (summary: the dump's own count; totals can hold a function's
+                # inclusive cost carried over from before the zeroing)
+                m = re.match(r"summary: (\d+)", line)
+                if m:
+                    total = int(m.group(1))
+        if name and total is not None:
+            per.setdefault(name, []).append(total)
+    for (sit, prec), v in sorted(per.items()):
+        med, p99, worst = stats(v)
+        rows.append({"name": "dist_" + sit, "prec": prec, "measure": "host_insn", "n": len(v),
+                     "median": med, "p99": p99, "worst": worst})
+    for r in rows:
+        r["name"] = "%s_%s_%s" % (r["name"], r["prec"], r["measure"])
+    return rows
+
+
+def dist_table(dist, targets, say):
+    """Print the distribution table, one block per precision."""
+    by = {}
+    for r in dist:
+        base = r["name"].rsplit("_" + r["prec"] + "_", 1)[0][len("dist_"):]
+        by.setdefault((r["prec"], base), {})[r["measure"]] = r
+    measures = [("evals", "evaluations"), ("host_ticks", "host ticks"),
+                ("host_insn", "host insn")] + [(t + "_insn", t + " insn") for t in targets]
+    for prec in ("double", "float"):
+        sits = [b for (p, b) in by if p == prec]
+        if not sits:
+            continue
+        order = {b: i for i, b in enumerate(dict.fromkeys(
+            r["name"].rsplit("_" + r["prec"] + "_", 1)[0][len("dist_"):] for r in dist))}
+        sits.sort(key=lambda b: order[b])
+        say("== the %s inverse per situation (bench/dist.h): median / p99 / worst per call"
+            % prec)
+        hdr = "%-27s %14s %5s" % ("situation", "evaluations", "bound")
+        for m, title in measures[1:]:
+            hdr += " %20s" % title
+        hdr += "  %s" % "ok/warn/err"
+        say(hdr)
+        for b in sits:
+            d = by[(prec, b)]
+            e = d.get("evals")
+            row = "%-27s %14s %5s" % (
+                b, "%g/%g/%g" % (e["median"], e["p99"], e["worst"]) if e else "-",
+                e["bound"] if e else "-")
+            for m, title in measures[1:]:
+                x = d.get(m)
+                row += " %20s" % ("%s/%s/%s" % (fmt(x["median"]), fmt(x["p99"]), fmt(x["worst"]))
+                                  if x else "-")
+            st = e or next(iter(d.values()))
+            row += "  %d/%d/%d" % (st.get("ok", 0), st.get("warn", 0), st.get("err", 0))
+            say(row)
+        say("   (bench: the bench's model, 15\" harmonic terms; real: 8 models, isotropic terms"
+            " within 10 deg, harmonic within 10'; hard:")
+        say("   check_bounded's adversarial cases; far/mid/pole: > 5, 0.5-5, < 0.5 deg from the"
+            " mount's pole; track10/1k: from the")
+        say("   previous tick's solution, 0.1 s / 1 ms of sidereal motion; host ticks: the median"
+            " of the rounds per call; host insn:")
+        say("   callgrind, every %s-th call; Cortex-M: QEMU, each call %s times; statuses of"
+            " the evaluation count's run)" % ("4", "8"))
+        say()
+
+
 def machine():
     info = {}
     try:
@@ -130,6 +216,7 @@ def main():
             if re.search(r"_(fwd|inv_near|inv|naive_fwd|naive_inv)_L", name):
                 loop = raw.get(re.sub(r"_(fwd|inv_near|inv|naive_fwd|naive_inv)_", "_empty_", name))
             insns[name] = v - loop if loop is not None else v
+    dist = dist_rows(D, targets)
     fit = read_jsonl(os.path.join(D, "fit.jsonl"))
     expl = read_jsonl(os.path.join(D, "explain.jsonl"))
 
@@ -152,7 +239,7 @@ def main():
                 e["ratio_vs"] = vs
                 e["ratio"] = round(e[key] / ref, 4)
         entries.append(e)
-    results = entries + fit + expl
+    results = entries + dist + fit + expl
     with open(os.path.join(D, "results.json"), "w") as f:
         json.dump(results, f, indent=1)
         f.write("\n")
@@ -233,6 +320,9 @@ def main():
     say("   method had run on 100 of them: what grows with the problem; ours also holds"
         " sizeof(pm_fit) = %s KB, static)" % ("%.0f" % fixed if fixed else "?"))
     say()
+
+    if dist:
+        dist_table(dist, targets, say)
 
     # the issue's targets
     say("== targets (benchmark figures, not test assertions)")
