@@ -220,6 +220,11 @@ typedef struct pm_model {
                                       aside; infinite if |d|, |i| or the
                                       polar offset exceed 0.5 rad
                                       (pm_model_invert, Note 4) */
+    double lip2;                   /* bound on the second derivative of
+                                      the harmonic displacement per
+                                      radian^2 (pm_model_invert, Note 1);
+                                      infinite where the inverse does not
+                                      predict its stop */
     double dense[PM_N_HARM(PM_MAX_L)][6]; /* per harmonic, per base vector k */
 } pm_model;
 
