@@ -330,6 +330,30 @@ def main():
     def verdict(ok):
         return "met" if ok else "MISSED"
     f2 = g(ticks, "host", "fwd", 2, "double")
+    # issue 18: inverse <= 2x forward (median, L=2), forward <= 120 ticks
+    if f2 is not None:
+        say("   issue 18: forward L=2 double <= 120 TSC ticks: %.0f  %s" % (
+            f2, verdict(f2 <= 120)))
+    for t, prec in (("host", "double"), ("m7", "double"), ("m4f", "float"), ("m7", "float")):
+        fw = g(ticks if t == "host" else insns, t, "fwd", 2, prec)
+        for op in ("inv", "inv_near"):
+            iv = g(ticks if t == "host" else insns, t, op, 2, prec)
+            if fw and iv:
+                say("   issue 18: %s %s %s L=2 <= 2x forward (%s): %.2fx  %s" % (
+                    t, prec, op, "ticks" if t == "host" else "instructions", iv / fw,
+                    verdict(iv <= 2 * fw)))
+        if t == "host":
+            fi, ii = g(insns, t, "fwd", 2, prec), g(insns, t, "inv", 2, prec)
+            ni = g(insns, t, "inv_near", 2, prec)
+            if fi and ii and ni:
+                say("   issue 18: host %s L=2 in instructions: invert %.2fx, invert_near %.2fx"
+                    " the forward" % (prec, ii / fi, ni / fi))
+    trk = [r for r in dist if r["measure"] == "evals" and r["prec"] == "double" and
+           "_track" in r["name"] and "_pole_" not in r["name"]]
+    if trk:
+        w = max(r["worst"] for r in trk)
+        say("   issue 18: tracking beyond 0.5 deg of the pole, worst evaluations <= 4: %g  %s"
+            " (bound %s)" % (w, verdict(w <= 4), trk[0].get("bound")))
     if f2 is not None:
         say("   forward L=2 double <= 150 TSC ticks: %.0f  %s%s" % (
             f2, verdict(f2 <= 150), "" if f2 <= 150 else " (%.1fx over)" % (f2 / 150)))
