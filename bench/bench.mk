@@ -18,6 +18,9 @@
 BN            := $(B)/bench
 BENCH_MAX_N   ?= 1000000
 BENCH_BATCHES ?= 31
+# the distribution bench: timing rounds per call; callgrind dumps every K-th call
+DIST_ROUNDS   ?= 15
+DIST_CG_EVERY ?= 4
 # each Cortex-M bench ELF measures both the double and the float build
 BENCH_TARGETS := m4f m7
 BENCH_CFLAGS  := -std=gnu99 $(OPT) -g -Wall -Wextra -Iinclude -Ibench -Ifirmware_demo
@@ -61,7 +64,44 @@ $(foreach t,$(BENCH_TARGETS),$(eval $(call bench_target,$(t))))
 
 BENCH_ELFS := $(foreach t,$(BENCH_TARGETS),$(BN)/$(t)/bench.elf)
 
-bench-run: fw-toolchain $(BN)/pmbench $(BN)/pmbench_fit $(BN)/pmbench_explain $(BENCH_ELFS)
+# --- issue 18: the inverse's cost as a distribution (bench/dist.h) -------
+# pmbench_dist (TSC ticks; --callgrind: one dump per call), pmbench_dist_probe
+# (model evaluations: the core with the counter of tests/probe.h, the objects
+# check_bounded uses), <t>/dist.elf (Cortex-M instructions per call).
+DIST_SRC := bench/dist.c bench/bench_common.c
+DIST_H   := bench/dist.h bench/bench_common.h tests/hard_cases.h tests/testutil.h include/pm.h
+
+$(BN)/pmbench_dist: bench/bench_dist_host.c $(DIST_SRC) $(DIST_H) $(BN)/host/naive.o $(B)/libpm.a
+	@mkdir -p $(@D)
+	$(CC) $(BENCH_CFLAGS) -Itests bench/bench_dist_host.c $(DIST_SRC) $(BN)/host/naive.o \
+	  $(B)/libpm.a -lm -o $@
+
+$(BN)/pmbench_dist_probe: bench/bench_dist_host.c $(DIST_SRC) $(DIST_H) $(BN)/host/naive.o \
+                          $(PROBE_OBJ)
+	@mkdir -p $(@D)
+	$(CC) $(BENCH_CFLAGS) -Itests -DDIST_PROBE bench/bench_dist_host.c $(DIST_SRC) \
+	  $(BN)/host/naive.o $(PROBE_OBJ) -lstdc++ -lm -o $@
+
+# $(call dist_target,T): the Cortex-M distribution bench of target T (the
+# objects of the bench's core, PM_MAX_L=4).
+define dist_target
+$(BN)/$(1)/dist/%.o: bench/%.c $$(DIST_H) bench/dist.h firmware_demo/fw_platform.h
+	@mkdir -p $$(@D)
+	$$(ARM_CC) $$(BENCH_CFLAGS) -Itests $$(FW_CPU_$(1)) -ffunction-sections -fdata-sections \
+	  -DPM_MAX_L=4 -c $$< -o $$@
+
+$(BN)/$(1)/dist.elf: $(addprefix $(BN)/$(1)/dist/,bench_dist_cm.o dist.o bench_common.o) \
+                     $(BN)/$(1)/naive.o $(BN)/$(1)/platform_cm.o \
+                     $(addprefix $(BN)/$(1)/core/,$(FW_CORE_NAMES)) firmware_demo/cortex_m.ld
+	$$(ARM_CC) $$(FW_CPU_$(1)) $$(filter %.o,$$^) -o $$@ $$(FW_ARM_LDFLAGS) -lm
+endef
+$(foreach t,$(BENCH_TARGETS),$(eval $(call dist_target,$(t))))
+
+DIST_ELFS := $(foreach t,$(BENCH_TARGETS),$(BN)/$(t)/dist.elf)
+
+
+bench-run: fw-toolchain $(BN)/pmbench $(BN)/pmbench_fit $(BN)/pmbench_explain $(BENCH_ELFS) \
+           $(BN)/pmbench_dist $(BN)/pmbench_dist_probe $(DIST_ELFS)
 	@command -v valgrind > /dev/null || { echo "bench: valgrind not found (tools/deps.sh)"; exit 1; }
 	@echo "== host: TSC ticks per call ($(BENCH_BATCHES) batches of 256 calls, median)"
 	$(BN)/pmbench --batches $(BENCH_BATCHES) --out $(BN)/host.jsonl
@@ -73,6 +113,17 @@ bench-run: fw-toolchain $(BN)/pmbench $(BN)/pmbench_fit $(BN)/pmbench_explain $(
 	  timeout 600 $(QEMU_ARM) -M $(FW_MACHINE_$(t)) \
 	  -nographic -semihosting -icount shift=0,align=off,sleep=off -kernel $(BN)/$(t)/bench.elf \
 	  > $(BN)/$(t).out 2>&1 || { cat $(BN)/$(t).out; exit 1; };)
+	@echo "== the inverse per situation (bench/dist.h): evaluations, host ticks, instructions"
+	$(BN)/pmbench_dist_probe --out $(BN)/dist_evals.jsonl
+	$(BN)/pmbench_dist --rounds $(DIST_ROUNDS) --out $(BN)/dist_host.jsonl
+	@rm -rf $(BN)/callgrind_dist && mkdir -p $(BN)/callgrind_dist
+	valgrind --tool=callgrind --callgrind-out-file=$(BN)/callgrind_dist/cg.out --dump-instr=no \
+	  --dump-line=no $(BN)/pmbench_dist --callgrind --every $(DIST_CG_EVERY) \
+	  > $(BN)/callgrind_dist/log.txt 2>&1
+	@$(foreach t,$(BENCH_TARGETS),echo "== $(t): instructions of each inverse under QEMU" && \
+	  timeout 900 $(QEMU_ARM) -M $(FW_MACHINE_$(t)) \
+	  -nographic -semihosting -icount shift=0,align=off,sleep=off -kernel $(BN)/$(t)/dist.elf \
+	  > $(BN)/$(t)_dist.out 2>&1 || { cat $(BN)/$(t)_dist.out; exit 1; };)
 	@echo "== fit scaling (N up to $(BENCH_MAX_N)); ours vs LAPACK dgels"
 	$(BN)/pmbench_fit --max-n $(BENCH_MAX_N) --out $(BN)/fit.jsonl
 	@echo "== pmfit explain on large runs"

@@ -86,8 +86,39 @@ extern "C" {
     ((2 + 2 * PM_INVERT_POLE_STARTS) * \
      (PM_INVERT_MAX_FIXED + 2 + 15 * PM_INVERT_MAX_NEWTON) + 1)
 
+/* Tracking bound: pm_model_invert_near for a target more than 0.5 deg from
+** the mount's pole, started from the previous tick's solution (up to 0.1 s
+** of sidereal motion before: ticks of 10 Hz or faster), with isotropic
+** terms within 10 deg and harmonic terms of order L <= 2 within 10' each
+** (AUX terms allowed): at most this many
+** model evaluations (pm_model_invert Note 1 gives the reasons; measured
+** worst 3, tests/check_bounded.c asserts both). */
+#define PM_INVERT_TRACK_MAX_EVALS 8
+
 /* Round-trip tolerance the inverse iterates to (radians). */
 #define PM_INVERT_TOL 1e-13
+
+/* Per-call budgets for firmware (worst cases; instructions as counted by
+** QEMU, not cycles: docs/performance.md).  Measured by "make bench"
+** (build/bench/results.txt, "per situation"; bench/dist.h), L = 2, gcc
+** 12 -O2, the library at PM_MAX_L = 4:
+**   tracking beyond 0.5 deg of the mount's pole, 10 Hz or faster, terms
+**   within 10 deg / 10' (PM_INVERT_TRACK_MAX_EVALS): the Cortex-M7
+**   double inverse took at most 3,825 instructions at its worst measured
+**   3 evaluations; PM_BUDGET_M7_TRACK_INSNS adds 5 more evaluations of
+**   PM_BUDGET_M7_INSNS_PER_EVAL each, for the bound of 8.
+**   PM_BUDGET_M7_INSNS_PER_EVAL: the most one more evaluation costs in
+**   any measured situation of a harmonic L = 2 model (762 in the pole
+**   rescue's Newton): any other bound times it (plus the tracking
+**   figure's fixed part) bounds a call.
+**   The float build on the Cortex-M4F (pm_model_invert_near_f): at most
+**   PM_INVERT_F_MAX_EVALS evaluations; PM_BUDGET_M4F_F_INSNS_PER_EVAL the
+**   most one costs (2,926 measured near the pole).  It is no faster than
+**   the double build's bound near the pole or with 10' terms (its inverse
+**   fails to converge there more often: docs/performance.md). */
+#define PM_BUDGET_M7_INSNS_PER_EVAL 800
+#define PM_BUDGET_M7_TRACK_INSNS (3825 + 5 * PM_BUDGET_M7_INSNS_PER_EVAL)
+#define PM_BUDGET_M4F_F_INSNS_PER_EVAL 3000
 
 /* ---------------------------------------------------------------------- */
 /* Status.                                                                */
@@ -220,6 +251,11 @@ typedef struct pm_model {
                                       aside; infinite if |d|, |i| or the
                                       polar offset exceed 0.5 rad
                                       (pm_model_invert, Note 4) */
+    double lip2;                   /* bound on the second derivative of
+                                      the harmonic displacement per
+                                      radian^2 (pm_model_invert, Note 1);
+                                      infinite where the inverse does not
+                                      predict its stop */
     double dense[PM_N_HARM(PM_MAX_L)][6]; /* per harmonic, per base vector k */
 } pm_model;
 
@@ -376,13 +412,35 @@ pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
 **              pm_status   PM_OK; PM_WARN_NOT_CONVERGED; PM_WARN_UNREACHABLE;
 **                          PM_ERR_ARG; PM_ERR_NONFINITE; PM_ERR_STATE
 **  Notes:
-**  1) The isotropic part is inverted in closed form; the anisotropic
-**     displacement is iterated to a fixed point (at most
-**     PM_INVERT_MAX_FIXED steps), falling back to damped Newton steps (at
-**     most PM_INVERT_MAX_NEWTON, each with at most 12 step halvings) where
-**     the fixed point does not contract (within about the anisotropic
-**     amplitude of the mount's pole).  The round-trip error
-**     |apply(invert(x)) - x| is below PM_INVERT_TOL on return with PM_OK.
+**  1) The isotropic part is inverted in closed form (x = F(D): the encoder
+**     position that points at the target for a given anisotropic
+**     displacement D); D is iterated to the model's own, D = D(F(D)).  A
+**     point x = F(D^) misses the target by |D(x) - D^| (to first order):
+**     the measured stop.  The first evaluation also gives the Jacobian
+**     J = dD/dx (analytic), and the steps are Newton steps on D with the
+**     closed form's derivative F_D: (I - J F_D) (D^' - D^) = D(x) - D^, J
+**     kept for the call (a chord).  Where the model's second-derivative
+**     bound m->lip2 is known (harmonic and AUX terms) the next point's
+**     miss is bounded before it is evaluated,
+**       |D(x') - D^'| <= |D(x) + J h - D^'| + lip2 (|x - x_J| + |h|/2) |h|,
+**     h = x' - x (Taylor's theorem), and the iteration stops when that is
+**     below PM_INVERT_TOL/2: the predicted stop.  So a tracking call
+**     started within 0.1 s of sidereal motion of the solution needs: one
+**     evaluation (with J) at the start, whose miss the start's own
+**     displacement measures; one closed form to x1, whose miss is
+**     quadratic in the start's (the chord's error); one evaluation at x1
+**     (its miss measured), or none where the bound above already holds
+**     (1 kHz ticks); a third or fourth only where the step is long and
+**     the contraction weak (within a few degrees of the mount's pole,
+**     |F_D| ~ 1/cos of the distance, with 10' terms): hence
+**     PM_INVERT_TRACK_MAX_EVALS = 8 (measured worst 4 with ticks up to
+**     0.1 s, 6 with 1 s ticks within a degree of the pole).  At most
+**     PM_INVERT_MAX_FIXED such steps; where they do not contract (within
+**     about the anisotropic amplitude of the mount's pole) damped Newton
+**     steps on the full forward model take over (at most
+**     PM_INVERT_MAX_NEWTON, each with at most 12 step halvings).  The
+**     round-trip error |apply(invert(x)) - x| is below PM_INVERT_TOL on
+**     return with PM_OK.
 **  2) Within a few arcminutes of the mount's pole the closed form's two
 **     branches need not match the two sides of the pole (the anisotropic
 **     terms fold the sky there), so the other branch is tried, then

@@ -70,6 +70,35 @@ double lipschitz(const pm_model *m)
     return amp <= far ? s : __builtin_inf();
 }
 
+/* Bound on the second derivative of the anisotropic displacement (rad per
+** rad^2, along any unit direction of the two axis angles), for the
+** inverse's predicted stop (pm.h, pm_model_invert Note 1): the sum of
+** |coef| times, for a harmonic term of degree l, 1.25 (l(l+1) + 2.5 l + 4),
+** which is above 1.25 times the maxima of F2 B0 + 2 F1 B1 + F0 B2 measured
+** by tests/ref/lip2_bounds.py for l <= 10 (4.1, 14.3, 22.6, 32.9, ...,
+** 136.8: the product rule on N_lm Y_lm and the base vector's components,
+** the i-th derivatives' suprema F_i and B_i).  The AUX terms' part depends
+** on the context (pm_model_invert adds 1.45 |coef (input - param)|: 1.25
+** B2); any other added term, a degree beyond 10 or an infinite lip make it
+** infinite: the inverse then stops on measured changes only. */
+double second_rate(const pm_model *m)
+{
+    const double inf = __builtin_inf();
+    if (!(m->lip < inf))
+        return inf;
+    double s = 0;
+    for (int i = 6; i < m->n_base; i++) {
+        int l = m->term[i].l;
+        if (l > 10)
+            return inf;
+        s += m_fabs(m->coef[i]) * 1.25 * (l * (l + 1) + 2.5 * l + 4);
+    }
+    for (int i = m->n_base; i < m->n_terms; i++)
+        if (m->term[i].kind != PM_TERM_AUX || m->term[i].side != 0)
+            return inf;
+    return s;
+}
+
 /* Round-trip residual of encoder trig g against target q, measured as the
 ** tangent offset (radians) of q seen from the model's position. */
 double miss(const pm_model *m, const Iso<double> &k, const pm_context *ctx,
@@ -322,6 +351,113 @@ void on_turn(const pm_model *m, const Iso<double> &k, const Aim &a, Trig<double>
     g->have_angles = true;
 }
 
+/* The displacement D at g, bit for bit as aniso computes it, and its
+** Jacobian J = dD/d(t, d) (J[0] = d dt/dt, J[1] = d dt/dd, J[2] = d dd/dt,
+** J[3] = d dd/dd) from the harmonic terms and the AUX terms (any other
+** added term is left out of J: the model's lip2 is then infinite and J
+** serves the Newton step only).  One model evaluation. */
+void aniso_jac(const pm_model *m, const Iso<double> &k, const Trig<double> &g,
+               const pm_context *ctx, double *dt, double *dd, double J[4])
+{
+    PM_EVAL_PROBE();
+    double S[6], St[6], Sd[6];
+    sh_sums_jac<double>(m->order, g, m->dense, S, St, Sd);
+    aniso_of_sums<double>(m, k, g, ctx, S, dt, dd, 0);
+    /* the AUX terms: constant factors of their base vectors */
+    for (int i = m->n_base; i < m->n_terms; i++)
+        if (m->term[i].kind == PM_TERM_AUX && m->term[i].side == 0)
+            S[m->term[i].k - 1] +=
+                m->coef[i] * (aux_input(ctx, m->term[i].aux) - m->term[i].param);
+    double stp, ctp, sdp, cdp;
+    shifted<double>(k, g, &stp, &ctp, &sdp, &cdp);
+    /* dt = cd S2 + S5 - sdp ctp S0 - sdp stp S1 - sd S3, dd = stp S0 - S4 -
+    ** ctp S1 (aniso_of_sums); d/dt turns (stp, ctp), d/dd (sd, cd) and
+    ** (sdp, cdp) */
+    J[0] = g.cd * St[2] + St[5] - sdp * (ctp * St[0] - stp * S[0]) -
+           sdp * (stp * St[1] + ctp * S[1]) - g.sd * St[3];
+    J[1] = -g.sd * S[2] + g.cd * Sd[2] + Sd[5] - cdp * (ctp * S[0] + stp * S[1]) -
+           sdp * (ctp * Sd[0] + stp * Sd[1]) - g.cd * S[3] - g.sd * Sd[3];
+    J[2] = ctp * S[0] + stp * St[0] - St[4] + stp * S[1] - ctp * St[1];
+    J[3] = stp * Sd[0] - Sd[4] - ctp * Sd[1];
+}
+
+/* The step from trig b to trig a, when both angles are within 0.01 rad:
+** their sines (ht, hd); the angles are larger by at most |h|^3 / 5. */
+inline bool small_step(const Trig<double> &a, const Trig<double> &b, double *ht, double *hd)
+{
+    double s1 = a.st * b.ct - a.ct * b.st, c1 = a.ct * b.ct + a.st * b.st;
+    double s2 = a.sd * b.cd - a.cd * b.sd, c2 = a.cd * b.cd + a.sd * b.sd;
+    if (!(m_fabs(s1) <= 0.01 && c1 > 0 && m_fabs(s2) <= 0.01 && c2 > 0))
+        return false;
+    *ht = s1;
+    *hd = s2;
+    return true;
+}
+
+/* The predicted bound on |D(x') - D^'| (solve_branch): the linear model's
+** miss at the step h (sines of the angles: the angles' excess over them,
+** |h|^3 / 5 per axis, times |J| added), J's own change since it was taken
+** (lip2 times the distance dist_j) and the second-order remainder; hn
+** bounds the step's length in angle. */
+inline double step_bound(double dt, double dd, const double J[4], double ht, double hd,
+                         double nt, double nd, double lip2, double dist_j, double hn)
+{
+    double et = dt + (J[0] * ht + J[1] * hd) - nt;
+    double ed = dd + (J[2] * ht + J[3] * hd) - nd;
+    double jn = m_fabs(J[0]) + m_fabs(J[1]) + m_fabs(J[2]) + m_fabs(J[3]);
+    return m_sqrt(et * et + ed * ed) + jn * hn * hn * hn * 0.4 +
+           lip2 * (dist_j + 0.5 * hn) * hn;
+}
+
+/* The Newton step on the displacement: with F the closed form (D to the
+** encoder position it needs) and J = dD/dx, y = (I - J F_D)^-1 r; this
+** prepares the matrix Ni = (I - J F_D)^-1 (once per call: a chord).  F_D
+** at g = F(D^), D^ = (a, b): the closed form solves M'(x) v = H^T q with
+** M' = Pt(t') X(d) Pd(d'), v = T(i) w, w = expmap(a, b); differentiated,
+** in the frame of w, dt (A x w) - dd (y x w) = -w_D dD with A = (T(i)
+** M')^T z the polar axis, y = T(i)^T (0, 1, 0) the declination axis there
+** (every vector tangent at w: the y and z components are the system).
+** w_D to O(|D|^3) by the series; an approximation only changes how fast
+** the iteration converges, never when it stops (the stop is measured, or
+** bounded with J itself).  False where the step is ill-conditioned (the
+** mount's pole). */
+inline bool newton_prep(const Iso<double> &k, const Trig<double> &g, double a, double b,
+                        const double J[4], double Ni[4])
+{
+    double sdp = g.sd * k.ce - g.cd * k.se, cdp = g.cd * k.ce + g.sd * k.se;
+    /* A in the frame of v, then of w */
+    double ax = sdp * k.cd, ay = k.sd, az = cdp * k.cd;
+    double bx = k.ci * ax + k.si * ay, by = k.ci * ay - k.si * ax;
+    double r2 = a * a + b * b, sc = 1 - r2 * (1.0 / 6);
+    double wx = 1 - 0.5 * r2, wy = a * sc, wz = b * sc;
+    /* columns (A x w), -(y x w) restricted to y, z; y = (si, ci, 0) */
+    double m00 = az * wx - bx * wz, m10 = bx * wy - by * wx;
+    double m01 = k.si * wz, m11 = k.ci * wx - k.si * wy;
+    double dm = m00 * m11 - m01 * m10;
+    if (!(m_fabs(dm) >= 1e-3 * k.ci))
+        return false;
+    double idm = 1 / dm;
+    /* w_D (y, z rows): [[sc - a^2/3, -ab/3], [-ab/3, sc - b^2/3]] */
+    double w00 = sc - a * a * (1.0 / 3), w01 = -a * b * (1.0 / 3), w11 = sc - b * b * (1.0 / 3);
+    /* F_D = -M^-1 W */
+    double i00 = m11 * idm, i01 = -m01 * idm, i10 = -m10 * idm, i11 = m00 * idm;
+    double f00 = -(i00 * w00 + i01 * w01), f01 = -(i00 * w01 + i01 * w11);
+    double f10 = -(i10 * w00 + i11 * w01), f11 = -(i10 * w01 + i11 * w11);
+    double K00 = J[0] * f00 + J[1] * f10, K01 = J[0] * f01 + J[1] * f11;
+    double K10 = J[2] * f00 + J[3] * f10, K11 = J[2] * f01 + J[3] * f11;
+    double A = 1 - K00, B = -K01, C = -K10, D = 1 - K11;
+    double det = A * D - B * C;
+    if (!(m_fabs(det) >= 0.05))
+        return false;
+    double id = 1 / det;
+    /* (I - K)^-1 */
+    Ni[0] = D * id;
+    Ni[1] = -B * id;
+    Ni[2] = -C * id;
+    Ni[3] = A * id;
+    return true;
+}
+
 /* Solve on one branch of the closed form (side = +1/-1), or from the start
 ** position's branch, with the angles on the turn the result is returned
 ** on (turn_of).  Returns the status and (t, d). */
@@ -329,42 +465,97 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
                        const pm_context *ctx, const Aim &a, int side, const double *start,
                        const double *turn, double *t_out, double *d_out)
 {
-    double dt_prev = 0, dd_prev = 0;
     /* Periodic terms of non-integer G read the raw angle itself, not only
     ** its sine and cosine: iterate with the angles on the returned turn. */
     const double ref_t = turn[0], ref_d = turn[1];
     const Target<double> tg = target_of(k, a.q);
-    Trig<double> g;
-    if (start) {
+    /* the angles themselves (on_turn) only where a term reads them; else
+    ** once, at the end */
+    const bool raw = reads_raw_angles(m);
+    /* The predicted stop (Note 1 of pm_model_invert in pm.h) needs the
+    ** second-derivative bound: finite only where J is complete (harmonic
+    ** and AUX terms) and no term reads the raw angles; the AUX terms' part
+    ** at this context. */
+    double lip2 = raw ? __builtin_inf() : m->lip2;
+    if (lip2 < 1e300)
+        for (int i = m->n_base; i < m->n_terms; i++)
+            lip2 += 1.45 * m_fabs(m->coef[i] * (aux_input(ctx, m->term[i].aux) -
+                                                m->term[i].param));
+    if (!(lip2 < 1e300))
+        lip2 = -1; /* no prediction */
+
+    /* Iteration: g = F(D^), the closed form for the displacement D^; the
+    ** model's displacement D at g misses D^ by |D - D^|, which is g's
+    ** round-trip error (to first order): the measured stop.  The next D^
+    ** is the Newton step on D^ = D(F(D^)) with J = dD/dx from the first
+    ** evaluation (a chord: J is not evaluated again), and where lip2 is
+    ** known the next point's error is bounded before it is evaluated,
+    **   |D(x') - D^'| <= |D + J h - D^'| + lip2 (|x - x_J| + |h| / 2) |h|,
+    ** h = x' - x: the predicted stop. */
+    Trig<double> g, g2;
+    double dh_t = 0, dh_d = 0; /* D^ of g */
+    double J[4] = {0, 0, 0, 0}, Ni[4] = {1, 0, 0, 1}, dist_j = 0;
+    bool have_j = false, have_n = false, tried_n = false, reachable;
+    double d0t = 0, d0d = 0;
+    bool have_d = false; /* (d0t, d0d): D at g, evaluated */
+    if (m->order == 0 && m->n_terms == m->n_base) {
+        /* No anisotropic term: D = 0 everywhere, and the closed form is
+        ** the solution (no evaluation); from a start, on its branch. */
+        if (start) {
+            Trig<double> gs = trig_of(start[0], start[1]);
+            double cdp = gs.cd * k.ce + gs.sd * k.se;
+            side = cdp * k.ci >= 0 ? 1 : -1;
+        }
+        reachable = iso_inverse<double>(k, tg, 0.0, 0.0, side, &g);
+        if (raw)
+            on_turn(m, k, a, &g, ref_t, ref_d);
+        have_d = true; /* (the iteration below stops at once: D = D^ = 0) */
+    } else if (start) {
         /* The branch of the start: the sign of the x-component of
         ** Pd(d - e') T(i) w there, the quantity iso_inverse chooses by
         ** (near the mount's pole it differs from the sign of cos(dec)). */
         g = trig_of(start[0], start[1]);
-        aniso<double>(m, k, g, ctx, &dt_prev, &dd_prev);
+        aniso_jac(m, k, g, ctx, &d0t, &d0d, J);
+        have_j = have_d = true;
         double stp, ctp, sdp, cdp;
         shifted<double>(k, g, &stp, &ctp, &sdp, &cdp);
-        V3<double> v = rot_z<double>(k.si, k.ci, expmap<double>(dt_prev, dd_prev));
+        V3<double> v = rot_z<double>(k.si, k.ci, expmap<double>(d0t, d0d));
         side = cdp * v.x - sdp * v.z >= 0 ? 1 : -1;
+        /* The start is the closed form's exact point for the displacement
+        ** at which the target is seen from it: D^ = log((H Pt X Pd T)^T q),
+        ** so it is the first iterate (its miss |D - D^| is measured like
+        ** the others', and a start that already points there is returned
+        ** after one evaluation). */
+        V3<double> w = rot_zt<double>(
+            k.si, k.ci, rot_dt<double>(sdp, cdp, rot_xt<double>(k.sd, k.cd,
+                                                                rot_zt<double>(stp, ctp, tg.q0))));
+        logmap<double>(w, &dh_t, &dh_d);
+        reachable = true;
+    } else {
+        reachable = iso_inverse<double>(k, tg, 0.0, 0.0, side, &g);
     }
-    /* the angles themselves (on_turn) only where a term reads them; else
-    ** once, at the end */
-    const bool raw = reads_raw_angles(m);
-    bool reachable = iso_inverse<double>(k, tg, dt_prev, dd_prev, side, &g);
     if (raw)
         on_turn(m, k, a, &g, ref_t, ref_d);
 
-    /* Fixed point: x_{n+1} = iso_inverse(D(x_n)).  x_n misses the target
-    ** by |D(x_n) - D(x_{n-1})| (to first order), which is the test. */
     double change = 0, last_change = 1e300, best_change = 1e300;
     bool converged = false, best_reachable = reachable;
     Trig<double> best = g;
-    for (int it = 0; it < PM_INVERT_MAX_FIXED; it++) {
+    for (int it = 0; it < PM_INVERT_MAX_FIXED && !converged; it++) {
         double dt, dd;
-        aniso<double>(m, k, g, ctx, &dt, &dd);
+        if (have_d) {
+            dt = d0t;
+            dd = d0d;
+            have_d = false;
+        } else if (have_j) {
+            aniso<double>(m, k, g, ctx, &dt, &dd);
+        } else {
+            aniso_jac(m, k, g, ctx, &dt, &dd, J);
+            have_j = true;
+            dist_j = 0;
+        }
         if (!finite(dt * dt + dd * dd))
             break; /* the forward model overflows here: not converged */
-        change = m_sqrt((dt - dt_prev) * (dt - dt_prev) +
-                        (dd - dd_prev) * (dd - dd_prev));
+        change = m_sqrt((dt - dh_t) * (dt - dh_t) + (dd - dh_d) * (dd - dh_d));
         if (change < best_change) {
             best_change = change;
             best = g;
@@ -377,11 +568,36 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
         if (it > 0 && change > 0.5 * last_change)
             break; /* not contracting: Newton takes over */
         last_change = change;
-        dt_prev = dt;
-        dd_prev = dd;
-        reachable = iso_inverse<double>(k, tg, dt, dd, side, &g);
+        double nt = dt, nd = dd, ht, hd;
+        if (!tried_n) { /* (F_D once, where the first step needs it) */
+            tried_n = true;
+            have_n = newton_prep(k, g, dh_t, dh_d, J, Ni);
+        }
+        if (have_n && change <= 0.01) {
+            nt = dh_t + (Ni[0] * (dt - dh_t) + Ni[1] * (dd - dh_d));
+            nd = dh_d + (Ni[2] * (dt - dh_t) + Ni[3] * (dd - dh_d));
+        }
+        reachable = iso_inverse<double>(k, tg, nt, nd, side, &g2);
         if (raw)
-            on_turn(m, k, a, &g, ref_t, ref_d);
+            on_turn(m, k, a, &g2, ref_t, ref_d);
+        if (lip2 >= 0 && small_step(g2, g, &ht, &hd)) {
+            double h2 = ht * ht + hd * hd, hn = m_sqrt(h2) * (1 + h2 * 0.2);
+            /* (the second-order part alone first: it fails most steps) */
+            if (!(lip2 * (dist_j + 0.5 * hn) * hn > PM_INVERT_TOL * 0.5) &&
+                step_bound(dt, dd, J, ht, hd, nt, nd, lip2, dist_j, hn) <=
+                    PM_INVERT_TOL * 0.5) {
+                best = g2;
+                best_reachable = reachable;
+                converged = true;
+                break;
+            }
+            dist_j += hn;
+        } else {
+            dist_j = 1e300; /* (a bound fails from here on: J is not evaluated again) */
+        }
+        g = g2;
+        dh_t = nt;
+        dh_d = nd;
     }
     g = best;
     reachable = best_reachable;
@@ -692,6 +908,7 @@ pm_status pm_model_prepare(pm_model *m)
         m->dense[j][t->k - 1] += m->coef[i] * norm_lm(t->l, t->m);
     }
     m->lip = lipschitz(m);
+    m->lip2 = second_rate(m);
     for (int i = 0; i < PM_MAX_TERMS; i++)
         m->prep_coef[i] = i < m->n_terms ? m->coef[i] : 0.0;
     m->prepared = 1;

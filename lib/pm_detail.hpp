@@ -374,6 +374,66 @@ template <typename T> inline void harmonics(int L, const Trig<T> &g, T *Y)
     }
 }
 
+/* The raw harmonics Y (the same operations as harmonics_n: the same bits)
+** and their derivatives along the axes, Yt = dY/dt and Yd = dY/dd, for
+** the inverse's Newton step (analytic Jacobian).  With Q_l^m the Legendre
+** part, Y_{l,m} = Q cos(m t), Y_{l,-m} = Q sin(m t): Yt_{l,+-m} = -+m
+** Y_{l,-+m}, and dQ/dd by the derivative of each recurrence step
+** (d cos d = -sin d, d sin d = cos d). */
+template <typename T, int LC>
+inline void harmonics_jac_n(int Lrt, const Trig<T> &g, T *Y, T *Yt, T *Yd)
+{
+    const int L = LC > 0 ? LC : Lrt;
+    T cm = 1, sm = 0;
+    T pmm = 1, dpmm = 0; /* P_m^m and its derivative */
+#pragma GCC unroll 16
+    for (int m = 0; m <= L; m++) {
+        if (m == 1) {
+            cm = g.ct;
+            sm = g.st;
+            pmm = g.cd;
+            dpmm = -g.sd;
+        } else if (m > 1) {
+            T c2 = cm * g.ct - sm * g.st;
+            sm = sm * g.ct + cm * g.st;
+            cm = c2;
+            dpmm = (T)(2 * m - 1) * (dpmm * g.cd - pmm * g.sd);
+            pmm = pmm * (T)(2 * m - 1) * g.cd;
+        }
+        T p2 = 0, p1 = pmm, d2 = 0, d1 = dpmm;
+#pragma GCC unroll 16
+        for (int l = m; l <= L; l++) {
+            T p, dp;
+            if (l == m) {
+                p = pmm;
+                dp = dpmm;
+            } else if (l == m + 1) {
+                p = (T)(2 * m + 1) * g.sd * pmm;
+                dp = (T)(2 * m + 1) * (g.cd * pmm + g.sd * dpmm);
+            } else {
+                p = ((T)(2 * l - 1) * g.sd * p1 - (T)(l + m - 1) * p2) / (T)(l - m);
+                dp = ((T)(2 * l - 1) * (g.cd * p1 + g.sd * d1) - (T)(l + m - 1) * d2) /
+                     (T)(l - m);
+            }
+            if (l > m) {
+                p2 = p1;
+                p1 = p;
+                d2 = d1;
+                d1 = dp;
+            }
+            int j = l * l + l;
+            Y[j + m] = p * cm;
+            Yd[j + m] = dp * cm;
+            Yt[j + m] = -(T)m * p * sm;
+            if (m > 0) {
+                Y[j - m] = p * sm;
+                Yd[j - m] = dp * sm;
+                Yt[j - m] = (T)m * p * cm;
+            }
+        }
+    }
+}
+
 /* Normalisation N_lm reproducing the paper's Y_lm for l <= 2:
 ** 1/(2l-1)!! for m != 0 (so Y_ll = cos^l d cos l t), and for m = 0:
 ** 1 for l <= 1, 2 for l >= 2 (Y_20 = 3 sin^2 d - 1). */
@@ -872,9 +932,60 @@ inline void sh_sums(int L, const Trig<T> &g, const W (*dense)[6], T S[6])
     }
 }
 
+/* The harmonic sums (as sh_sums_n: the same bits) and their derivatives
+** along the axes, St and Sd, for order LC >= 1 (compile time) or Lrt. */
+template <typename T, int LC>
+inline void sh_sums_jac_n(int Lrt, const Trig<T> &g, const double (*dense)[6], T *S, T *St,
+                          T *Sd)
+{
+    const int L = LC > 0 ? LC : Lrt;
+    T Y[PM_N_HARM(LC > 0 ? LC : PM_MAX_L)], Yt[PM_N_HARM(LC > 0 ? LC : PM_MAX_L)],
+        Yd[PM_N_HARM(LC > 0 ? LC : PM_MAX_L)];
+    harmonics_jac_n<T, LC>(L, g, Y, Yt, Yd);
+    HarmSums<T, double, LC>::sum((L + 1) * (L + 1), dense, Y, S);
+    HarmSums<T, double, LC>::sum((L + 1) * (L + 1), dense, Yt, St);
+    HarmSums<T, double, LC>::sum((L + 1) * (L + 1), dense, Yd, Sd);
+}
+
+/* sh_sums_jac_n for order L (0..PM_MAX_L), dispatched as sh_sums. */
+template <typename T>
+inline void sh_sums_jac(int L, const Trig<T> &g, const double (*dense)[6], T S[6], T St[6],
+                        T Sd[6])
+{
+    switch (L) {
+    case 0:
+        for (int i = 0; i < 6; i++)
+            S[i] = St[i] = Sd[i] = 0;
+        return;
+    case 1: sh_sums_jac_n<T, 1>(1, g, dense, S, St, Sd); return;
+#if PM_MAX_L >= 2
+    case 2: sh_sums_jac_n<T, 2>(2, g, dense, S, St, Sd); return;
+#endif
+#if PM_MAX_L >= 3
+    case 3: sh_sums_jac_n<T, 3>(3, g, dense, S, St, Sd); return;
+#endif
+#if PM_MAX_L >= 4
+    case 4: sh_sums_jac_n<T, 4>(4, g, dense, S, St, Sd); return;
+#endif
+    default:
+#if PM_MAX_L > 4
+        sh_sums_jac_n<T, 0>(L, g, dense, S, St, Sd);
+#else
+        for (int i = 0; i < 6; i++)
+            S[i] = St[i] = Sd[i] = 0; /* (L is checked) */
+#endif
+        return;
+    }
+}
+
 /* Anisotropic displacement (tangent components in the transported frame)
 ** at encoder trig g: the base harmonic terms with l >= 1 through the dense
 ** table, then the added terms. */
+template <typename T>
+__attribute__((always_inline)) inline void
+aniso_of_sums(const pm_model *m, const Iso<T> &k, const Trig<T> &g0, const pm_context *ctx,
+              const T *S, T *dt, T *dd, const T *sh);
+
 template <typename T>
 inline void aniso(const pm_model *m, const Iso<T> &k, const Trig<T> &g0,
                   const pm_context *ctx, T *dt, T *dd, const T *sh = 0)
@@ -882,6 +993,17 @@ inline void aniso(const pm_model *m, const Iso<T> &k, const Trig<T> &g0,
     PM_EVAL_PROBE();
     T S[6];
     sh_sums<T, double>(m->order, g0, m->dense, S);
+    aniso_of_sums<T>(m, k, g0, ctx, S, dt, dd, sh);
+}
+
+/* The displacement from the harmonic sums S at g0: the projection on the
+** base vectors, then the added terms (aniso and the inverse's aniso_jac:
+** the same operations). */
+template <typename T>
+__attribute__((always_inline)) inline void
+aniso_of_sums(const pm_model *m, const Iso<T> &k, const Trig<T> &g0, const pm_context *ctx,
+              const T *S, T *dt, T *dd, const T *sh)
+{
     /* sum_k S_k (u_k, v_k), written out (the products of the position's
     ** trig formed beside the sums: a short chain after them); the tilts
     ** (S_0, S_1) at the shifted position (base_uv_at; sh: its trig when

@@ -1,0 +1,120 @@
+/*
+**  hard_cases.h - the adversarial models, contexts and targets of
+**  tests/check_bounded.c, shared with the bench (bench/bench_dist.c
+**  measures the inverse's cost on the same cases the test bounds).
+**  Header-only C99 (static functions), deterministic: tu_rng.
+*/
+#ifndef PM_HARD_CASES_H
+#define PM_HARD_CASES_H
+
+#include <math.h>
+#include <string.h>
+#include "pm.h"
+#include "testutil.h"
+
+/* Coefficient scales: ordinary mounts, badly built ones, and absurd. */
+enum { HC_SCALE_NORMAL, HC_SCALE_LARGE, HC_SCALE_HUGE, HC_N_SCALES };
+
+/* A random model of every term kind at the given scale (any order up to
+** PM_MAX_L, equatorial or alt-az, up to five added terms of the kinds
+** FOURIER..AUX).  Returns 0, or -1 if the library refused it. */
+static int hc_random_model(pm_model *m, tu_rng *r, int scale)
+{
+    static const double iso_scale[HC_N_SCALES] = {1e-2, 0.3, 1e3};
+    static const double an_scale[HC_N_SCALES] = {1e-3, 3e-2, 10.0};
+    int mount = tu_uniform(r) < 0.5 ? PM_MOUNT_EQUATORIAL : PM_MOUNT_ALTAZ;
+    int order = (int)(tu_uniform(r) * (PM_MAX_L + 1));
+    int i, n_extra;
+    if (pm_model_init(m, mount, order) != PM_OK)
+        return -1;
+    m->latitude = (tu_uniform(r) * 2 - 1) * M_PI / 2;
+    for (i = 0; i < m->n_terms; i++)
+        m->coef[i] = tu_gauss(r) * (i < 6 ? iso_scale[scale] : an_scale[scale]);
+    if (pm_model_prepare(m) != PM_OK)
+        return -1;
+    n_extra = (int)(tu_uniform(r) * 6);
+    for (i = 0; i < n_extra; i++) {
+        pm_term t;
+        memset(&t, 0, sizeof t);
+        t.kind = (unsigned char)(1 + (int)(tu_uniform(r) * 4)); /* FOURIER..AUX */
+        t.k = (unsigned char)(1 + (int)(tu_uniform(r) * 6));
+        t.side = (signed char)((int)(tu_uniform(r) * 3) - 1);
+        t.m = (signed char)(tu_uniform(r) < 0.5);
+        switch (t.kind) {
+        case PM_TERM_FOURIER:
+            t.l = (signed char)(1 + (tu_uniform(r) < 0.5));
+            t.param = tu_uniform(r) < 0.3 ? 1e6 : 1 + tu_uniform(r) * 720;
+            break;
+        case PM_TERM_SECTORAL:
+            t.param = (double)(1 + (int)(tu_uniform(r) * 300));
+            break;
+        case PM_TERM_ZENITH:
+            t.l = (signed char)(tu_uniform(r) < 0.5);
+            t.m = 0;
+            break;
+        default:
+            t.aux = (unsigned char)(tu_uniform(r) * (PM_AUX_USER + PM_MAX_AUX));
+            t.param = tu_gauss(r) * 10;
+            break;
+        }
+        if (pm_model_add_term(m, &t, tu_gauss(r) * an_scale[scale], NULL) != PM_OK)
+            return -1;
+    }
+    return 0;
+}
+
+/* A context with ordinary, huge or denormal values. */
+static void hc_random_context(pm_context *c, tu_rng *r)
+{
+    static const double vals[] = {0.0, 1e300, -1e300, 4.9e-324, 1e6, -40.0};
+    int j;
+    double u = tu_uniform(r);
+    c->temp_c = u < 0.7 ? tu_gauss(r) * 10 : vals[(int)(tu_uniform(r) * 6)];
+    c->time_h = u < 0.7 ? tu_gauss(r) * 5 : vals[(int)(tu_uniform(r) * 6)];
+    c->pier = (int)(tu_uniform(r) * 3) - 1;
+    c->dir = (int)(tu_uniform(r) * 3) - 1;
+    for (j = 0; j < PM_MAX_AUX; j++)
+        c->aux[j] = u < 0.7 ? tu_gauss(r) : vals[(int)(tu_uniform(r) * 6)];
+}
+
+/* An adversarial apparent position (ha, dec) for model m: the celestial
+** poles, the mount's pole (within the anisotropic amplitude of it), hour
+** angles at and next to +-180 deg and far outside (-pi, pi]. */
+static void hc_hard_target(const pm_model *m, tu_rng *r, double *ha, double *dec)
+{
+    static const double has[] = {M_PI, -M_PI, 3.141592653589793, -3.1415926535897927,
+                                 0.0, -0.0, 1e6, -1e300, 7 * M_PI};
+    double e = m->coef[4];
+    double u = tu_uniform(r);
+    *ha = tu_uniform(r) < 0.5 ? has[(int)(tu_uniform(r) * 9)]
+                              : (tu_uniform(r) * 2 - 1) * M_PI;
+    if (u < 0.2)
+        *dec = tu_uniform(r) < 0.5 ? M_PI / 2 : -M_PI / 2; /* celestial poles */
+    else if (u < 0.5) {
+        /* at the mount's pole, within the anisotropic amplitude of it */
+        double p = (tu_uniform(r) < 0.5 ? M_PI / 2 : -M_PI / 2) + e;
+        p += tu_gauss(r) * 1e-3 * (tu_uniform(r) < 0.5 ? 1.0 : 1e-6);
+        *dec = p;
+    } else
+        *dec = asin(tu_uniform(r) * 2 - 1);
+    if (*dec > M_PI / 2)
+        *dec = M_PI - *dec; /* keep it on the sphere */
+    if (*dec < -M_PI / 2)
+        *dec = -M_PI - *dec;
+}
+
+/* The start of pm_model_invert_near for a hard case: near the solution
+** just found (sol != 0: within ~1e-3 rad of it), or absurd. */
+static void hc_hard_start(tu_rng *r, const double *sol, double *sh, double *sd)
+{
+    static const double starts[] = {1e300, -1e300, 1e7, M_PI, -M_PI, 0.0};
+    if (sol && tu_uniform(r) < 0.5) {
+        *sh = sol[0] + tu_gauss(r) * 1e-3;
+        *sd = sol[1] + tu_gauss(r) * 1e-3;
+    } else {
+        *sh = starts[(int)(tu_uniform(r) * 6)];
+        *sd = tu_uniform(r) < 0.5 ? starts[(int)(tu_uniform(r) * 6)] : tu_gauss(r);
+    }
+}
+
+#endif
