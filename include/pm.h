@@ -182,8 +182,8 @@ typedef enum pm_status {
 #endif
 
 /* Base vectors k = 1..6 of Pal et al. Eq. (tdvectexpansion). */
-#define PM_BASE_A 1 /* polar axis misalignment, a (TPOINT: ME-like)  */
-#define PM_BASE_B 2 /* polar axis misalignment, b (TPOINT: MA-like)  */
+#define PM_BASE_A 1 /* polar axis misalignment, a (TPOINT: MA-like)  */
+#define PM_BASE_B 2 /* polar axis misalignment, b (TPOINT: ME-like)  */
 #define PM_BASE_C 3 /* hour-angle encoder index, c' (TPOINT: IH)     */
 #define PM_BASE_D 4 /* axis non-perpendicularity, d (TPOINT: NP)     */
 #define PM_BASE_E 5 /* declination encoder index, e' (TPOINT: ID)    */

@@ -1,16 +1,14 @@
 /*
 **  check_formats.c - the readers of the pointing files users already have
 **  (RTS2 gpoint input, MountWizzard4 JSON model files, N.I.N.A./ASCOM-style
-**  CSV logs, the MMT pointing log; tools/lib/runfile.h) and the TPOINT
-**  term export (tools/lib/tpointterms.h, pmfit fit --tpoint-terms).
+**  CSV logs, the MMT pointing log; tools/lib/runfile.h).  The TPOINT term
+**  export (pmfit fit --tpoint-terms) is tested in check_tpointterms.c.
 **
 **  TCases: "detect" (detection by content, forcing a format, the names),
 **  "samples" (every sample in tests/data, written by tests/ref/formats_gen.py
 **  from two simulated runs, reads as the run it came from), "fit" (pmfit
 **  fits every sample to the source run's fit and to the true terms),
-**  "errors" (each bad_* sample's message, skipped records), "export" (the
-**  TPOINT formulas with the exported values against pm_model_apply),
-**  "realdata" (the MMT log against its TPOINT conversion; skipped when
+**  "errors" (each bad_* sample's message, skipped records), "realdata" (the MMT log against its TPOINT conversion; skipped when
 **  $PM_DATA_DIR has no mmt/).
 */
 #define _POSIX_C_SOURCE 200809L
@@ -23,7 +21,6 @@
 
 #include "pm.h"
 #include "runfile.h"
-#include "tpointterms.h"
 #include "tu_runfile.h"
 #include "tu_tool.h"
 
@@ -51,9 +48,6 @@
 #define TOL_MMT_EL_OFFSET_AS 0.01
 #define TOL_MMT_SECOND_ORDER_AS 0.15
 #define TOL_MMT_SAME_AS 0.001
-/* The TPOINT first-order formulas against pm_model_apply, coefficients of
-** 20 arcsec, |dec| <= 75 deg, el >= 20 deg: the neglected second order. */
-#define TOL_FIRST_ORDER_AS 0.1
 
 /* ------------------------------------------------------------ helpers */
 
@@ -509,167 +503,6 @@ START_TEST(test_pmrun_read_skip_bad_lists_skipped)
 }
 END_TEST
 
-/* ------------------------------------------------------------- export */
-
-/* The TPOINT first-order formulas (tpointterms.h, docs/formats.md), written
-** here from the published form, independent of the export code: the true
-** place of raw (h, d) at latitude phi. */
-static void tpoint_true(const double v[8], double phi, double h, double d, double *ht, double *dt)
-{
-    double ih = v[0], id = v[1], np = v[2], ch = v[3], ma = v[4], me = v[5], tf = v[6], tx = v[7];
-    double sd = sin(d), cd = cos(d), sh = sin(h), chh = cos(h), td = sd / cd;
-    double sel = sin(phi) * sd + cos(phi) * cd * chh;
-    double z = tf + tx / sel;
-    double dh = -ih - ch / cd - np * td + ma * chh * td - me * sh * td - z * cos(phi) * sh / cd;
-    double dd = -id - ma * sh - me * chh - z * (cos(phi) * chh * sd - sin(phi) * cd);
-    *ht = h + dh;
-    *dt = d + dd;
-}
-
-static double sep(double h1, double d1, double h2, double d2)
-{
-    double x1 = cos(d1) * cos(h1), y1 = cos(d1) * sin(h1), z1 = sin(d1);
-    double x2 = cos(d2) * cos(h2), y2 = cos(d2) * sin(h2), z2 = sin(d2);
-    double cx = y1 * z2 - z1 * y2, cy = z1 * x2 - x1 * z2, cz = x1 * y2 - y1 * x2;
-    return atan2(sqrt(cx * cx + cy * cy + cz * cz), x1 * x2 + y1 * y2 + z1 * z2);
-}
-
-/* A model of random isotropic terms, tube flexure and cot(el) of up to
-** `size` arcsec; the largest difference (arcsec) between pm_model_apply
-** and the TPOINT formulas with the exported values at 4000 places (both
-** sides, |dec| <= 75, el >= 20); flip: the sign of one exported value
-** turned (a negative control). */
-static double worst_first_order(double size, unsigned seed, int flip)
-{
-    pm_model m;
-    pm_term t;
-    pmtp_term named[PMTP_MAX_NAMED];
-    double v[8] = {0, 0, 0, 0, 0, 0, 0, 0}, worst = 0, phi = 47 * DEG;
-    static const char *const names[8] = {"IH", "ID", "NP", "CH", "MA", "ME", "TF", "TX"};
-    int n = 0, k, j, done = 0;
-    srand(seed);
-    ck_assert_int_eq(pm_model_init(&m, PM_MOUNT_EQUATORIAL, 0), PM_OK);
-    m.latitude = phi;
-    /* each of size/2..size, either sign (none negligible: the negative
-    ** control turns each one) */
-#define RANDOM_COEF() (size * AS * (0.5 + 0.5 * rand() / RAND_MAX) * (rand() % 2 ? 1.0 : -1.0))
-    for (k = 0; k < 6; ++k) m.coef[k] = RANDOM_COEF();
-    memset(&t, 0, sizeof t);
-    t.kind = PM_TERM_ZENITH;
-    t.l = 1;
-    ck_assert_int_eq(pm_model_add_term(&m, &t, RANDOM_COEF(), NULL), PM_OK);
-    t.l = 0;
-    ck_assert_int_eq(pm_model_add_term(&m, &t, RANDOM_COEF(), NULL), PM_OK);
-    ck_assert_int_eq(pm_model_prepare(&m), PM_OK);
-    ck_assert_int_eq(pmtp_terms(&m, NULL, named, &n), 0);
-    ck_assert_int_eq(n, 8);
-    for (k = 0; k < n; ++k) {
-        ck_assert_str_eq(named[k].name, names[k]);
-        v[k] = named[k].value_arcsec * AS;
-    }
-    if (flip >= 0) v[flip] = -v[flip];
-    while (done < 4000) {
-        double h = PI * (2.0 * rand() / RAND_MAX - 1.0), d = 75 * DEG * (2.0 * rand() / RAND_MAX - 1.0);
-        double el = asin(sin(phi) * sin(d) + cos(phi) * cos(d) * cos(h));
-        double eh = h, ed = d, ah, ad, th, td, s;
-        if (el < 20 * DEG) continue;
-        if (done % 2) { /* beyond the pole: the same place, the other side */
-            eh = remainder(h + PI, 2 * PI);
-            ed = PI - d;
-        }
-        ck_assert_int_eq(pm_model_apply(&m, NULL, eh, ed, &ah, &ad), PM_OK);
-        tpoint_true(v, phi, eh, ed, &th, &td);
-        s = sep(ah, ad, th, td) / AS;
-        if (s > worst) worst = s;
-        ++done;
-    }
-    (void)j;
-    return worst;
-}
-
-START_TEST(test_pmtp_terms_first_order_agree_with_pm)
-{
-    double big = worst_first_order(20.0, 11, -1), small = worst_first_order(2.0, 11, -1);
-    int k;
-    fprintf(stderr, "check_formats: TPOINT first-order formulas vs pm_model_apply: worst %.4f\" "
-                    "with 10-20\" terms, %.6f\" with 1-2\" terms\n",
-            big, small);
-    ck_assert_msg(big < TOL_FIRST_ORDER_AS, "TPOINT formulas vs pm: %.4g arcsec at 20\" terms", big);
-    /* the difference is second order: 10x smaller terms, ~100x smaller */
-    ck_assert_msg(big / small > 50, "not second order: %.4g\" at 20\", %.4g\" at 2\"", big, small);
-    /* and the test can fail: any one sign turned is off by tens of arcsec */
-    for (k = 0; k < 8; ++k) {
-        double w = worst_first_order(20.0, 11, k);
-        ck_assert_msg(w > 1.0, "term %d with its sign turned still agrees (%.3g\")", k, w);
-    }
-}
-END_TEST
-
-START_TEST(test_pmtp_terms_args_and_altaz)
-{
-    pm_model m;
-    pmtp_term named[PMTP_MAX_NAMED];
-    int n = -1;
-    char err[512];
-    ck_assert_int_eq(pm_model_init(&m, PM_MOUNT_ALTAZ, 0), PM_OK);
-    ck_assert_int_eq(pmtp_terms(&m, NULL, named, &n), -1);
-    ck_assert_int_eq(pmtp_terms(NULL, NULL, named, &n), -1);
-    ck_assert_int_eq(pmtp_write("/tmp/pm_formats_never.tpm", &m, NULL, NULL, err, sizeof err), -1);
-    ck_assert_ptr_nonnull(strstr(err, "TPOINT terms are written for equatorial models only"));
-    ck_assert_int_eq(access("/tmp/pm_formats_never.tpm", F_OK), -1);
-}
-END_TEST
-
-START_TEST(test_pmfit_tpoint_terms_file)
-{
-    char dir[64], file[128], cmd[4096], out[16384], path[2048], text[8192];
-    FILE *f;
-    size_t n;
-    double c, e, i_, a, b, d;
-    tu_tmpdir(dir, "pm_formats_");
-    snprintf(file, sizeof file, "%s/model.tpm", dir);
-    data_path(path, sizeof path, "formats_source_eq.dat");
-    snprintf(cmd, sizeof cmd, "%s fit %s --order 1 --tpoint-terms %s --json", tu_pmfit_path(), path,
-             file);
-    ck_assert_int_eq(tu_capture(cmd, out, sizeof out), 0);
-    f = fopen(file, "r");
-    ck_assert_ptr_nonnull(f);
-    n = fread(text, 1, sizeof text - 1, f);
-    text[n] = 0;
-    fclose(f);
-    c = term_value(out, "c'"), e = term_value(out, "e'"), i_ = term_value(out, "i");
-    a = term_value(out, "a"), b = term_value(out, "b"), d = term_value(out, "d");
-    {
-        const char *names[6] = {"IH", "ID", "NP", "CH", "MA", "ME"};
-        double want[6];
-        int k;
-        want[0] = -c, want[1] = e, want[2] = d, want[3] = -i_, want[4] = -a, want[5] = b;
-        for (k = 0; k < 6; ++k) {
-            char pat[16];
-            const char *p;
-            snprintf(pat, sizeof pat, "     %-4s ", names[k]);
-            p = strstr(text, pat);
-            ck_assert_msg(p != NULL, "no %s in %s", names[k], text);
-            ck_assert_msg(fabs(atof(p + strlen(pat)) - want[k]) < 1e-4, "%s %.5f, want %.5f",
-                          names[k], atof(p + strlen(pat)), want[k]);
-        }
-    }
-    ck_assert_ptr_nonnull(strstr(text, "\nEND\n"));
-    /* the order-1 harmonics: listed apart, and said so */
-    ck_assert_ptr_nonnull(strstr(text, "! Terms of the model with no TPOINT name"));
-    ck_assert_ptr_nonnull(strstr(text, "!   a*Y(1,-1) "));
-    unlink(file);
-    /* an alt-az run: the fit is reported, the file refused, exit 1 */
-    data_path(path, sizeof path, "mmt_log.dat");
-    snprintf(cmd, sizeof cmd, "%s fit %s --order 0 --tpoint-terms %s", tu_pmfit_path(), path, file);
-    ck_assert_int_eq(tu_capture(cmd, out, sizeof out), 1);
-    ck_assert_ptr_nonnull(strstr(out, "unbiased sigma"));
-    ck_assert_ptr_nonnull(strstr(out, "TPOINT terms are written for equatorial models only"));
-    ck_assert_int_eq(access(file, F_OK), -1);
-    rmdir(dir);
-}
-END_TEST
-
 /* ----------------------------------------------------------- realdata */
 
 static int mmt_paths(char *log, char *tp, size_t n)
@@ -768,12 +601,6 @@ static Suite *formats_suite(void)
     tcase_add_test(tc, test_pmrun_read_bad_csv);
     tcase_add_test(tc, test_pmrun_read_bad_mmt);
     tcase_add_test(tc, test_pmrun_read_skip_bad_lists_skipped);
-    suite_add_tcase(s, tc);
-    tc = tcase_create("export");
-    tcase_set_timeout(tc, 120);
-    tcase_add_test(tc, test_pmtp_terms_first_order_agree_with_pm);
-    tcase_add_test(tc, test_pmtp_terms_args_and_altaz);
-    tcase_add_test(tc, test_pmfit_tpoint_terms_file);
     suite_add_tcase(s, tc);
     tc = tcase_create("realdata");
     tcase_set_timeout(tc, 120);

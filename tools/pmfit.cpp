@@ -136,7 +136,8 @@ void usage(FILE *f)
         "                   (1 sigma, from the fit's covariance) as an SVG map; with\n"
         "                   --pier split: F-east and F-west (docs/model.md)\n"
 "  --tpoint-terms F write the fitted model as a TPOINT-style term list (IH ID NP CH\n"
-        "                   MA ME, TF TX when added; the other terms listed apart) to F;\n"
+        "                   MA ME, alt-az IA IE CA NPAE AN AW; TF TX when added; the\n"
+        "                   other terms listed apart) to F;\n"
         "                   with --pier split: F-east and F-west (docs/formats.md)\n"
         "  --no-refraction  leave refraction out of the reductions (TPOINT, CSV, RTS2)\n"
         "  --skip-bad       skip malformed records (each is reported) instead of failing\n"
@@ -1517,13 +1518,9 @@ int run_main(int argc, char **argv)
             pmmodel_save((o.save + suffix).c_str(), &fits[k].model, note.c_str(), e, sizeof e) != 0)
             write_errors.push_back(e);
         if (!o.tpoint_terms.empty()) {
-            if (fits[k].model.mount != PM_MOUNT_EQUATORIAL)
-                write_errors.push_back("--tpoint-terms " + o.tpoint_terms + suffix +
-                                       ": TPOINT terms are written for equatorial models only "
-                                       "(TPOINT's alt-az terms are not exported; docs/formats.md)");
-            else if (pmtp_write((o.tpoint_terms + suffix).c_str(), &fits[k].model, fits[k].res.err,
-                                ("pmfit fit " + o.run + " (" + titles[k] + ")").c_str(), e,
-                                sizeof e) != 0)
+            if (pmtp_write((o.tpoint_terms + suffix).c_str(), &fits[k].model, fits[k].res.err,
+                           ("pmfit fit " + o.run + " (" + titles[k] + ")").c_str(), e,
+                           sizeof e) != 0)
                 write_errors.push_back(e);
         }
         if (!o.emit_c.empty()) {

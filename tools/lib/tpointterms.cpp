@@ -1,4 +1,4 @@
-// tpointterms.cpp - a fitted equatorial model as a TPOINT-style term list
+// tpointterms.cpp - a fitted model as a TPOINT-style term list
 // (tpointterms.h; docs/formats.md, "TPOINT term export").
 #include "tpointterms.h"
 
@@ -21,12 +21,26 @@ struct Map {
     double sign;    // TPOINT value = sign * pm coefficient
 };
 
-// From the first-order forms (tpointterms.h): IH = -c', ID = e', NP = d,
-// CH = -i, MA = -a, ME = b, TF = tube flexure, TX = cot(el) term.
-const Map kMap[PMTP_MAX_NAMED] = {
-    {"IH", PM_BASE_C, -1, -1.0}, {"ID", PM_BASE_E, -1, 1.0}, {"NP", PM_BASE_D, -1, 1.0},
-    {"CH", PM_BASE_I, -1, -1.0}, {"MA", PM_BASE_A, -1, -1.0}, {"ME", PM_BASE_B, -1, 1.0},
-    {"TF", 0, 1, 1.0},           {"TX", 0, 0, 1.0}};
+// From the first-order forms (tpointterms.h): true = raw + correction.
+// Equatorial: IH = c', ID = -e', NP = -d, CH = i, MA = a, ME = -b.
+const Map kEquatorial[PMTP_MAX_NAMED] = {
+    {"IH", PM_BASE_C, -1, 1.0}, {"ID", PM_BASE_E, -1, -1.0}, {"NP", PM_BASE_D, -1, -1.0},
+    {"CH", PM_BASE_I, -1, 1.0}, {"MA", PM_BASE_A, -1, 1.0},  {"ME", PM_BASE_B, -1, -1.0},
+    {"TF", 0, 1, -1.0},         {"TX", 0, 0, -1.0}};
+
+// Alt-az, TPOINT's azimuth from south through east: IA = c', IE = -e',
+// CA = i, NPAE = -d, AN = b, AW = a.
+const Map kAltaz[PMTP_MAX_NAMED] = {
+    {"IA", PM_BASE_C, -1, 1.0}, {"IE", PM_BASE_E, -1, -1.0},  {"CA", PM_BASE_I, -1, 1.0},
+    {"NPAE", PM_BASE_D, -1, -1.0}, {"AN", PM_BASE_B, -1, 1.0}, {"AW", PM_BASE_A, -1, 1.0},
+    {"TF", 0, 1, -1.0},         {"TX", 0, 0, -1.0}};
+
+const Map *map_of(const pm_model *m)
+{
+    if (m->mount == PM_MOUNT_EQUATORIAL) return kEquatorial;
+    if (m->mount == PM_MOUNT_ALTAZ) return kAltaz;
+    return nullptr;
+}
 
 // Index of the term a map entry names, -1 if the model has none.
 int find(const pm_model *m, const Map &e)
@@ -40,13 +54,34 @@ int find(const pm_model *m, const Map &e)
     return -1;
 }
 
+// The '!' lines at the top of the file: the convention of the values.
+const char *convention(const pm_model *m)
+{
+    if (m->mount == PM_MOUNT_ALTAZ)
+        return "! Values in arcsec; TPOINT corrections from the raw to the true position,\n"
+               "! true = raw + (dA, dE), A, E the raw azimuth and elevation, A from SOUTH\n"
+               "! through east (TPOINT's convention; A = 180 deg - pmfit's azimuth):\n"
+               "!   dA = -IA - CA sec E - NPAE tan E + AN sin A tan E - AW cos A tan E\n"
+               "!   dE =  IE + AN cos A + AW sin A - TF cos E - TX cot E\n"
+               "! Positive TF, TX: the telescope points below where the encoders say (droop).\n";
+    return "! Values in arcsec; TPOINT corrections from the raw to the true position,\n"
+           "! true = raw + (dh, dd), h, d the raw hour angle (west positive) and dec:\n"
+           "!   dh = IH + CH sec d + NP tan d - MA cos h tan d + ME sin h tan d\n"
+           "!        + (TF + TX / sin el) cos phi sin h sec d\n"
+           "!   dd = ID + MA sin h + ME cos h + (TF + TX / sin el) (cos phi cos h sin d - sin phi cos d)\n"
+           "! Positive TF, TX: the telescope points below where the encoders say (droop).\n";
+}
+
 }  // namespace
 
 extern "C" int pmtp_terms(const pm_model *m, const double *err_rad, pmtp_term *named, int *n_named)
 {
-    if (!m || !named || !n_named || m->mount != PM_MOUNT_EQUATORIAL) return -1;
+    if (!m || !named || !n_named) return -1;
+    const Map *map = map_of(m);
+    if (!map) return -1;
     int n = 0;
-    for (const Map &e : kMap) {
+    for (int j = 0; j < PMTP_MAX_NAMED; ++j) {
+        const Map &e = map[j];
         int i = find(m, e);
         if (i < 0) continue;
         pmtp_term &t = named[n++];
@@ -71,19 +106,14 @@ extern "C" int pmtp_write(const char *path, const pm_model *m, const double *err
     int n = 0;
     if (pmtp_terms(m, err_rad, named, &n) != 0) {
         if (err && errlen)
-            std::snprintf(err, errlen, "%s: TPOINT terms are written for equatorial models only "
-                                       "(TPOINT's alt-az terms IA IE CA NPAE AN AW are not "
-                                       "exported; docs/formats.md)",
-                          path);
+            std::snprintf(err, errlen, "%s: TPOINT terms are written for equatorial and alt-az "
+                                       "models only (mount type %d; docs/formats.md)",
+                          path, m->mount);
         return -1;
     }
     std::string text =
-        "! TPOINT-style term list written by pmfit (docs/formats.md, \"TPOINT term export\").\n"
-        "! Values in arcsec; true = raw + (dh, dd) with h, d the raw hour angle and dec:\n"
-        "!   dh = -IH - CH sec d - NP tan d + MA cos h tan d - ME sin h tan d\n"
-        "!        - (TF + TX / sin el) cos phi sin h sec d\n"
-        "!   dd = -ID - MA sin h - ME cos h - (TF + TX / sin el) (cos phi cos h sin d - sin phi cos d)\n"
-        "! Check the signs against your TPOINT's own term definitions (docs/formats.md).\n";
+        "! TPOINT-style term list written by pmfit (docs/formats.md, \"TPOINT term export\").\n";
+    text += convention(m);
     std::string cap = caption ? caption : "pmfit model";
     for (char &c : cap)
         if (c == '\n' || c == '\r') c = ' ';
