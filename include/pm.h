@@ -72,19 +72,26 @@ extern "C" {
 /* Packed symmetric matrix of n x n: n(n+1)/2 doubles. */
 #define PM_PACKED(n) ((n) * ((n) + 1) / 2)
 
-/* Hard iteration bounds of pm_model_invert (see its Notes). */
-#define PM_INVERT_MAX_FIXED 8
-#define PM_INVERT_MAX_NEWTON 8
+/* Hard iteration bounds of pm_model_invert (see its Notes 1 and 2), in
+** model evaluations (each about one pm_model_apply, the Jacobian
+** included): the closed form's fixed point on one branch, the Newton
+** iteration that takes over where it does not converge, the points of the
+** mount's pole's edge the pole rescue ranks, the Newton runs it makes from
+** the best of them and their length. */
+#define PM_INVERT_MAX_FIXED 4
+#define PM_INVERT_MAX_NEWTON 9
 #define PM_INVERT_POLE_STARTS 8
-/* Worst-case model evaluations per call, from the bounds above (each
-** evaluation is about one pm_model_apply): pm_model_invert_near (131),
-** pm_model_invert (2,341).  pm_model_apply makes exactly one.  tests/check_bounded.c counts them on adversarial
-** inputs. */
-#define PM_INVERT_NEAR_MAX_EVALS \
-    (PM_INVERT_MAX_FIXED + 3 + 15 * PM_INVERT_MAX_NEWTON)
+#define PM_INVERT_POLE_RUNS 2
+#define PM_INVERT_POLE_NEWTON 16
+/* Worst-case model evaluations per call, whatever the inputs:
+** pm_model_invert_near one branch, fixed point then Newton (13);
+** pm_model_invert two branches, then the pole rescue (66).
+** pm_model_apply makes exactly one.  tests/check_bounded.c counts them on
+** adversarial inputs. */
+#define PM_INVERT_NEAR_MAX_EVALS (PM_INVERT_MAX_FIXED + PM_INVERT_MAX_NEWTON)
 #define PM_INVERT_MAX_EVALS \
-    ((2 + 2 * PM_INVERT_POLE_STARTS) * \
-     (PM_INVERT_MAX_FIXED + 2 + 15 * PM_INVERT_MAX_NEWTON) + 1)
+    (2 * (PM_INVERT_MAX_FIXED + PM_INVERT_MAX_NEWTON) + PM_INVERT_POLE_STARTS + \
+     PM_INVERT_POLE_RUNS * PM_INVERT_POLE_NEWTON)
 
 /* Tracking bound: pm_model_invert_near for a target more than 0.5 deg from
 ** the mount's pole, started from the previous tick's solution (up to 0.1 s

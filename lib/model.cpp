@@ -99,17 +99,6 @@ double second_rate(const pm_model *m)
     return s;
 }
 
-/* Round-trip residual of encoder trig g against target q, measured as the
-** tangent offset (radians) of q seen from the model's position. */
-double miss(const pm_model *m, const Iso<double> &k, const pm_context *ctx,
-            const Trig<double> &g,
-            const V3<double> &q)
-{
-    V3<double> p = forward_vec<double>(m, k, g, ctx);
-    V3<double> c = cross<double>(p, q);
-    return m_atan2(m_sqrt(dot<double>(c, c)), dot<double>(p, q));
-}
-
 /* Which side of the mount's pole an encoder declination is on: the sign of
 ** cos(dec - e'). */
 int side_of(const pm_model *m, double d)
@@ -207,68 +196,166 @@ bool frame_angles(const pm_model *m, double t, double d, const double sh[4],
     return true;
 }
 
+/* The inverse's target: apparent (ha, dec), their sines and cosines, the
+** unit vector. */
+struct Aim {
+    double ha, dec;
+    double sh, ch, sd, cd;
+    V3<double> q;
+};
+
+/* A trial point of the Newton iteration (newton): the forward model's
+** unit vector p at (t, d) -- the operations of forward_vec --, its miss of
+** the target (the angle between them) and p's derivatives along the axes,
+** analytic: the rotations' and, through J = dD/dx (aniso_jac), the
+** displacement's.  One model evaluation. */
+struct NPoint {
+    double t, d, err;
+    V3<double> p, pt, pd;
+};
+
+void newton_point(const pm_model *m, const Iso<double> &k, const pm_context *ctx,
+                  const V3<double> &q, double t, double d, NPoint *o)
+{
+    const Trig<double> g = trig_of(t, d);
+    double a, b, J[4], stp, ctp, sdp, cdp;
+    aniso_jac(m, k, g, ctx, &a, &b, J);
+    shifted<double>(k, g, &stp, &ctp, &sdp, &cdp);
+    /* w = expmap(a, b) = (c, a s, b s), c and s functions of r^2 = a^2 +
+    ** b^2; c1, s1 their derivatives by r^2 */
+    const double r2 = a * a + b * b;
+    double s, c1, s1;
+    if (r2 < 1e-4) {
+        s = 1 - r2 * (1.0 / 6) + r2 * r2 * (1.0 / 120);
+        c1 = -0.5 + r2 * (1.0 / 12) - r2 * r2 * (1.0 / 240);
+        s1 = -1.0 / 6 + r2 * (1.0 / 60) - r2 * r2 * (1.0 / 1680);
+    } else {
+        const double r = m_sqrt(r2), c = m_cos(r);
+        s = m_sin(r) / r;
+        c1 = -0.5 * s;
+        s1 = (c - s) / (2 * r2);
+    }
+    const V3<double> wa = v3(2 * a * c1, s + 2 * a * a * s1, 2 * a * b * s1);
+    const V3<double> wb = v3(2 * b * c1, 2 * a * b * s1, s + 2 * b * b * s1);
+    V3<double> w = expmap<double>(a, b);
+    V3<double> wt = v3(wa.x * J[0] + wb.x * J[2], wa.y * J[0] + wb.y * J[2],
+                       wa.z * J[0] + wb.z * J[2]);
+    V3<double> wd = v3(wa.x * J[1] + wb.x * J[3], wa.y * J[1] + wb.y * J[3],
+                       wa.z * J[1] + wb.z * J[3]);
+    /* p = H Pt(t') X(d) Pd(d') T(i) w; the same rotations of the
+    ** derivatives (the frame before H: cc) */
+    w = rot_z<double>(stp, ctp, rot_x<double>(k.sd, k.cd, rot_d<double>(sdp, cdp,
+                                                  rot_z<double>(k.si, k.ci, w))));
+    wt = rot_z<double>(stp, ctp, rot_x<double>(k.sd, k.cd, rot_d<double>(sdp, cdp,
+                                                   rot_z<double>(k.si, k.ci, wt))));
+    wd = rot_z<double>(stp, ctp, rot_x<double>(k.sd, k.cd, rot_d<double>(sdp, cdp,
+                                                   rot_z<double>(k.si, k.ci, wd))));
+    /* the axes turn w themselves: d/dt' Pt(t') y = z x (Pt y); d/dd' Pd(d')
+    ** y = -y^ x (Pd y), i.e. -(Pt X y^) x w after the outer rotations */
+    const V3<double> ax = v3(-stp * k.cd, ctp * k.cd, k.sd);
+    wt = v3(wt.x - w.y, wt.y + w.x, wt.z);
+    const V3<double> cw = cross<double>(ax, w);
+    wd = v3(wd.x - cw.x, wd.y - cw.y, wd.z - cw.z);
+    o->t = t;
+    o->d = d;
+    o->p = mat_mul<double>(k.h, w);
+    o->pt = mat_mul<double>(k.h, wt);
+    o->pd = mat_mul<double>(k.h, wd);
+    const V3<double> x = cross<double>(o->p, q);
+    o->err = m_atan2(m_sqrt(dot<double>(x, x)), dot<double>(o->p, q));
+}
+
+#ifndef NEWTON_MAX_STEP
+#define NEWTON_MAX_STEP 1.0
+#endif
 /* Damped Newton iteration on the forward model, in a frame fixed at the
-** target.  Used where the fixed point does not contract (close to the
-** mount's pole).  x = (t, d) encoder angles, updated in place.  With
+** target, with the analytic Jacobian (newton_point: one evaluation per
+** trial point, the Jacobian included).  Used where the closed form's
+** fixed point does not contract (close to the mount's pole) and to check
+** returned angles.  x = (t, d) encoder angles, updated in place.  At most
+** PM_INVERT_MAX_NEWTON evaluations (trial points), the first at x; a trial
+** point that does not reduce the miss shortens the step to a quarter.  With
 ** lock = +1/-1 a trial point beyond the pole from that side is moved back
 ** onto the pole's edge (projected steps: the nearest point on one side).
 ** Trial points are kept on the turn the result is returned on (turn,
 ** from turn_of), since periodic terms of non-integer G read the raw
 ** angles and jump between turns. */
 pm_status newton(const pm_model *m, const Iso<double> &k, const pm_context *ctx,
-                 const V3<double> &q, double tq, double dq, const double *turn,
-                 double *t, double *d, double *err, int lock = 0)
+                 const Aim &a, const double *turn, double *t, double *d, double *err,
+                 int lock, int budget, const NPoint *first = 0)
 {
     /* frame at the target: e1 along increasing axis 1, e2 along axis 2 */
-    double st = m_sin(tq), ct = m_cos(tq), sd = m_sin(dq), cd = m_cos(dq);
-    V3<double> e1 = v3(-st, ct, 0.0);
-    V3<double> e2 = v3(-sd * ct, -sd * st, cd);
-    const double h = 1e-7;
-    double best = miss(m, k, ctx, trig_of(*t, *d), q);
-    for (int it = 0; it < PM_INVERT_MAX_NEWTON && best > PM_INVERT_TOL; it++) {
-        V3<double> f0 = forward_vec<double>(m, k, trig_of(*t, *d), ctx);
-        V3<double> ft = forward_vec<double>(m, k, trig_of(*t + h, *d), ctx);
-        V3<double> fd = forward_vec<double>(m, k, trig_of(*t, *d + h), ctx);
-        double F1 = dot(q, e1) - dot(f0, e1), F2 = dot(q, e2) - dot(f0, e2);
-        double a = (dot(ft, e1) - dot(f0, e1)) / h;
-        double b = (dot(fd, e1) - dot(f0, e1)) / h;
-        double c = (dot(ft, e2) - dot(f0, e2)) / h;
-        double dd = (dot(fd, e2) - dot(f0, e2)) / h;
-        /* Levenberg-damped 2x2 solve of [a b; c dd] x = F */
-        double jtj00 = a * a + c * c, jtj01 = a * b + c * dd,
-               jtj11 = b * b + dd * dd;
-        double g0 = a * F1 + c * F2, g1 = b * F1 + dd * F2;
-        double mu = 1e-12 * (jtj00 + jtj11);
-        double lam = 1.0;
-        bool improved = false;
-        for (int tries = 0; tries < 12 && !improved; tries++) {
-            double A = jtj00 + mu, B = jtj01, D = jtj11 + mu;
-            double det = A * D - B * B;
-            if (!(det > 0))
-                break;
-            double x0 = (D * g0 - B * g1) / det, x1 = (A * g1 - B * g0) / det;
-            double nt = *t + lam * x0, nd = *d + lam * x1;
-            if (lock && side_of(m, nd) != lock) {
-                /* back onto the edge: dec - e' = +-90 deg on the locked side */
-                double pole = m_sin(nd - m->coef[4]) >= 0 ? PI / 2 : -PI / 2;
-                nd = pole + m->coef[4] - (pole > 0 ? 1 : -1) * lock * 1e-12;
-            }
-            finish_angles(turn, &nt, &nd);
-            double e = miss(m, k, ctx, trig_of(nt, nd), q);
-            if (e < best) {
-                best = e;
-                *t = nt;
-                *d = nd;
-                improved = true;
-            } else {
-                lam *= 0.25;
-            }
-        }
-        if (!improved)
-            break;
+    const V3<double> e1 = v3(-a.sh, a.ch, 0.0);
+    const V3<double> e2 = v3(-a.sd * a.ch, -a.sd * a.sh, a.cd);
+    NPoint cur, trial;
+    int evals = 0;
+    if (first) {
+        cur = *first;
+    } else {
+        newton_point(m, k, ctx, a.q, *t, *d, &cur);
+        evals = 1;
     }
-    *err = best;
-    return best <= PM_INVERT_TOL ? PM_OK : PM_WARN_NOT_CONVERGED;
+    double lam = 1, edge_t = 0, edge_cp = 0;
+    bool have_edge = false;
+    while (cur.err > PM_INVERT_TOL && evals < budget) {
+        /* F = (e1 . p, e2 . p) -> 0; M = dF/dx; Levenberg-damped 2x2 solve
+        ** of M x = -F */
+        const double F1 = dot(cur.p, e1), F2 = dot(cur.p, e2);
+        const double A = dot(cur.pt, e1), B = dot(cur.pd, e1);
+        const double C = dot(cur.pt, e2), D = dot(cur.pd, e2);
+        const double j00 = A * A + C * C, j01 = A * B + C * D, j11 = B * B + D * D;
+        const double g0 = -(A * F1 + C * F2), g1 = -(B * F1 + D * F2);
+        const double mu = 1e-12 * (j00 + j11);
+        const double det = (j00 + mu) * (j11 + mu) - j01 * j01;
+        if (!(det > 0))
+            break;
+        double x0 = ((j11 + mu) * g0 - j01 * g1) / det;
+        double x1 = ((j00 + mu) * g1 - j01 * g0) / det;
+        /* a trust region: the linear model holds over a fraction of a
+        ** radian at most (near the mount's pole, where the hour angle is
+        ** ill-determined, over much less) */
+        const double big = m_fabs(x0) > 4 * m_fabs(x1) ? m_fabs(x0) : 4 * m_fabs(x1);
+        if (big > NEWTON_MAX_STEP) {
+            x0 *= NEWTON_MAX_STEP / big;
+            x1 *= NEWTON_MAX_STEP / big;
+        }
+        double nt = cur.t + lam * x0, nd = cur.d + lam * x1;
+        if (lock && side_of(m, nd) != lock) {
+            /* back onto the edge: dec - e' = +-90 deg on the locked side,
+            ** and the step along the edge (the hour angle's own
+            ** Gauss-Newton step: the nearest point of the edge where the
+            ** target is out of reach) */
+            double pole = m_sin(nd - m->coef[4]) >= 0 ? PI / 2 : -PI / 2;
+            nd = pole + m->coef[4] - (pole > 0 ? 1 : -1) * lock * 1e-12;
+            double x0e = g0 / (j00 + mu);
+            /* along the edge, where the target is out of reach, the
+            ** nearest point is where p . q peaks: the secant step on its
+            ** derivative p_t . q once two points of the edge are known
+            ** (Gauss-Newton alone converges slowly there) */
+            const double cp = dot(cur.pt, a.q);
+            if (have_edge && cur.t != edge_t && cp != edge_cp)
+                x0e = -cp * (cur.t - edge_t) / (cp - edge_cp);
+            edge_t = cur.t;
+            edge_cp = cp;
+            have_edge = true;
+            if (m_fabs(x0e) > NEWTON_MAX_STEP)
+                x0e = x0e > 0 ? NEWTON_MAX_STEP : -NEWTON_MAX_STEP;
+            nt = cur.t + lam * x0e;
+        }
+        finish_angles(turn, &nt, &nd);
+        newton_point(m, k, ctx, a.q, nt, nd, &trial);
+        evals++;
+        if (trial.err < cur.err) {
+            cur = trial;
+            lam = 1;
+        } else {
+            lam *= 0.25;
+        }
+    }
+    *t = cur.t;
+    *d = cur.d;
+    *err = cur.err;
+    return cur.err <= PM_INVERT_TOL ? PM_OK : PM_WARN_NOT_CONVERGED;
 }
 
 /* Does an evaluation of m read the raw axis angles, not only their sines
@@ -291,14 +378,6 @@ int side_at(const Iso<double> &k, const Trig<double> &g)
     shifted<double>(k, g, &stp, &ctp, &sdp, &cdp);
     return cdp >= 0 ? 1 : -1;
 }
-
-/* The inverse's target: apparent (ha, dec), their sines and cosines, the
-** unit vector. */
-struct Aim {
-    double ha, dec;
-    double sh, ch, sd, cd;
-    V3<double> q;
-};
 
 /* Angle of the unit pair (s, c) near the angle a0 whose sine and cosine
 ** are (s0, c0): a - a0 = asin(sin(a - a0)) with cos(a - a0) > 0, by its
@@ -349,36 +428,6 @@ void on_turn(const pm_model *m, const Iso<double> &k, const Aim &a, Trig<double>
     g->t = ref_t + wrap_pi(t - ref_t);
     g->d = ref_d + wrap_pi(d - ref_d);
     g->have_angles = true;
-}
-
-/* The displacement D at g, bit for bit as aniso computes it, and its
-** Jacobian J = dD/d(t, d) (J[0] = d dt/dt, J[1] = d dt/dd, J[2] = d dd/dt,
-** J[3] = d dd/dd) from the harmonic terms and the AUX terms (any other
-** added term is left out of J: the model's lip2 is then infinite and J
-** serves the Newton step only).  One model evaluation. */
-void aniso_jac(const pm_model *m, const Iso<double> &k, const Trig<double> &g,
-               const pm_context *ctx, double *dt, double *dd, double J[4])
-{
-    PM_EVAL_PROBE();
-    double S[6], St[6], Sd[6];
-    sh_sums_jac<double>(m->order, g, m->dense, S, St, Sd);
-    aniso_of_sums<double>(m, k, g, ctx, S, dt, dd, 0);
-    /* the AUX terms: constant factors of their base vectors */
-    for (int i = m->n_base; i < m->n_terms; i++)
-        if (m->term[i].kind == PM_TERM_AUX && m->term[i].side == 0)
-            S[m->term[i].k - 1] +=
-                m->coef[i] * (aux_input(ctx, m->term[i].aux) - m->term[i].param);
-    double stp, ctp, sdp, cdp;
-    shifted<double>(k, g, &stp, &ctp, &sdp, &cdp);
-    /* dt = cd S2 + S5 - sdp ctp S0 - sdp stp S1 - sd S3, dd = stp S0 - S4 -
-    ** ctp S1 (aniso_of_sums); d/dt turns (stp, ctp), d/dd (sd, cd) and
-    ** (sdp, cdp) */
-    J[0] = g.cd * St[2] + St[5] - sdp * (ctp * St[0] - stp * S[0]) -
-           sdp * (stp * St[1] + ctp * S[1]) - g.sd * St[3];
-    J[1] = -g.sd * S[2] + g.cd * Sd[2] + Sd[5] - cdp * (ctp * S[0] + stp * S[1]) -
-           sdp * (ctp * Sd[0] + stp * Sd[1]) - g.cd * S[3] - g.sd * Sd[3];
-    J[2] = ctp * S[0] + stp * St[0] - St[4] + stp * S[1] - ctp * St[1];
-    J[3] = stp * Sd[0] - Sd[4] - ctp * Sd[1];
 }
 
 /* The step from trig b to trig a, when both angles are within 0.01 rad:
@@ -460,10 +509,11 @@ inline bool newton_prep(const Iso<double> &k, const Trig<double> &g, double a, d
 
 /* Solve on one branch of the closed form (side = +1/-1), or from the start
 ** position's branch, with the angles on the turn the result is returned
-** on (turn_of).  Returns the status and (t, d). */
+** on (turn_of).  Returns the status, (t, d) and the miss at (t, d) (0 for
+** PM_OK: below PM_INVERT_TOL). */
 pm_status solve_branch(const pm_model *m, const Iso<double> &k,
                        const pm_context *ctx, const Aim &a, int side, const double *start,
-                       const double *turn, double *t_out, double *d_out)
+                       const double *turn, double *t_out, double *d_out, double *err_out)
 {
     /* Periodic terms of non-integer G read the raw angle itself, not only
     ** its sine and cosine: iterate with the angles on the returned turn. */
@@ -634,14 +684,15 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
             converged = false;
     }
     pm_status result = PM_OK;
+    double err = 0;
     if (!converged || !reachable) {
-        double err;
-        result = newton(m, k, ctx, a.q, a.ha, a.dec, turn, &t, &d, &err);
+        result = newton(m, k, ctx, a, turn, &t, &d, &err, 0, PM_INVERT_MAX_NEWTON);
         if (result != PM_OK && !reachable)
             result = PM_WARN_UNREACHABLE;
     }
     *t_out = t;
     *d_out = d;
+    *err_out = err;
     return result;
 }
 
@@ -670,60 +721,74 @@ pm_status invert(const pm_model *m, const pm_context *ctx, double app_ha,
     sincos_d2(app_ha, app_dec, &a.sh, &a.ch, &a.sd, &a.cd);
     a.q = v3(a.cd * a.ch, a.cd * a.sh, a.sd);
     const V3<double> &q = a.q;
-    double turn[2], t, d;
+    double turn[2], t, d, err;
     turn_of(start, side, m->coef[4], turn);
-    pm_status result = solve_branch(m, k, ctx, a, side, start, turn, &t, &d);
+    pm_status result = solve_branch(m, k, ctx, a, side, start, turn, &t, &d, &err);
     if (!start && (result != PM_OK || side_of(m, d) != side)) {
         /* Within the anisotropic amplitude of the mount's pole the closed
         ** form's branches (sign of cos(dec - e' + displacement angle)) and
         ** the sides of the pole (sign of cos(dec - e')) differ: the other
         ** branch may hold the solution on the requested side. */
-        double t2, d2;
-        pm_status r2 = solve_branch(m, k, ctx, a, -side, 0, turn, &t2, &d2);
+        double t2, d2, err2;
+        pm_status r2 = solve_branch(m, k, ctx, a, -side, 0, turn, &t2, &d2, &err2);
         if (r2 == PM_OK && side_of(m, d2) == side) {
             result = r2;
             t = t2;
             d = d2;
+            err = err2;
         } else {
             /* Close to the mount's pole a solution on the requested side
             ** can lie between the pole and the fold, out of both branches'
-            ** reach: Newton from PM_INVERT_POLE_STARTS points on the pole's
-            ** edge of the requested side. */
+            ** reach: Newton from PM_INVERT_POLE_STARTS points on the edge
+            ** of the pole nearer the target (the sign of the target's
+            ** component along the polar axis, H^T q), on the requested
+            ** side.  (The other pole is at least 90 deg less the
+            ** isotropic and anisotropic amplitudes away.) */
             bool found = false;
-            /* unreachable: the nearest point on the requested side seen */
+            /* unreachable: the nearest point on the requested side seen
+            ** (the branches' misses: a point not PM_OK came from Newton,
+            ** which measured it) */
             double best_err = 1e300, best_t = t, best_d = d;
-            if (side_of(m, d) == side)
-                best_err = miss(m, k, ctx, trig_of(t, d), q);
-            if (side_of(m, d2) == side) {
-                double e2 = miss(m, k, ctx, trig_of(t2, d2), q);
-                if (e2 < best_err) {
-                    best_err = e2;
-                    best_t = t2;
-                    best_d = d2;
-                }
+            if (side_of(m, d) == side && result != PM_OK)
+                best_err = err;
+            if (side_of(m, d2) == side && r2 != PM_OK && err2 < best_err) {
+                best_err = err2;
+                best_t = t2;
+                best_d = d2;
             }
-            for (int j = 0; j < PM_INVERT_POLE_STARTS && !found; j++) {
+            const double qz = k.h[2] * q.x + k.h[5] * q.y + k.h[8] * q.z;
+            const int hemi = qz >= 0 ? 1 : -1;
+            NPoint edge[PM_INVERT_POLE_STARTS];
+            for (int j = 0; j < PM_INVERT_POLE_STARTS; j++) {
                 double tj = -PI + 2 * PI * (j + 0.5) / PM_INVERT_POLE_STARTS;
-                for (int hemi = -1; hemi <= 1 && !found; hemi += 2) {
-                    /* dec - e' = +-(pi/2 - 1e-9) on the normal side,
-                    ** +-(pi/2 + 1e-9) beyond the pole */
-                    double dj = hemi * (PI / 2 - side * 1e-9) + m->coef[4];
-                    double err;
-                    finish_angles(turn, &tj, &dj);
-                    pm_status sj =
-                        newton(m, k, ctx, q, app_ha, app_dec, turn, &tj, &dj, &err, side);
-                    if (side_of(m, dj) != side)
-                        continue;
-                    if (sj == PM_OK) {
-                        t = tj;
-                        d = dj;
-                        result = PM_OK;
-                        found = true;
-                    } else if (err < best_err) {
-                        best_err = err;
-                        best_t = tj;
-                        best_d = dj;
-                    }
+                /* dec - e' = +-(pi/2 - 1e-9) on the normal side, +-(pi/2 +
+                ** 1e-9) beyond the pole */
+                double dj = hemi * (PI / 2 - side * 1e-9) + m->coef[4];
+                finish_angles(turn, &tj, &dj);
+                newton_point(m, k, ctx, a.q, tj, dj, &edge[j]);
+            }
+            for (int r = 0; r < PM_INVERT_POLE_RUNS && !found; r++) {
+                int jb = -1; /* the r-th best edge point: Newton from it */
+                for (int j = 0; j < PM_INVERT_POLE_STARTS; j++)
+                    if (edge[j].err >= 0 && (jb < 0 || edge[j].err < edge[jb].err))
+                        jb = j;
+                if (jb < 0)
+                    break;
+                double tj = edge[jb].t, dj = edge[jb].d, ej;
+                pm_status sj = newton(m, k, ctx, a, turn, &tj, &dj, &ej, side,
+                                      PM_INVERT_POLE_NEWTON, &edge[jb]);
+                edge[jb].err = -1; /* (used) */
+                if (side_of(m, dj) != side)
+                    continue;
+                if (sj == PM_OK) {
+                    t = tj;
+                    d = dj;
+                    result = PM_OK;
+                    found = true;
+                } else if (ej < best_err) {
+                    best_err = ej;
+                    best_t = tj;
+                    best_d = dj;
                 }
             }
             if (!found) {
@@ -732,16 +797,16 @@ pm_status invert(const pm_model *m, const pm_context *ctx, double app_ha,
                 if (best_err < 1e300) {
                     t = best_t;
                     d = best_d;
+                    err = best_err;
                 }
             }
         }
     }
     /* A warning returns the best position found: the model must still be
     ** finite there (coefficients or context values can overflow it, and
-    ** then no position is any good).  One more evaluation, counted in
-    ** PM_INVERT_MAX_EVALS; PM_OK already passed the round trip. */
-    if (!finite(t) || !finite(d) ||
-        (result != PM_OK && !finite(miss(m, k, ctx, trig_of(t, d), q))))
+    ** then no position is any good): its miss, measured where it was
+    ** found, is finite.  PM_OK already passed the round trip. */
+    if (!finite(t) || !finite(d) || (result != PM_OK && !finite(err)))
         return PM_ERR_NONFINITE; /* outputs untouched */
     finish_angles(turn, &t, &d);
     *enc_ha = t;

@@ -1056,6 +1056,157 @@ inline V3<T> forward_vec(const pm_model *m, const Iso<T> &k, const Trig<T> &g,
     return mat_mul<T>(k.h, w);
 }
 
+/* The derivatives (ft, fd) along the axes of an added term's factor f at g
+** (term_factor; f itself in *f): harmonic, periodic, sectoral and AUX
+** terms (AUX: constant). */
+inline void factor_jac(const pm_term &t, const Trig<double> &g, const pm_context *ctx, double *f,
+                double *ft, double *fd)
+{
+    *f = *ft = *fd = 0;
+    switch (t.kind) {
+    case PM_TERM_SH: {
+        double Y[PM_N_HARM(PM_MAX_L)], Yt[PM_N_HARM(PM_MAX_L)], Yd[PM_N_HARM(PM_MAX_L)];
+        const int j = t.l * t.l + t.l + t.m;
+        const double nl = norm_lm(t.l, t.m);
+        if (t.l == 0) {
+            *f = nl;
+            return;
+        }
+        harmonics_jac_n<double, 0>(t.l, g, Y, Yt, Yd);
+        *f = Y[j] * nl;
+        *ft = Yt[j] * nl;
+        *fd = Yd[j] * nl;
+        return;
+    }
+    case PM_TERM_FOURIER: {
+        const double G = t.param, a = G * (t.l == 1 ? g.t : g.d);
+        const double sa = m_sin(a), ca = m_cos(a);
+        *f = t.m ? sa : ca;
+        const double df = G * (t.m ? ca : -sa);
+        if (t.l == 1)
+            *ft = df;
+        else
+            *fd = df;
+        return;
+    }
+    case PM_TERM_SECTORAL: {
+        const long G = (long)t.param;
+        const double a = (double)G * g.t, sa = m_sin(a), ca = m_cos(a);
+        const double p1 = ipow<double>(g.cd, G - 1), p = p1 * g.cd;
+        const double tr = t.m ? sa : ca;
+        *f = p * tr;
+        *ft = p * (double)G * (t.m ? ca : -sa);
+        *fd = (double)G * p1 * -g.sd * tr;
+        return;
+    }
+    case PM_TERM_AUX:
+        *f = aux_input(ctx, t.aux) - t.param;
+        return;
+    default:
+        return;
+    }
+}
+
+/* The zenith in the transported frame at g (site_of's (zx, zy, zz)) and
+** its derivatives along the axes: M^T Z with M = H Pt(t') X Pd(d') T(i);
+** d/dt' of Pt^T y is (y'_y, -y'_x, 0) and d/dd' of Pd^T y is (y'_z, 0,
+** -y'_x), y' the rotated vector. */
+inline void zenith_jac(const pm_model *m, const Iso<double> &k, const Trig<double> &g, V3<double> *z,
+                V3<double> *zt, V3<double> *zd)
+{
+    double stp, ctp, sdp, cdp;
+    shifted<double>(k, g, &stp, &ctp, &sdp, &cdp);
+    V3<double> y = m->mount == PM_MOUNT_ALTAZ
+                       ? v3(0.0, 0.0, 1.0)
+                       : v3(m_cos(m->latitude), 0.0, m_sin(m->latitude));
+    y = rot_zt<double>(stp, ctp, mat_tmul<double>(k.h, y));
+    V3<double> yt = v3(y.y, -y.x, 0.0);
+    y = rot_dt<double>(sdp, cdp, rot_xt<double>(k.sd, k.cd, y));
+    yt = rot_dt<double>(sdp, cdp, rot_xt<double>(k.sd, k.cd, yt));
+    V3<double> yd = v3(y.z, 0.0, -y.x);
+    *z = rot_zt<double>(k.si, k.ci, y);
+    *zt = rot_zt<double>(k.si, k.ci, yt);
+    *zd = rot_zt<double>(k.si, k.ci, yd);
+}
+
+/* The displacement D at g, bit for bit as aniso computes it, and its
+** Jacobian J = dD/d(t, d) (J[0] = d dt/dt, J[1] = d dt/dd, J[2] = d dd/dt,
+** J[3] = d dd/dd), analytic for every term kind (a term of one pier side
+** counts on the side g is on, its jump at the pole's edge aside).  One
+** model evaluation. */
+inline void aniso_jac(const pm_model *m, const Iso<double> &k, const Trig<double> &g0,
+               const pm_context *ctx, double *dt, double *dd, double J[4])
+{
+    PM_EVAL_PROBE();
+    double S[6], St[6], Sd[6];
+    sh_sums_jac<double>(m->order, g0, m->dense, S, St, Sd);
+    aniso_of_sums<double>(m, k, g0, ctx, S, dt, dd, 0);
+    double zj[4] = {0, 0, 0, 0}; /* the zenith terms' part of J */
+    if (m->n_terms > m->n_base) {
+        /* the added terms: factor f times base vector k, so (f, ft, fd)
+        ** join the harmonic sums of k (the J below differentiates the base
+        ** vectors); the zenith terms apart */
+        Trig<double> g = g0;
+        if (!g.have_angles) {
+            g.t = m_atan2(g.st, g.ct);
+            g.d = m_atan2(g.sd, g.cd);
+            g.have_angles = true;
+        }
+        Site<double> s = site_of<double>(m, k, g, ctx);
+        V3<double> z, zt, zd;
+        bool have_z = false;
+        for (int i = m->n_base; i < m->n_terms; i++) {
+            const pm_term &t = m->term[i];
+            if (t.side && t.side != s.side)
+                continue;
+            if (t.kind == PM_TERM_ZENITH) {
+                if (!have_z) {
+                    zenith_jac(m, k, g, &z, &zt, &zd);
+                    have_z = true;
+                }
+                double ut, ud, vt, vd;
+                if (t.l == 0) { /* (zy, zz) / max(zx, 0.01) */
+                    const bool lo = !(z.x > 0.01);
+                    const double sel = lo ? 0.01 : z.x;
+                    const double u = z.y / sel, v = z.z / sel;
+                    const double st_ = lo ? 0.0 : zt.x, sd_ = lo ? 0.0 : zd.x;
+                    ut = (zt.y - u * st_) / sel;
+                    ud = (zd.y - u * sd_) / sel;
+                    vt = (zt.z - v * st_) / sel;
+                    vd = (zd.z - v * sd_) / sel;
+                } else {
+                    ut = zt.y;
+                    ud = zd.y;
+                    vt = zt.z;
+                    vd = zd.z;
+                }
+                zj[0] += m->coef[i] * ut;
+                zj[1] += m->coef[i] * ud;
+                zj[2] += m->coef[i] * vt;
+                zj[3] += m->coef[i] * vd;
+                continue;
+            }
+            double f, ft, fd;
+            factor_jac(t, g, ctx, &f, &ft, &fd);
+            S[t.k - 1] += m->coef[i] * f;
+            St[t.k - 1] += m->coef[i] * ft;
+            Sd[t.k - 1] += m->coef[i] * fd;
+        }
+    }
+    double stp, ctp, sdp, cdp;
+    shifted<double>(k, g0, &stp, &ctp, &sdp, &cdp);
+    const Trig<double> &g = g0;
+    /* dt = cd S2 + S5 - sdp ctp S0 - sdp stp S1 - sd S3, dd = stp S0 - S4 -
+    ** ctp S1 (aniso_of_sums); d/dt turns (stp, ctp), d/dd (sd, cd) and
+    ** (sdp, cdp) */
+    J[0] = g.cd * St[2] + St[5] - sdp * (ctp * St[0] - stp * S[0]) -
+           sdp * (stp * St[1] + ctp * S[1]) - g.sd * St[3] + zj[0];
+    J[1] = -g.sd * S[2] + g.cd * Sd[2] + Sd[5] - cdp * (ctp * S[0] + stp * S[1]) -
+           sdp * (ctp * Sd[0] + stp * Sd[1]) - g.cd * S[3] - g.sd * Sd[3] + zj[1];
+    J[2] = ctp * S[0] + stp * St[0] - St[4] + stp * S[1] - ctp * St[1] + zj[2];
+    J[3] = stp * Sd[0] - Sd[4] - ctp * Sd[1] + zj[3];
+}
+
 /* sin and cos of one angle: sincos_d for doubles, libm for floats. */
 inline void sin_cos(double x, double *s, double *c) { sincos_d(x, s, c); }
 inline void sin_cos(float x, float *s, float *c)
