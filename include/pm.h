@@ -442,21 +442,39 @@ pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
 **     |F_D| ~ 1/cos of the distance, with 10' terms): hence
 **     PM_INVERT_TRACK_MAX_EVALS = 8 (measured worst 4 with ticks up to
 **     0.1 s, 6 with 1 s ticks within a degree of the pole).  At most
-**     PM_INVERT_MAX_FIXED such steps; where they do not contract (within
-**     about the anisotropic amplitude of the mount's pole) damped Newton
-**     steps on the full forward model take over (at most
-**     PM_INVERT_MAX_NEWTON, each with at most 12 step halvings).  The
-**     round-trip error |apply(invert(x)) - x| is below PM_INVERT_TOL on
-**     return with PM_OK.
+**     PM_INVERT_MAX_FIXED (4) such steps: where they have not converged by
+**     then (within about the anisotropic amplitude of the mount's pole,
+**     where the closed form's branch is ill-conditioned, or for
+**     displacements of degrees) Newton steps on the full forward model
+**     take over from the best point: the residual is the tangent offset
+**     of the model's position from the target, its Jacobian analytic (the
+**     rotations' derivatives and J, every term kind differentiated), so
+**     each trial point costs one evaluation; a trial that does not reduce
+**     the miss shortens the step to a quarter, and steps are capped at 1
+**     rad (a trust region: near the pole the hour angle is ill-determined
+**     and the linear model holds over little).  Newton converges
+**     quadratically from the points the fixed point hands it; at most
+**     PM_INVERT_MAX_NEWTON (9) trial points.  So pm_model_invert_near
+**     needs at most PM_INVERT_NEAR_MAX_EVALS = PM_INVERT_MAX_FIXED +
+**     PM_INVERT_MAX_NEWTON = 13 evaluations, whatever the inputs (the
+**     misses of the points it returns are those measured on the way: no
+**     evaluation to check them).  The round-trip error
+**     |apply(invert(x)) - x| is below PM_INVERT_TOL on return with PM_OK.
 **  2) Within a few arcminutes of the mount's pole the closed form's two
 **     branches need not match the two sides of the pole (the anisotropic
-**     terms fold the sky there), so the other branch is tried, then
-**     side-locked Newton runs from PM_INVERT_POLE_STARTS points on the
-**     pole's edge.  Hard bound, whatever the inputs: PM_INVERT_MAX_EVALS
-**     = (2 + 2 * PM_INVERT_POLE_STARTS) * (PM_INVERT_MAX_FIXED + 2 + 15 *
-**     PM_INVERT_MAX_NEWTON) + 1 model evaluations (2,341); elsewhere a
-**     few.  For tracking use pm_model_invert_near, which never needs the
-**     rescue (at most PM_INVERT_NEAR_MAX_EVALS, 131).
+**     terms fold the sky there), so pm_model_invert tries the other
+**     branch (fixed point and Newton again: 13 more), then the pole
+**     rescue: PM_INVERT_POLE_STARTS (8) points on the edge of the mount's
+**     pole nearer the target (the other pole is about 180 deg away), on
+**     the requested side, are evaluated (8) and Newton, locked to that
+**     side (a trial point beyond the pole is moved back onto its edge, and
+**     there the step is the secant of the hour angle along the edge, so
+**     that an unreachable target gets the nearest point), runs from the
+**     PM_INVERT_POLE_RUNS (2) best of them for PM_INVERT_POLE_NEWTON (16)
+**     trial points each (32).  Hard bound, whatever the inputs:
+**     PM_INVERT_MAX_EVALS = 2 x 13 + 8 + 2 x 16 = 66 model evaluations;
+**     elsewhere a few.  For tracking use pm_model_invert_near, which never
+**     needs the rescue (at most 13).
 **  3) PM_WARN_NOT_CONVERGED: a bound was reached; the best position found
 **     is returned.  PM_WARN_UNREACHABLE: no position on the requested side
 **     points at the target: it lies in the cap around the mount's pole
@@ -472,7 +490,8 @@ pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
 **     |i| or the polar axis's offset beyond 0.5 rad, or an anisotropic
 **     displacement that can reach 0.5 rad, where the closed form
 **     degenerates towards 90 deg), one more evaluation checks the round
-**     trip at the returned angles (Newton, within the bound of Note 2).
+**     trip at the returned angles (Newton, within the bounds of Notes 1
+**     and 2).
 **     So it does where a term restricted to one pier side (no pier side
 **     in ctx) sees the rounded angles on the other side of the pole's
 **     edge than the fixed point's last position: such a term jumps there,
@@ -500,7 +519,7 @@ pm_status pm_model_invert(const pm_model *m, const pm_context *ctx,
 **                                  tracking).  |start_ha|, |start_dec|
 **                                  at most PM_START_MAX, else
 **                                  PM_ERR_ARG.  At most
-**                                  PM_INVERT_NEAR_MAX_EVALS (131) model
+**                                  PM_INVERT_NEAR_MAX_EVALS (13) model
 **                                  evaluations, whatever the inputs.
 **  Other arguments, return values and notes as pm_model_invert.
 */
