@@ -17,6 +17,9 @@
 **                  tests/internal_shim.cpp); pm_model_invert's PM_OK round
 **                  trips within PM_INVERT_TOL through that long double
 **                  forward model
+**    the Jacobian  the inverse's analytic dD/d(ha, dec) (aniso_jac: every
+**                  term kind) against central differences of the long
+**                  double displacement
 */
 #include "tu_check.h"
 #include "testutil.h"
@@ -30,6 +33,10 @@ void pm_test_sincos_d(double x, double *s, double *c);
 void pm_test_sincos_d2(double x0, double x1, double *s0, double *c0, double *s1, double *c1);
 void pm_test_apply_ld(const pm_model *m, const pm_context *ctx, double t, double d,
                       long double *T, long double *D);
+void pm_test_aniso_ld(const pm_model *m, const pm_context *ctx, long double t, long double d,
+                      long double D[2]);
+void pm_test_aniso_jac(const pm_model *m, const pm_context *ctx, double t, double d,
+                       double D[2], double J[4]);
 
 /* |a - ref| in units of the last place of the double nearest ref. */
 static double ulp_err(double a, long double ref)
@@ -231,6 +238,107 @@ START_TEST(test_invert_vs_long_double)
 }
 END_TEST
 
+/* The inverse's Newton steps use the Jacobian J = dD/d(ha, dec) of the
+** anisotropic displacement, analytic (lib/pm_detail.hpp aniso_jac): against
+** central differences (steps 1e-4 and 5e-5 rad, Richardson-extrapolated)
+** of the displacement in long double,
+** for models of every order with every added term kind (periodic of
+** non-integer G, sectoral, both zenith terms, AUX, a harmonic term of one
+** pier side; the pier side given, as a jump is not differentiable).  The
+** differences' truncation is ~1e-17 of the fifth derivative; J agrees to
+** TOL_JAC_REL of its size plus TOL_JAC_ABS (rad/rad). */
+#define TOL_JAC_REL 1e-9
+#define TOL_JAC_ABS 1e-14
+START_TEST(test_aniso_jacobian)
+{
+    static pm_model m;
+    static const int kinds[6] = {PM_TERM_FOURIER, PM_TERM_SECTORAL, PM_TERM_ZENITH,
+                                 PM_TERM_ZENITH, PM_TERM_AUX, PM_TERM_SH};
+    tu_rng r;
+    pm_context c;
+    double worst = 0;
+    long n = 0;
+    int mi, j, i;
+    if (LDBL_MANT_DIG < 64)
+        return;
+    tu_seed(&r, 41);
+    memset(&c, 0, sizeof c);
+    c.temp_c = 12;
+    c.pier = 1;
+    for (mi = 0; mi < 40; mi++) {
+        ck_assert_int_eq(pm_model_init(&m, mi % 2 ? PM_MOUNT_EQUATORIAL : PM_MOUNT_ALTAZ,
+                                       1 + mi % PM_MAX_L), PM_OK);
+        m.latitude = 0.7;
+        for (i = 0; i < m.n_terms; i++)
+            m.coef[i] = (tu_uniform(&r) * 2 - 1) * (i < 6 ? 0.1 : 3e-3);
+        ck_assert_int_eq(pm_model_prepare(&m), PM_OK);
+        for (i = 0; i < 6; i++) {
+            pm_term t;
+            memset(&t, 0, sizeof t);
+            t.kind = (unsigned char)kinds[i];
+            t.k = (unsigned char)(1 + (i + mi) % 6);
+            t.m = (signed char)(mi % 2);
+            switch (t.kind) {
+            case PM_TERM_FOURIER:
+                t.l = (signed char)(1 + mi % 2);
+                t.param = 1.5 + 3 * tu_uniform(&r);
+                break;
+            case PM_TERM_SECTORAL: t.param = 1 + mi % 4; break;
+            case PM_TERM_ZENITH: t.l = (signed char)(i == 3); t.m = 0; break;
+            case PM_TERM_AUX: t.aux = PM_AUX_TEMP; t.param = 3; break;
+            default:
+                t.l = 1;
+                t.m = (signed char)(mi % 3 - 1);
+                t.side = 1;
+                break;
+            }
+            ck_assert_int_eq(pm_model_add_term(&m, &t, (tu_uniform(&r) * 2 - 1) * 2e-3, NULL),
+                             PM_OK);
+        }
+        for (j = 0; j < 200; j++) {
+            const long double h = 1e-4L;
+            double t = (tu_uniform(&r) * 2 - 1) * M_PI, d = (tu_uniform(&r) * 2 - 1) * 1.5;
+            double D[2], J[4];
+            long double P[2], M[2];
+            int ax, k;
+            /* the zenith terms' cot(el) grows fast toward the horizon:
+            ** positions 0.3 rad or more above it (at the encoder angles,
+            ** within the isotropic terms' 0.1 rad of the model's) */
+            double sel = m.mount == PM_MOUNT_ALTAZ
+                             ? sin(d)
+                             : sin(m.latitude) * sin(d) + cos(m.latitude) * cos(d) * cos(t);
+            if (sel < sin(0.3))
+                continue;
+            pm_test_aniso_jac(&m, &c, t, d, D, J);
+            for (ax = 0; ax < 2; ax++) {
+                long double P2[2], M2[2];
+                pm_test_aniso_ld(&m, &c, t + (ax == 0 ? h : 0), d + (ax == 1 ? h : 0), P);
+                pm_test_aniso_ld(&m, &c, t - (ax == 0 ? h : 0), d - (ax == 1 ? h : 0), M);
+                pm_test_aniso_ld(&m, &c, t + (ax == 0 ? h / 2 : 0), d + (ax == 1 ? h / 2 : 0),
+                                 P2);
+                pm_test_aniso_ld(&m, &c, t - (ax == 0 ? h / 2 : 0), d - (ax == 1 ? h / 2 : 0),
+                                 M2);
+                for (k = 0; k < 2; k++) {
+                    /* Richardson: the h^2 term of the central difference
+                    ** cancels */
+                    long double d1 = (P[k] - M[k]) / (2 * h), d2 = (P2[k] - M2[k]) / h;
+                    double fd = (double)((4 * d2 - d1) / 3), an = J[2 * k + ax];
+                    double e = fabs(fd - an) / (TOL_JAC_REL * fabs(an) + TOL_JAC_ABS);
+                    if (e > worst)
+                        worst = e;
+                    ck_assert_msg(e <= 1, "model %d at (%.17g, %.17g): J[%d] %.17g, differences "
+                                  "%.17g", mi, t, d, 2 * k + ax, an, fd);
+                }
+            }
+            n++;
+        }
+    }
+    printf("check_internal: the analytic Jacobian of the displacement at %ld positions: within "
+           "%.2g of its tolerance (%.0e relative + %.0e) of central differences\n", n, worst,
+           TOL_JAC_REL, TOL_JAC_ABS);
+}
+END_TEST
+
 static Suite *internal_suite(void)
 {
     Suite *s = suite_create("internal");
@@ -241,6 +349,7 @@ static Suite *internal_suite(void)
     tcase_add_test(tc, test_sincos_d2_same_bits);
     tcase_add_test(tc, test_apply_vs_long_double);
     tcase_add_test(tc, test_invert_vs_long_double);
+    tcase_add_test(tc, test_aniso_jacobian);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -44,10 +44,9 @@ void pm_test_sincos_d2(double x0, double x1, double *s0, double *c0, double *s1,
 
 /* The forward model of a prepared model at encoder (t, d), in long double:
 ** the apparent angles (T in (-pi, pi], D). */
-void pm_test_apply_ld(const pm_model *m, const pm_context *ctx, double t, double d,
-                      long double *T, long double *D)
+static void iso_ld(const pm_model *m, Iso<LD> *ko)
 {
-    Iso<LD> k;
+    Iso<LD> &k = *ko;
     LD a = m->coef[0], b = m->coef[1], th2 = a * a + b * b, th = m_sqrt(th2);
     LD A = th > 0 ? m_sin(th) / th : 1, B = th > 0 ? (1 - m_cos(th)) / th2 : 0.5L;
     LD K[9] = {0, 0, b, 0, 0, -a, -b, a, 0}, W[3] = {a, b, 0};
@@ -59,9 +58,34 @@ void pm_test_apply_ld(const pm_model *m, const pm_context *ctx, double t, double
     sin_cos((LD)m->coef[3], &k.sd, &k.cd);
     sin_cos((LD)m->coef[4], &k.se, &k.ce);
     sin_cos((LD)m->coef[5], &k.si, &k.ci);
+}
+
+void pm_test_apply_ld(const pm_model *m, const pm_context *ctx, double t, double d,
+                      long double *T, long double *D)
+{
+    Iso<LD> k;
+    iso_ld(m, &k);
     Trig<LD> g = trig_of<LD>(t, d);
     V3<LD> p = forward_vec<LD>(m, k, g, ctx);
     *T = m_atan2(p.y, p.x);
     *D = m_atan2(p.z, m_sqrt(p.x * p.x + p.y * p.y));
+}
+
+/* The anisotropic displacement D at encoder (t, d) in long double (the
+** model's constants recomputed, as pm_test_apply_ld). */
+void pm_test_aniso_ld(const pm_model *m, const pm_context *ctx, long double t, long double d,
+                      long double D[2])
+{
+    Iso<LD> k;
+    iso_ld(m, &k);
+    aniso<LD>(m, k, trig_of<LD>(t, d), ctx, &D[0], &D[1]);
+}
+
+/* The inverse's analytic Jacobian (aniso_jac, double): D and J = dD/d(t, d)
+** (J[0] = d Dt/dt, J[1] = d Dt/dd, J[2] = d Dd/dt, J[3] = d Dd/dd). */
+void pm_test_aniso_jac(const pm_model *m, const pm_context *ctx, double t, double d,
+                       double D[2], double J[4])
+{
+    aniso_jac(m, iso_of(m), trig_of<double>(t, d), ctx, &D[0], &D[1], J);
 }
 }
