@@ -214,7 +214,7 @@ struct NPoint {
     V3<double> p, pt, pd;
 };
 
-void newton_point(const pm_model *m, const Iso<double> &k, const pm_context *ctx,
+__attribute__((noinline)) void newton_point(const pm_model *m, const Iso<double> &k, const pm_context *ctx,
                   const V3<double> &q, double t, double d, NPoint *o)
 {
     const Trig<double> g = trig_of(t, d);
@@ -280,7 +280,7 @@ void newton_point(const pm_model *m, const Iso<double> &k, const pm_context *ctx
 ** Trial points are kept on the turn the result is returned on (turn,
 ** from turn_of), since periodic terms of non-integer G read the raw
 ** angles and jump between turns. */
-pm_status newton(const pm_model *m, const Iso<double> &k, const pm_context *ctx,
+__attribute__((noinline)) pm_status newton(const pm_model *m, const Iso<double> &k, const pm_context *ctx,
                  const Aim &a, const double *turn, double *t, double *d, double *err,
                  int lock, int budget, const NPoint *first = 0)
 {
@@ -696,6 +696,90 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
     return result;
 }
 
+/* The pole rescue of pm_model_invert (pm.h, Note 2), after both branches
+** failed to give a PM_OK point on the requested side: (t, d, err) the
+** first branch's point and status `result`, (t2, d2, err2) the second's
+** and its status r2; returns the status and the point in (t, d, err).
+** Kept out of line: its table of edge points would otherwise sit in every
+** inverse's stack frame. */
+__attribute__((noinline)) pm_status pole_rescue(const pm_model *m, const Iso<double> &k,
+                                                const pm_context *ctx, const Aim &a, int side,
+                                                const double *turn, pm_status result,
+                                                pm_status r2, double t2, double d2,
+                                                double err2, double *tp, double *dp,
+                                                double *errp)
+{
+    double t = *tp, d = *dp, err = *errp;
+    const V3<double> &q = a.q;
+    /* Close to the mount's pole a solution on the requested side
+    ** can lie between the pole and the fold, out of both branches'
+    ** reach: Newton from PM_INVERT_POLE_STARTS points on the edge
+    ** of the pole nearer the target (the sign of the target's
+    ** component along the polar axis, H^T q), on the requested
+    ** side.  (The other pole is at least 90 deg less the
+    ** isotropic and anisotropic amplitudes away.) */
+    bool found = false;
+    /* unreachable: the nearest point on the requested side seen
+    ** (the branches' misses: a point not PM_OK came from Newton,
+    ** which measured it) */
+    double best_err = 1e300, best_t = t, best_d = d;
+    if (side_of(m, d) == side && result != PM_OK)
+        best_err = err;
+    if (side_of(m, d2) == side && r2 != PM_OK && err2 < best_err) {
+        best_err = err2;
+        best_t = t2;
+        best_d = d2;
+    }
+    const double qz = k.h[2] * q.x + k.h[5] * q.y + k.h[8] * q.z;
+    const int hemi = qz >= 0 ? 1 : -1;
+    NPoint edge[PM_INVERT_POLE_STARTS];
+    for (int j = 0; j < PM_INVERT_POLE_STARTS; j++) {
+        double tj = -PI + 2 * PI * (j + 0.5) / PM_INVERT_POLE_STARTS;
+        /* dec - e' = +-(pi/2 - 1e-9) on the normal side, +-(pi/2 +
+        ** 1e-9) beyond the pole */
+        double dj = hemi * (PI / 2 - side * 1e-9) + m->coef[4];
+        finish_angles(turn, &tj, &dj);
+        newton_point(m, k, ctx, a.q, tj, dj, &edge[j]);
+    }
+    for (int r = 0; r < PM_INVERT_POLE_RUNS && !found; r++) {
+        int jb = -1; /* the r-th best edge point: Newton from it */
+        for (int j = 0; j < PM_INVERT_POLE_STARTS; j++)
+            if (edge[j].err >= 0 && (jb < 0 || edge[j].err < edge[jb].err))
+                jb = j;
+        if (jb < 0)
+            break;
+        double tj = edge[jb].t, dj = edge[jb].d, ej;
+        pm_status sj = newton(m, k, ctx, a, turn, &tj, &dj, &ej, side,
+                              PM_INVERT_POLE_NEWTON, &edge[jb]);
+        edge[jb].err = -1; /* (used) */
+        if (side_of(m, dj) != side)
+            continue;
+        if (sj == PM_OK) {
+            t = tj;
+            d = dj;
+            result = PM_OK;
+            found = true;
+        } else if (ej < best_err) {
+            best_err = ej;
+            best_t = tj;
+            best_d = dj;
+        }
+    }
+    if (!found) {
+        /* nothing on the requested side reaches the target */
+        result = PM_WARN_UNREACHABLE;
+        if (best_err < 1e300) {
+            t = best_t;
+            d = best_d;
+            err = best_err;
+        }
+    }
+    *tp = t;
+    *dp = d;
+    *errp = err;
+    return result;
+}
+
 /* Shared inverse: side = +1/-1, or use the start position. */
 pm_status invert(const pm_model *m, const pm_context *ctx, double app_ha,
                  double app_dec, int side, const double *start, double *enc_ha,
@@ -720,7 +804,6 @@ pm_status invert(const pm_model *m, const pm_context *ctx, double app_ha,
     a.dec = app_dec;
     sincos_d2(app_ha, app_dec, &a.sh, &a.ch, &a.sd, &a.cd);
     a.q = v3(a.cd * a.ch, a.cd * a.sh, a.sd);
-    const V3<double> &q = a.q;
     double turn[2], t, d, err;
     turn_of(start, side, m->coef[4], turn);
     pm_status result = solve_branch(m, k, ctx, a, side, start, turn, &t, &d, &err);
@@ -737,69 +820,8 @@ pm_status invert(const pm_model *m, const pm_context *ctx, double app_ha,
             d = d2;
             err = err2;
         } else {
-            /* Close to the mount's pole a solution on the requested side
-            ** can lie between the pole and the fold, out of both branches'
-            ** reach: Newton from PM_INVERT_POLE_STARTS points on the edge
-            ** of the pole nearer the target (the sign of the target's
-            ** component along the polar axis, H^T q), on the requested
-            ** side.  (The other pole is at least 90 deg less the
-            ** isotropic and anisotropic amplitudes away.) */
-            bool found = false;
-            /* unreachable: the nearest point on the requested side seen
-            ** (the branches' misses: a point not PM_OK came from Newton,
-            ** which measured it) */
-            double best_err = 1e300, best_t = t, best_d = d;
-            if (side_of(m, d) == side && result != PM_OK)
-                best_err = err;
-            if (side_of(m, d2) == side && r2 != PM_OK && err2 < best_err) {
-                best_err = err2;
-                best_t = t2;
-                best_d = d2;
-            }
-            const double qz = k.h[2] * q.x + k.h[5] * q.y + k.h[8] * q.z;
-            const int hemi = qz >= 0 ? 1 : -1;
-            NPoint edge[PM_INVERT_POLE_STARTS];
-            for (int j = 0; j < PM_INVERT_POLE_STARTS; j++) {
-                double tj = -PI + 2 * PI * (j + 0.5) / PM_INVERT_POLE_STARTS;
-                /* dec - e' = +-(pi/2 - 1e-9) on the normal side, +-(pi/2 +
-                ** 1e-9) beyond the pole */
-                double dj = hemi * (PI / 2 - side * 1e-9) + m->coef[4];
-                finish_angles(turn, &tj, &dj);
-                newton_point(m, k, ctx, a.q, tj, dj, &edge[j]);
-            }
-            for (int r = 0; r < PM_INVERT_POLE_RUNS && !found; r++) {
-                int jb = -1; /* the r-th best edge point: Newton from it */
-                for (int j = 0; j < PM_INVERT_POLE_STARTS; j++)
-                    if (edge[j].err >= 0 && (jb < 0 || edge[j].err < edge[jb].err))
-                        jb = j;
-                if (jb < 0)
-                    break;
-                double tj = edge[jb].t, dj = edge[jb].d, ej;
-                pm_status sj = newton(m, k, ctx, a, turn, &tj, &dj, &ej, side,
-                                      PM_INVERT_POLE_NEWTON, &edge[jb]);
-                edge[jb].err = -1; /* (used) */
-                if (side_of(m, dj) != side)
-                    continue;
-                if (sj == PM_OK) {
-                    t = tj;
-                    d = dj;
-                    result = PM_OK;
-                    found = true;
-                } else if (ej < best_err) {
-                    best_err = ej;
-                    best_t = tj;
-                    best_d = dj;
-                }
-            }
-            if (!found) {
-                /* nothing on the requested side reaches the target */
-                result = PM_WARN_UNREACHABLE;
-                if (best_err < 1e300) {
-                    t = best_t;
-                    d = best_d;
-                    err = best_err;
-                }
-            }
+            result = pole_rescue(m, k, ctx, a, side, turn, result, r2, t2, d2, err2, &t,
+                                 &d, &err);
         }
     }
     /* A warning returns the best position found: the model must still be

@@ -1059,7 +1059,7 @@ inline V3<T> forward_vec(const pm_model *m, const Iso<T> &k, const Trig<T> &g,
 /* The derivatives (ft, fd) along the axes of an added term's factor f at g
 ** (term_factor; f itself in *f): harmonic, periodic, sectoral and AUX
 ** terms (AUX: constant). */
-inline void factor_jac(const pm_term &t, const Trig<double> &g, const pm_context *ctx, double *f,
+__attribute__((noinline)) inline void factor_jac(const pm_term &t, const Trig<double> &g, const pm_context *ctx, double *f,
                 double *ft, double *fd)
 {
     *f = *ft = *fd = 0;
@@ -1111,7 +1111,7 @@ inline void factor_jac(const pm_term &t, const Trig<double> &g, const pm_context
 ** its derivatives along the axes: M^T Z with M = H Pt(t') X Pd(d') T(i);
 ** d/dt' of Pt^T y is (y'_y, -y'_x, 0) and d/dd' of Pd^T y is (y'_z, 0,
 ** -y'_x), y' the rotated vector. */
-inline void zenith_jac(const pm_model *m, const Iso<double> &k, const Trig<double> &g, V3<double> *z,
+__attribute__((noinline)) inline void zenith_jac(const pm_model *m, const Iso<double> &k, const Trig<double> &g, V3<double> *z,
                 V3<double> *zt, V3<double> *zd)
 {
     double stp, ctp, sdp, cdp;
