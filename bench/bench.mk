@@ -131,3 +131,10 @@ bench-run: fw-toolchain $(BN)/pmbench $(BN)/pmbench_fit $(BN)/pmbench_explain $(
 	@$(PYTHON) bench/report.py --dir $(BN) --targets "$(BENCH_TARGETS)"
 
 .PHONY: bench-run
+
+# The double inverse's outcomes on large samples (issue 18, round 3):
+# pmbench_inv_stress real [N] [SEED] | hard (bench/inv_stress.c).
+$(BN)/pmbench_inv_stress: bench/inv_stress.c tests/hard_cases.h tests/testutil.h tests/probe.h \
+                          include/pm.h $(PROBE_OBJ)
+	@mkdir -p $(@D)
+	$(CC) $(BENCH_CFLAGS) -Itests $< $(PROBE_OBJ) -lstdc++ -lm -o $@

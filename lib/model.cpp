@@ -7,6 +7,11 @@
 #include "pm_detail.hpp"
 
 using namespace pm::detail;
+#ifndef PM_TRACE
+#define PM_TRACE(s, a, b, c) ((void)0)
+#else
+extern "C" void pm_trace(const char *, double, double, double);
+#endif
 
 namespace {
 
@@ -204,18 +209,45 @@ struct Aim {
     V3<double> q;
 };
 
-/* A trial point of the Newton iteration (newton): the forward model's
-** unit vector p at (t, d) -- the operations of forward_vec --, its miss of
-** the target (the angle between them) and p's derivatives along the axes,
-** analytic: the rotations' and, through J = dD/dx (aniso_jac), the
-** displacement's.  One model evaluation. */
-struct NPoint {
-    double t, d, err;
-    V3<double> p, pt, pd;
+/* The target as the Newton iteration sees it, in the frame before H (the
+** outermost rotation, applied to the target once instead of to every
+** trial point): q and its tangent frame, e1 along increasing axis 1, e2
+** along axis 2. */
+struct Frame {
+    V3<double> q, e1, e2;
 };
 
-__attribute__((noinline)) void newton_point(const pm_model *m, const Iso<double> &k, const pm_context *ctx,
-                  const V3<double> &q, double t, double d, NPoint *o)
+inline Frame frame_of(const Iso<double> &k, const Aim &a)
+{
+    Frame f;
+    f.q = mat_tmul<double>(k.h, a.q);
+    f.e1 = mat_tmul<double>(k.h, v3(-a.sh, a.ch, 0.0));
+    f.e2 = mat_tmul<double>(k.h, v3(-a.sd * a.ch, -a.sd * a.sh, a.cd));
+    return f;
+}
+
+/* A trial point of the Newton iteration (newton): at (t, d), the forward
+** model's unit vector p (the operations of forward_vec), its miss of the
+** target (the angle between them), the residual F = (e1 . p, e2 . p) and
+** its derivatives along the axes: M = dF/d(t, d) (rows e1, e2), analytic
+** -- the rotations' and, through J = dD/dx (aniso_jac), the
+** displacement's --, and the second derivatives of the rotations' part
+** (H: tt, td, dd, each (e1, e2); the displacement's own second derivative,
+** below lip2, left out), for the fold step (fold_step).  gt = dp/dt . q,
+** gtt = d2p/dt2 . q: the search along the pole's edge.  One model
+** evaluation. */
+struct NPoint {
+    double t, d, err;
+    double F[2], M[4], H[6];
+    double gt, gtt;
+    double dphi; /* the target's azimuth about the mount's pole less p's */
+    double pz[3]; /* q_z - p_z, and p's azimuth's and p_z's derivatives: */
+    double pa[4]; /* (dA/dt, dA/dd, dz/dt, dz/dd) */
+};
+
+__attribute__((noinline)) void newton_point(const pm_model *m, const Iso<double> &k,
+                                            const pm_context *ctx, const Frame &f, double t,
+                                            double d, NPoint *o)
 {
     const Trig<double> g = trig_of(t, d);
     double a, b, J[4], stp, ctp, sdp, cdp;
@@ -237,115 +269,267 @@ __attribute__((noinline)) void newton_point(const pm_model *m, const Iso<double>
     }
     const V3<double> wa = v3(2 * a * c1, s + 2 * a * a * s1, 2 * a * b * s1);
     const V3<double> wb = v3(2 * b * c1, 2 * a * b * s1, s + 2 * b * b * s1);
-    V3<double> w = expmap<double>(a, b);
-    V3<double> wt = v3(wa.x * J[0] + wb.x * J[2], wa.y * J[0] + wb.y * J[2],
-                       wa.z * J[0] + wb.z * J[2]);
-    V3<double> wd = v3(wa.x * J[1] + wb.x * J[3], wa.y * J[1] + wb.y * J[3],
-                       wa.z * J[1] + wb.z * J[3]);
-    /* p = H Pt(t') X(d) Pd(d') T(i) w; the same rotations of the
-    ** derivatives (the frame before H: cc) */
-    w = rot_z<double>(stp, ctp, rot_x<double>(k.sd, k.cd, rot_d<double>(sdp, cdp,
-                                                  rot_z<double>(k.si, k.ci, w))));
-    wt = rot_z<double>(stp, ctp, rot_x<double>(k.sd, k.cd, rot_d<double>(sdp, cdp,
-                                                   rot_z<double>(k.si, k.ci, wt))));
-    wd = rot_z<double>(stp, ctp, rot_x<double>(k.sd, k.cd, rot_d<double>(sdp, cdp,
-                                                   rot_z<double>(k.si, k.ci, wd))));
-    /* the axes turn w themselves: d/dt' Pt(t') y = z x (Pt y); d/dd' Pd(d')
-    ** y = -y^ x (Pd y), i.e. -(Pt X y^) x w after the outer rotations */
+    /* W = Pt(t') X(d) Pd(d') T(i) w, and the same rotations of w's
+    ** derivatives (Wt, Wd): p = H W */
+    V3<double> v[3] = {expmap<double>(a, b),
+                       v3(wa.x * J[0] + wb.x * J[2], wa.y * J[0] + wb.y * J[2],
+                          wa.z * J[0] + wb.z * J[2]),
+                       v3(wa.x * J[1] + wb.x * J[3], wa.y * J[1] + wb.y * J[3],
+                          wa.z * J[1] + wb.z * J[3])};
+    for (int i = 0; i < 3; i++)
+        v[i] = rot_z<double>(stp, ctp, rot_x<double>(k.sd, k.cd, rot_d<double>(sdp, cdp,
+                                                    rot_z<double>(k.si, k.ci, v[i]))));
+    const V3<double> &W = v[0], &Wt = v[1], &Wd = v[2];
+    /* The axes turn W themselves: d/dt' Pt(t') y = z x (Pt y), d/dd' Pd(d')
+    ** y = -y^ x (Pd y), i.e. -ax x W with ax = Pt X y^ the declination
+    ** axis.  So p_t = Wt + z x W, p_d = Wd - ax x W, and differentiating
+    ** once more (ax turns with t only): p_tt = z x (p_t + Wt), p_dd = -ax x
+    ** (p_d + Wd), p_td = z x p_d - ax x Wt, up to the rotated second
+    ** derivatives of w (lip2 bounds them; they only slow the fold step). */
     const V3<double> ax = v3(-stp * k.cd, ctp * k.cd, k.sd);
-    wt = v3(wt.x - w.y, wt.y + w.x, wt.z);
-    const V3<double> cw = cross<double>(ax, w);
-    wd = v3(wd.x - cw.x, wd.y - cw.y, wd.z - cw.z);
+    const V3<double> pt = v3(Wt.x - W.y, Wt.y + W.x, Wt.z);
+    const V3<double> cw = cross<double>(ax, W);
+    const V3<double> pd = v3(Wd.x - cw.x, Wd.y - cw.y, Wd.z - cw.z);
+    const V3<double> ptt = v3(-(pt.y + Wt.y), pt.x + Wt.x, 0.0);
+    const V3<double> cdd = cross<double>(ax, v3(pd.x + Wd.x, pd.y + Wd.y, pd.z + Wd.z));
+    const V3<double> cwt = cross<double>(ax, Wt);
+    const V3<double> ptd = v3(-pd.y - cwt.x, pd.x - cwt.y, -cwt.z);
     o->t = t;
     o->d = d;
-    o->p = mat_mul<double>(k.h, w);
-    o->pt = mat_mul<double>(k.h, wt);
-    o->pd = mat_mul<double>(k.h, wd);
-    const V3<double> x = cross<double>(o->p, q);
-    o->err = m_atan2(m_sqrt(dot<double>(x, x)), dot<double>(o->p, q));
+    o->F[0] = dot(W, f.e1);
+    o->F[1] = dot(W, f.e2);
+    o->M[0] = dot(pt, f.e1);
+    o->M[1] = dot(pd, f.e1);
+    o->M[2] = dot(pt, f.e2);
+    o->M[3] = dot(pd, f.e2);
+    o->H[0] = dot(ptt, f.e1);
+    o->H[1] = dot(ptt, f.e2);
+    o->H[2] = dot(ptd, f.e1);
+    o->H[3] = dot(ptd, f.e2);
+    o->H[4] = -dot(cdd, f.e1);
+    o->H[5] = -dot(cdd, f.e2);
+    o->gt = dot(pt, f.q);
+    o->gtt = dot(ptt, f.q);
+    const V3<double> x = cross<double>(W, f.q);
+    o->err = m_atan2(m_sqrt(dot<double>(x, x)), dot<double>(W, f.q));
+    o->dphi = m_atan2(x.z, W.x * f.q.x + W.y * f.q.y);
+    const double ir2 = 1 / (W.x * W.x + W.y * W.y);
+    o->pz[0] = f.q.z - W.z;
+    o->pa[0] = (W.x * pt.y - W.y * pt.x) * ir2;
+    o->pa[1] = (W.x * pd.y - W.y * pd.x) * ir2;
+    o->pa[2] = pt.z;
+    o->pa[3] = pd.z;
+    PM_TRACE("npt", t, d - m->coef[4], o->err);
 }
 
+/* H(x, y) of point c: the second-order part of F along steps x and y
+** (x_t y_t H_tt + (x_t y_d + x_d y_t) H_td + x_d y_d H_dd), projected on
+** u. */
+inline double hess(const NPoint &c, const double *u, const double *x, const double *y)
+{
+    const double tt = x[0] * y[0], td = x[0] * y[1] + x[1] * y[0], dd = x[1] * y[1];
+    return u[0] * (tt * c.H[0] + td * c.H[2] + dd * c.H[4]) +
+           u[1] * (tt * c.H[1] + td * c.H[3] + dd * c.H[5]);
+}
+
+/* The step h of the Newton iteration from point c: a root of the
+** quadratic model F + M h + H(h, h)/2 = 0.  In M's singular directions
+** (M v1 = s1 u1, M v2 = s2 u2, s1 >= |s2|) h = alpha v2 + beta v1: along
+** u1 the model is solved for beta as a Newton step, along u2 as a
+** quadratic in alpha.  Where M is regular that is Newton's step with a
+** second-order correction; at the fold of the mount's pole, where M is
+** singular (s2 -> 0: the edge of the cap the tube cannot reach, and the
+** two solutions either side of it), plain Newton would halve its
+** distance to the fold per step, while the quadratic gives both
+** solutions at once: the one on side `want` is taken (+1/-1; 0: the
+** nearer), and where the quadratic has no root (the target is beyond the
+** fold: unreachable here) its vertex, the fold's point nearest the
+** target.  False where M is degenerate. */
+inline bool fold_step(const pm_model *m, const NPoint &c, int want, double *ht, double *hd)
+{
+    const double A = c.M[0], B = c.M[1], C = c.M[2], D = c.M[3];
+    const double j00 = A * A + C * C, j01 = A * B + C * D, j11 = B * B + D * D;
+    const double dif = j00 - j11, tr = j00 + j11;
+    if (!(tr > 0) || !(tr < 1e300))
+        return false;
+    const double l1 = 0.5 * (tr + m_sqrt(dif * dif + 4 * j01 * j01));
+    double v1[2] = {dif >= 0 ? l1 - j11 : j01, dif >= 0 ? j01 : l1 - j00};
+    double n = m_sqrt(v1[0] * v1[0] + v1[1] * v1[1]);
+    if (!(n > 0)) {
+        v1[0] = 1;
+        v1[1] = 0;
+    } else {
+        v1[0] /= n;
+        v1[1] /= n;
+    }
+    const double v2[2] = {-v1[1], v1[0]};
+    const double s1 = m_sqrt(l1);
+    const double u1[2] = {(A * v1[0] + B * v1[1]) / s1, (C * v1[0] + D * v1[1]) / s1};
+    const double u2[2] = {-u1[1], u1[0]};
+    const double s2 = u2[0] * (A * v2[0] + B * v2[1]) + u2[1] * (C * v2[0] + D * v2[1]);
+    const double f1 = u1[0] * c.F[0] + u1[1] * c.F[1], f2 = u2[0] * c.F[0] + u2[1] * c.F[1];
+    const double b0 = -f1 / s1;
+    const double h11 = hess(c, u2, v1, v1), h12 = hess(c, u2, v1, v2), h22 = hess(c, u2, v2, v2);
+    const double a2 = 0.5 * h22, a1 = s2 + b0 * h12, a0 = f2 + 0.5 * b0 * b0 * h11;
+    const double disc = a1 * a1 - 4 * a2 * a0;
+    double al;
+    if (disc < 0) {
+        al = -a1 / (2 * a2); /* the vertex: the fold's nearest point */
+    } else {
+        const double qq = -0.5 * (a1 + (a1 >= 0 ? m_sqrt(disc) : -m_sqrt(disc)));
+        al = qq != 0 ? a0 / qq : 0; /* the nearer root */
+        if (want && a2 != 0 && qq != 0) {
+            /* the other root where only it lies on the side wanted */
+            const double far = qq / a2;
+            if (m_fabs(far) <= 0.05 &&
+                side_of(m, c.d + al * v2[1] + b0 * v1[1]) != want &&
+                side_of(m, c.d + far * v2[1] + b0 * v1[1]) == want)
+                al = far;
+        }
+    }
+    /* beta with the second-order part at (alpha, b0) */
+    const double hh[2] = {al * v2[0] + b0 * v1[0], al * v2[1] + b0 * v1[1]};
+    const double be = -(f1 + 0.5 * hess(c, u1, hh, hh)) / s1;
+    *ht = al * v2[0] + be * v1[0];
+    *hd = al * v2[1] + be * v1[1];
+    return finite(*ht) && finite(*hd);
+}
+
+/* The encoder declination on the edge of the mount's pole (dec - e' =
+** pole, +-pi/2) on the turn of ref (turn_of), the double nearest it on
+** side `want`. */
+inline double edge_of(const pm_model *m, const double *ref, double pole, int want)
+{
+    double t = ref[0], d = pole + m->coef[4];
+    finish_angles(ref, &t, &d);
+    const double step = (pole > 0 ? -want : want) * (m_fabs(d) * 2.3e-16 + 1e-300);
+    for (int i = 0; i < 8 && side_of(m, d) != want; i++)
+        d += step;
+    return d;
+}
+
+/* Is trial point x better than c for an iteration that wants side `want`
+** (0: any)?  A point on the side wanted beats one beyond it; then the
+** smaller miss; where the misses agree to rounding (a target out of reach:
+** the miss is stationary at the nearest point), the smaller gradient of
+** the miss (along the edge only, for points on the pole's edge). */
+inline bool better(const pm_model *m, const NPoint &x, const NPoint &c, int want)
+{
+    if (want) {
+        const bool xs = side_of(m, x.d) == want, cs = side_of(m, c.d) == want;
+        if (xs != cs)
+            return xs;
+    }
+    if (x.err < c.err * (1 - 1e-12))
+        return true;
+    if (!(x.err <= c.err * (1 + 1e-12)))
+        return false;
+    const double gx0 = x.M[0] * x.F[0] + x.M[2] * x.F[1], gx1 = x.M[1] * x.F[0] + x.M[3] * x.F[1];
+    const double gc0 = c.M[0] * c.F[0] + c.M[2] * c.F[1], gc1 = c.M[1] * c.F[0] + c.M[3] * c.F[1];
+    return gx0 * gx0 + gx1 * gx1 < gc0 * gc0 + gc1 * gc1;
+}
+
+#ifndef AZ_STEP
+#define AZ_STEP 100
+#endif
 #ifndef NEWTON_MAX_STEP
 #define NEWTON_MAX_STEP 1.0
 #endif
 /* Damped Newton iteration on the forward model, in a frame fixed at the
-** target, with the analytic Jacobian (newton_point: one evaluation per
-** trial point, the Jacobian included).  Used where the closed form's
-** fixed point does not contract (close to the mount's pole) and to check
-** returned angles.  x = (t, d) encoder angles, updated in place.  At most
-** PM_INVERT_MAX_NEWTON evaluations (trial points), the first at x; a trial
-** point that does not reduce the miss shortens the step to a quarter.  With
-** lock = +1/-1 a trial point beyond the pole from that side is moved back
-** onto the pole's edge (projected steps: the nearest point on one side).
-** Trial points are kept on the turn the result is returned on (turn,
-** from turn_of), since periodic terms of non-integer G read the raw
-** angles and jump between turns. */
-__attribute__((noinline)) pm_status newton(const pm_model *m, const Iso<double> &k, const pm_context *ctx,
-                 const Aim &a, const double *turn, double *t, double *d, double *err,
-                 int lock, int budget, const NPoint *first = 0)
+** target, with the analytic Jacobian and the fold step (newton_point,
+** fold_step: one evaluation per trial point).  Used where the closed
+** form's fixed point does not contract (close to the mount's pole) and to
+** check returned angles.  x = (t, d) encoder angles, updated in place.  At
+** most `budget` evaluations (trial points), the first at x (or `first`,
+** already evaluated); a trial point that is not better shortens the step
+** to a quarter.  want = +1/-1: the side of the pole wanted (a trial
+** point beyond the pole from that side is moved back onto the pole's
+** edge, where the step is the hour angle's Newton step on p . q: the
+** nearest point of the edge); 0: any side, the nearer solution.  Trial
+** points are kept on the turn the result is returned on (turn, from
+** turn_of), since periodic terms of non-integer G read the raw angles and
+** jump between turns. */
+__attribute__((noinline)) pm_status newton(const pm_model *m, const Iso<double> &k,
+                                           const pm_context *ctx, const Aim &a,
+                                           const double *turn, double *t, double *d,
+                                           double *err, int want, int budget,
+                                           const NPoint *first = 0)
 {
-    /* frame at the target: e1 along increasing axis 1, e2 along axis 2 */
-    const V3<double> e1 = v3(-a.sh, a.ch, 0.0);
-    const V3<double> e2 = v3(-a.sd * a.ch, -a.sd * a.sh, a.cd);
+    const Frame f = frame_of(k, a);
     NPoint cur, trial;
     int evals = 0;
     if (first) {
         cur = *first;
     } else {
-        newton_point(m, k, ctx, a.q, *t, *d, &cur);
+        newton_point(m, k, ctx, f, *t, *d, &cur);
         evals = 1;
     }
-    double lam = 1, edge_t = 0, edge_cp = 0;
+    double lam = 1, edge_t = 0, edge_g = 0;
     bool have_edge = false;
-    while (cur.err > PM_INVERT_TOL && evals < budget) {
-        /* F = (e1 . p, e2 . p) -> 0; M = dF/dx; Levenberg-damped 2x2 solve
-        ** of M x = -F */
-        const double F1 = dot(cur.p, e1), F2 = dot(cur.p, e2);
-        const double A = dot(cur.pt, e1), B = dot(cur.pd, e1);
-        const double C = dot(cur.pt, e2), D = dot(cur.pd, e2);
-        const double j00 = A * A + C * C, j01 = A * B + C * D, j11 = B * B + D * D;
-        const double g0 = -(A * F1 + C * F2), g1 = -(B * F1 + D * F2);
-        const double mu = 1e-12 * (j00 + j11);
-        const double det = (j00 + mu) * (j11 + mu) - j01 * j01;
-        if (!(det > 0))
+    while (!(cur.err <= PM_INVERT_TOL && (!want || side_of(m, cur.d) == want)) &&
+           evals < budget) {
+        double ht, hd;
+        if (m_fabs(cur.dphi) > AZ_STEP) {
+            /* far round the mount's pole from the target: the turn about
+            ** the polar axis that brings p to the target's azimuth (the
+            ** quadratic model does not hold over such a turn) */
+            const double det = cur.pa[0] * cur.pa[3] - cur.pa[1] * cur.pa[2];
+            if (m_fabs(det) > 1e-6 * m_fabs(cur.pa[0] * cur.pa[3])) {
+                ht = (cur.pa[3] * cur.dphi - cur.pa[1] * cur.pz[0]) / det;
+                hd = (cur.pa[0] * cur.pz[0] - cur.pa[2] * cur.dphi) / det;
+            } else {
+                ht = cur.dphi / cur.pa[0];
+                hd = 0;
+            }
+        } else if (!fold_step(m, cur, want, &ht, &hd))
             break;
-        double x0 = ((j11 + mu) * g0 - j01 * g1) / det;
-        double x1 = ((j00 + mu) * g1 - j01 * g0) / det;
-        /* a trust region: the linear model holds over a fraction of a
+        /* a trust region: the quadratic model holds over a fraction of a
         ** radian at most (near the mount's pole, where the hour angle is
         ** ill-determined, over much less) */
-        const double big = m_fabs(x0) > 4 * m_fabs(x1) ? m_fabs(x0) : 4 * m_fabs(x1);
+        const double big = m_fabs(ht) > 4 * m_fabs(hd) ? m_fabs(ht) : 4 * m_fabs(hd);
         if (big > NEWTON_MAX_STEP) {
-            x0 *= NEWTON_MAX_STEP / big;
-            x1 *= NEWTON_MAX_STEP / big;
+            ht *= NEWTON_MAX_STEP / big;
+            hd *= NEWTON_MAX_STEP / big;
         }
-        double nt = cur.t + lam * x0, nd = cur.d + lam * x1;
-        if (lock && side_of(m, nd) != lock) {
-            /* back onto the edge: dec - e' = +-90 deg on the locked side,
-            ** and the step along the edge (the hour angle's own
-            ** Gauss-Newton step: the nearest point of the edge where the
-            ** target is out of reach) */
-            double pole = m_sin(nd - m->coef[4]) >= 0 ? PI / 2 : -PI / 2;
-            nd = pole + m->coef[4] - (pole > 0 ? 1 : -1) * lock * 1e-12;
-            double x0e = g0 / (j00 + mu);
-            /* along the edge, where the target is out of reach, the
-            ** nearest point is where p . q peaks: the secant step on its
-            ** derivative p_t . q once two points of the edge are known
-            ** (Gauss-Newton alone converges slowly there) */
-            const double cp = dot(cur.pt, a.q);
-            if (have_edge && cur.t != edge_t && cp != edge_cp)
-                x0e = -cp * (cur.t - edge_t) / (cp - edge_cp);
-            edge_t = cur.t;
-            edge_cp = cp;
-            have_edge = true;
-            if (m_fabs(x0e) > NEWTON_MAX_STEP)
-                x0e = x0e > 0 ? NEWTON_MAX_STEP : -NEWTON_MAX_STEP;
-            nt = cur.t + lam * x0e;
+        double nt = cur.t + lam * ht, nd = cur.d + lam * hd;
+        if (want && side_of(m, nd) != want) {
+            /* back onto the edge: dec - e' = +-90 deg on the side wanted,
+            ** and along the edge the hour angle's Newton step on p . q
+            ** (its maximum: the nearest point of the edge where the target
+            ** is out of reach), the plain step where p . q is not concave */
+            const double pole = m_sin(nd - m->coef[4]) >= 0 ? PI / 2 : -PI / 2;
+            const double step_d = nd - cur.d;
+            nd = edge_of(m, turn, pole, want);
+            if (nd != cur.d) {
+                /* the step as far as the edge */
+                double frac = (nd - cur.d) / step_d;
+                frac = frac > 0 ? (frac < 1 ? frac : 1) : 0;
+                nt = cur.t + lam * ht * frac;
+            } else {
+                /* from the edge along it: where the target is out of
+                ** reach, the nearest point is where p . q peaks; the
+                ** secant step on its derivative p_t . q once two points
+                ** of the edge are known, the Gauss-Newton step before */
+                double he = -(cur.M[0] * cur.F[0] + cur.M[2] * cur.F[1]) /
+                            (cur.M[0] * cur.M[0] + cur.M[2] * cur.M[2]);
+                if (have_edge && cur.t != edge_t && cur.gt != edge_g)
+                    he = -cur.gt * (cur.t - edge_t) / (cur.gt - edge_g);
+                edge_t = cur.t;
+                edge_g = cur.gt;
+                have_edge = true;
+                if (!finite(he))
+                    he = 0;
+                if (m_fabs(he) > NEWTON_MAX_STEP)
+                    he = he > 0 ? NEWTON_MAX_STEP : -NEWTON_MAX_STEP;
+                nt = cur.t + lam * he;
+            }
         }
         finish_angles(turn, &nt, &nd);
-        newton_point(m, k, ctx, a.q, nt, nd, &trial);
+        if (nt == cur.t && nd == cur.d)
+            break; /* no step left: the nearest point */
+        newton_point(m, k, ctx, f, nt, nd, &trial);
         evals++;
-        if (trial.err < cur.err) {
+        if (better(m, trial, cur, want)) {
             cur = trial;
             lam = 1;
         } else {
@@ -512,7 +696,8 @@ inline bool newton_prep(const Iso<double> &k, const Trig<double> &g, double a, d
 ** on (turn_of).  Returns the status, (t, d) and the miss at (t, d) (0 for
 ** PM_OK: below PM_INVERT_TOL). */
 pm_status solve_branch(const pm_model *m, const Iso<double> &k,
-                       const pm_context *ctx, const Aim &a, int side, const double *start,
+                       const pm_context *ctx, const Aim &a, int side, int want,
+                       const double *start,
                        const double *turn, double *t_out, double *d_out, double *err_out)
 {
     /* Periodic terms of non-integer G read the raw angle itself, not only
@@ -606,6 +791,7 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
         if (!finite(dt * dt + dd * dd))
             break; /* the forward model overflows here: not converged */
         change = m_sqrt((dt - dh_t) * (dt - dh_t) + (dd - dh_d) * (dd - dh_d));
+        PM_TRACE("fix", side, it, change);
         if (change < best_change) {
             best_change = change;
             best = g;
@@ -685,8 +871,8 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
     }
     pm_status result = PM_OK;
     double err = 0;
-    if (!converged || !reachable) {
-        result = newton(m, k, ctx, a, turn, &t, &d, &err, 0, PM_INVERT_MAX_NEWTON);
+    if (!converged || !reachable || (want && side_of(m, d) != want)) {
+        result = newton(m, k, ctx, a, turn, &t, &d, &err, want, PM_INVERT_MAX_NEWTON);
         if (result != PM_OK && !reachable)
             result = PM_WARN_UNREACHABLE;
     }
@@ -732,26 +918,30 @@ __attribute__((noinline)) pm_status pole_rescue(const pm_model *m, const Iso<dou
     }
     const double qz = k.h[2] * q.x + k.h[5] * q.y + k.h[8] * q.z;
     const int hemi = qz >= 0 ? 1 : -1;
-    NPoint edge[PM_INVERT_POLE_STARTS];
+    const Frame f = frame_of(k, a);
+    /* the PM_INVERT_POLE_RUNS best edge points, best first */
+    NPoint edge[PM_INVERT_POLE_RUNS + 1];
+    int n_edge = 0;
     for (int j = 0; j < PM_INVERT_POLE_STARTS; j++) {
         double tj = -PI + 2 * PI * (j + 0.5) / PM_INVERT_POLE_STARTS;
         /* dec - e' = +-(pi/2 - 1e-9) on the normal side, +-(pi/2 +
         ** 1e-9) beyond the pole */
         double dj = hemi * (PI / 2 - side * 1e-9) + m->coef[4];
         finish_angles(turn, &tj, &dj);
-        newton_point(m, k, ctx, a.q, tj, dj, &edge[j]);
+        int i = n_edge < PM_INVERT_POLE_RUNS ? n_edge++ : PM_INVERT_POLE_RUNS;
+        newton_point(m, k, ctx, f, tj, dj, &edge[i]);
+        for (; i > 0 && (edge[i].err < edge[i - 1].err || !(edge[i - 1].err >= 0)); i--) {
+            NPoint x = edge[i];
+            edge[i] = edge[i - 1];
+            edge[i - 1] = x;
+        }
     }
-    for (int r = 0; r < PM_INVERT_POLE_RUNS && !found; r++) {
-        int jb = -1; /* the r-th best edge point: Newton from it */
-        for (int j = 0; j < PM_INVERT_POLE_STARTS; j++)
-            if (edge[j].err >= 0 && (jb < 0 || edge[j].err < edge[jb].err))
-                jb = j;
-        if (jb < 0)
+    for (int r = 0; r < n_edge && !found; r++) {
+        if (!(edge[r].err >= 0))
             break;
-        double tj = edge[jb].t, dj = edge[jb].d, ej;
+        double tj = edge[r].t, dj = edge[r].d, ej;
         pm_status sj = newton(m, k, ctx, a, turn, &tj, &dj, &ej, side,
-                              PM_INVERT_POLE_NEWTON, &edge[jb]);
-        edge[jb].err = -1; /* (used) */
+                              PM_INVERT_POLE_NEWTON, &edge[r]);
         if (side_of(m, dj) != side)
             continue;
         if (sj == PM_OK) {
@@ -806,14 +996,16 @@ pm_status invert(const pm_model *m, const pm_context *ctx, double app_ha,
     a.q = v3(a.cd * a.ch, a.cd * a.sh, a.sd);
     double turn[2], t, d, err;
     turn_of(start, side, m->coef[4], turn);
-    pm_status result = solve_branch(m, k, ctx, a, side, start, turn, &t, &d, &err);
+    pm_status result = solve_branch(m, k, ctx, a, side, start ? 0 : side, start, turn, &t, &d, &err);
+    PM_TRACE("branch1", result, side_of(m, d), err);
     if (!start && (result != PM_OK || side_of(m, d) != side)) {
         /* Within the anisotropic amplitude of the mount's pole the closed
         ** form's branches (sign of cos(dec - e' + displacement angle)) and
         ** the sides of the pole (sign of cos(dec - e')) differ: the other
         ** branch may hold the solution on the requested side. */
         double t2, d2, err2;
-        pm_status r2 = solve_branch(m, k, ctx, a, -side, 0, turn, &t2, &d2, &err2);
+        pm_status r2 = solve_branch(m, k, ctx, a, -side, side, 0, turn, &t2, &d2, &err2);
+        PM_TRACE("branch2", r2, side_of(m, d2), err2);
         if (r2 == PM_OK && side_of(m, d2) == side) {
             result = r2;
             t = t2;

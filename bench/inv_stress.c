@@ -1,0 +1,201 @@
+/*
+**  inv_stress.c - the double inverse's outcomes on large samples (issue
+**  18, round 3): statuses and model evaluations, deterministic (the core
+**  with the evaluation counter of tests/probe.h).
+**
+**    pmbench_inv_stress real [N] [SEED]   N cold pm_model_invert calls
+**        (default 20,000) on realistic models near the mount's pole: order
+**        L = 0..2, isotropic terms uniform within +-10 deg, harmonic terms
+**        within +-10', both pier sides, the true encoder position within
+**        0.5 deg of the mount's pole (uniform in area, uniform in distance,
+**        log-uniform down to 1e-10 rad, and exactly on the pole's edge);
+**        every call must return PM_OK on the requested side, round trip
+**        within PM_INVERT_TOL
+**    pmbench_inv_stress hard              check_bounded's ordinary-scale
+**        cases (tests/hard_cases.h, the same sequence as the test): PM_OK
+**        counts of the double pm_model_invert and pm_model_invert_near
+**
+**  Prints one summary line per sample and the failures (up to 20).
+*/
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pm.h"
+#include "testutil.h"
+#include "probe.h"
+#include "hard_cases.h"
+
+static unsigned long probe_count;
+void pm_probe_hit(void) { probe_count++; }
+extern int pm_trace_on __attribute__((weak));
+
+static void real_sample(long n, unsigned long long seed)
+{
+    tu_rng r;
+    long i, ok = 0, bad = 0, hist[PM_INVERT_MAX_EVALS + 2];
+    unsigned long worst = 0;
+    double worst_rt = 0;
+    pm_model m;
+    memset(hist, 0, sizeof hist);
+    tu_seed(&r, seed);
+    for (i = 0; i < n; i++) {
+        double rho, t, d, ah, ad, eh, ed, bh, bd, e, rt, u;
+        int hemi, side, order, j, kind;
+        unsigned long evals;
+        pm_status st;
+        if (i % 10 == 0) {
+            order = (int)(tu_uniform(&r) * 3);
+            if (pm_model_init(&m, PM_MOUNT_EQUATORIAL, order) != PM_OK)
+                abort();
+            for (j = 0; j < m.n_terms; j++)
+                m.coef[j] = (2 * tu_uniform(&r) - 1) * (j < 6 ? 10 * DEG : 10 * ARCSEC * 60);
+            if (pm_model_prepare(&m) != PM_OK)
+                abort();
+        }
+        e = m.coef[4];
+        u = tu_uniform(&r);
+        kind = u < 0.4 ? 0 : u < 0.7 ? 1 : u < 0.9 ? 2 : 3;
+        if (kind == 0)
+            rho = sqrt(tu_uniform(&r)) * 0.5 * DEG;
+        else if (kind == 1)
+            rho = tu_uniform(&r) * 0.5 * DEG;
+        else if (kind == 2)
+            rho = pow(10, -10 + 7 * tu_uniform(&r));
+        else
+            rho = 0;
+        hemi = tu_uniform(&r) < 0.5 ? 1 : -1;
+        side = tu_uniform(&r) < 0.5 ? PM_SIDE_NORMAL : PM_SIDE_FLIPPED;
+        t = (2 * tu_uniform(&r) - 1) * M_PI;
+        d = e + hemi * (side == PM_SIDE_NORMAL ? M_PI / 2 - rho : M_PI / 2 + rho);
+        if (pm_model_apply(&m, NULL, t, d, &ah, &ad) != PM_OK)
+            abort();
+        probe_count = 0;
+        if (&pm_trace_on)
+            pm_trace_on = getenv("STRESS_ONLY") && atol(getenv("STRESS_ONLY")) == i;
+        st = pm_model_invert(&m, NULL, ah, ad, side, &eh, &ed);
+        if (&pm_trace_on)
+            pm_trace_on = 0;
+        if (getenv("STRESS_DUMP") && getenv("STRESS_ONLY") && atol(getenv("STRESS_ONLY")) == i) {
+            FILE *fp = fopen(getenv("STRESS_DUMP"), "wb");
+            fwrite(&m, sizeof m, 1, fp);
+            fwrite(&ah, sizeof ah, 1, fp);
+            fwrite(&ad, sizeof ad, 1, fp);
+            fwrite(&t, sizeof t, 1, fp);
+            fwrite(&d, sizeof d, 1, fp);
+            fwrite(&side, sizeof side, 1, fp);
+            fclose(fp);
+        }
+        if (probe_count > worst)
+            worst = probe_count;
+        hist[probe_count]++;
+        evals = probe_count;
+        rt = 1;
+        if (st >= 0 && pm_model_apply(&m, NULL, eh, ed, &bh, &bd) == PM_OK)
+            rt = tu_angle(bh, bd, ah, ad);
+        if (st == PM_OK && rt > worst_rt)
+            worst_rt = rt;
+        if (st == PM_OK && rt <= 1e-12 &&
+            (cos(ed - e) >= 0) == (side == PM_SIDE_NORMAL)) {
+            ok++;
+        } else {
+            if (bad < (getenv("STRESS_ALL") ? 1000000 : 20))
+                printf("  fail %ld: status %d, %lu evals, order %d, rho %.3e rad (kind %d), "
+                       "hemi %d side %d, t %.6f; round trip %.3e; result (%.9f, %.9f) "
+                       "cos(dec-e') %.3e; coef d %.3e i %.3e a %.3e b %.3e\n",
+                       i, (int)st, evals, m.order, rho, kind, hemi, side, t, rt, eh, ed,
+                       cos(ed - e), m.coef[3], m.coef[5], m.coef[0], m.coef[1]);
+            bad++;
+        }
+    }
+    {
+        long med = 0, p99 = 0, acc = 0;
+        unsigned long k;
+        for (k = 0; k <= (unsigned long)PM_INVERT_MAX_EVALS; k++) {
+            acc += hist[k];
+            if (!med && acc * 2 >= n)
+                med = (long)k;
+            if (!p99 && acc * 100 >= 99 * n)
+                p99 = (long)k;
+        }
+        printf("real near the pole: %ld cold calls (seed %llu): %ld PM_OK, %ld not; evaluations "
+               "median %ld, p99 %ld, worst %lu (bound %d); worst PM_OK round trip %.2e rad\n",
+               n, seed, ok, bad, med, p99, worst, PM_INVERT_MAX_EVALS, worst_rt);
+    }
+}
+
+static void hard_sample(void)
+{
+    tu_rng r;
+    long cold_ok = 0, near_ok = 0, calls = 0;
+    unsigned long worst_cold = 0, worst_near = 0;
+    int i, j;
+    tu_seed(&r, 101);
+    for (i = 0; i < 200; i++) {
+        pm_model m;
+        pm_model_f mf;
+        pm_context c;
+        const pm_context *ctx;
+        if (hc_random_model(&m, &r, HC_SCALE_NORMAL) != 0)
+            abort();
+        (void)pm_model_f_prepare(&mf, &m);
+        for (j = 0; j < 40; j++) {
+            double ha, dec, eh, ed, sh, sd, sol[2];
+            int side;
+            pm_status st;
+            hc_random_context(&c, &r);
+            ctx = m.needs_ctx || tu_uniform(&r) < 0.5 ? &c : NULL;
+            hc_hard_target(&m, &r, &ha, &dec);
+            /* check_bounded's check_point: the same draws in the same order */
+            side = tu_uniform(&r) < 0.5 ? PM_SIDE_NORMAL : PM_SIDE_FLIPPED;
+            probe_count = 0;
+            st = pm_model_invert(&m, ctx, ha, dec, side, &eh, &ed);
+            cold_ok += st == PM_OK;
+            if (probe_count > worst_cold)
+                worst_cold = probe_count;
+            sol[0] = eh;
+            sol[1] = ed;
+            hc_hard_start(&r, st >= 0 ? sol : NULL, &sh, &sd);
+            probe_count = 0;
+            st = pm_model_invert_near(&m, ctx, ha, dec, sh, sd, &eh, &ed);
+            near_ok += st == PM_OK;
+            if (probe_count > worst_near)
+                worst_near = probe_count;
+            calls++;
+            /* check_apply's draws */
+            {
+                double u = tu_uniform(&r);
+                if (u < 0.5)
+                    (void)tu_uniform(&r);
+                else
+                    (void)tu_gauss(&r);
+                u = tu_uniform(&r);
+                if (u < 0.5)
+                    (void)tu_uniform(&r);
+                else
+                    (void)tu_gauss(&r);
+            }
+        }
+    }
+    printf("hard (check_bounded, ordinary): %ld targets: pm_model_invert PM_OK %ld (worst %lu "
+           "evaluations, bound %d), pm_model_invert_near PM_OK %ld (worst %lu, bound %d)\n",
+           calls, cold_ok, worst_cold, PM_INVERT_MAX_EVALS, near_ok, worst_near,
+           PM_INVERT_NEAR_MAX_EVALS);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc >= 2 && !strcmp(argv[1], "real")) {
+        long n = argc >= 3 ? atol(argv[2]) : 20000;
+        unsigned long long seed = argc >= 4 ? strtoull(argv[3], 0, 10) : 1;
+        real_sample(n, seed);
+        return 0;
+    }
+    if (argc >= 2 && !strcmp(argv[1], "hard")) {
+        hard_sample();
+        return 0;
+    }
+    fprintf(stderr, "usage: pmbench_inv_stress real [N] [SEED] | hard\n");
+    return 2;
+}
