@@ -150,8 +150,24 @@ static void hard_sample(void)
             /* check_bounded's check_point: the same draws in the same order */
             side = tu_uniform(&r) < 0.5 ? PM_SIDE_NORMAL : PM_SIDE_FLIPPED;
             probe_count = 0;
+            if (&pm_trace_on)
+                pm_trace_on = getenv("STRESS_ONLY") && atol(getenv("STRESS_ONLY")) == i * 100 + j;
+            if (&pm_trace_on && pm_trace_on) {
+                int q;
+                printf("model %d point %d: order %d, mount %d, target (%.17g, %.17g) side %d, ctx %d\n",
+                       i, j, m.order, m.mount, ha, dec, side, ctx != NULL);
+                for (q = m.n_base; q < m.n_terms; q++)
+                    printf("  term kind %d k %d l %d m %d side %d aux %d param %g coef %g\n",
+                           m.term[q].kind, m.term[q].k, m.term[q].l, m.term[q].m, m.term[q].side,
+                           m.term[q].aux, m.term[q].param, m.coef[q]);
+            }
             st = pm_model_invert(&m, ctx, ha, dec, side, &eh, &ed);
+            if (&pm_trace_on)
+                pm_trace_on = 0;
             cold_ok += st == PM_OK;
+            if (getenv("STRESS_LIST"))
+                printf("cold %d %d %d %lu order %d n_terms %d n_base %d ctx %d dec %.6f\n", i, j,
+                       (int)st, probe_count, m.order, m.n_terms, m.n_base, ctx != NULL, dec);
             if (probe_count > worst_cold)
                 worst_cold = probe_count;
             sol[0] = eh;
@@ -160,6 +176,8 @@ static void hard_sample(void)
             probe_count = 0;
             st = pm_model_invert_near(&m, ctx, ha, dec, sh, sd, &eh, &ed);
             near_ok += st == PM_OK;
+            if (getenv("STRESS_LIST"))
+                printf("near %d %d %d %lu\n", i, j, (int)st, probe_count);
             if (probe_count > worst_near)
                 worst_near = probe_count;
             calls++;

@@ -733,6 +733,7 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
     bool have_j = false, have_n = false, tried_n = false, reachable;
     double d0t = 0, d0d = 0;
     bool have_d = false; /* (d0t, d0d): D at g, evaluated */
+    int used = 0;        /* evaluations made */
     if (m->order == 0 && m->n_terms == m->n_base) {
         /* No anisotropic term: D = 0 everywhere, and the closed form is
         ** the solution (no evaluation); from a start, on its branch. */
@@ -751,6 +752,7 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
         ** (near the mount's pole it differs from the sign of cos(dec)). */
         g = trig_of(start[0], start[1]);
         aniso_jac(m, k, g, ctx, &d0t, &d0d, J);
+        used = 1;
         have_j = have_d = true;
         double stp, ctp, sdp, cdp;
         shifted<double>(k, g, &stp, &ctp, &sdp, &cdp);
@@ -775,18 +777,26 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
     double change = 0, last_change = 1e300, best_change = 1e300;
     bool converged = false, best_reachable = reachable;
     Trig<double> best = g;
-    for (int it = 0; it < PM_INVERT_MAX_FIXED && !converged; it++) {
+    /* the best point's displacement, its D^ and distance from J's point */
+    double b_dt = 0, b_dd = 0, b_ht = 0, b_hd = 0, b_dist = 0;
+    bool chord = true; /* Newton steps on D (else plain fixed-point steps) */
+    for (int it = 0; !converged; it++) {
         double dt, dd;
         if (have_d) {
             dt = d0t;
             dd = d0d;
             have_d = false;
-        } else if (have_j) {
-            aniso<double>(m, k, g, ctx, &dt, &dd);
         } else {
-            aniso_jac(m, k, g, ctx, &dt, &dd, J);
-            have_j = true;
-            dist_j = 0;
+            if (used >= PM_INVERT_MAX_FIXED)
+                break;
+            used++;
+            if (have_j) {
+                aniso<double>(m, k, g, ctx, &dt, &dd);
+            } else {
+                aniso_jac(m, k, g, ctx, &dt, &dd, J);
+                have_j = true;
+                dist_j = 0;
+            }
         }
         if (!finite(dt * dt + dd * dd))
             break; /* the forward model overflows here: not converged */
@@ -796,20 +806,40 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
             best_change = change;
             best = g;
             best_reachable = reachable;
+            b_dt = dt;
+            b_dd = dd;
+            b_ht = dh_t;
+            b_hd = dh_d;
+            b_dist = dist_j;
         }
         if (change <= PM_INVERT_TOL * 0.5) {
             converged = true;
             break;
         }
-        if (it > 0 && change > 0.5 * last_change)
-            break; /* not contracting: Newton takes over */
+        if (it > 0 && change > 0.5 * last_change) {
+            /* not contracting: where the steps were Newton's on D (with
+            ** J from the first evaluation: a term that varies fast makes J
+            ** a poor guide), plain fixed-point steps from the best point;
+            ** else Newton on the forward model takes over */
+            if (!(chord && have_n))
+                break;
+            chord = false;
+            g = best;
+            reachable = best_reachable;
+            dt = b_dt;
+            dd = b_dd;
+            dh_t = b_ht;
+            dh_d = b_hd;
+            dist_j = b_dist;
+            change = best_change;
+        }
         last_change = change;
         double nt = dt, nd = dd, ht, hd;
         if (!tried_n) { /* (F_D once, where the first step needs it) */
             tried_n = true;
             have_n = newton_prep(k, g, dh_t, dh_d, J, Ni);
         }
-        if (have_n && change <= 0.01) {
+        if (chord && have_n && change <= 0.01) {
             nt = dh_t + (Ni[0] * (dt - dh_t) + Ni[1] * (dd - dh_d));
             nd = dh_d + (Ni[2] * (dt - dh_t) + Ni[3] * (dd - dh_d));
         }
@@ -872,7 +902,8 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
     pm_status result = PM_OK;
     double err = 0;
     if (!converged || !reachable || (want && side_of(m, d) != want)) {
-        result = newton(m, k, ctx, a, turn, &t, &d, &err, want, PM_INVERT_MAX_NEWTON);
+        result = newton(m, k, ctx, a, turn, &t, &d, &err, want,
+                        PM_INVERT_MAX_FIXED + PM_INVERT_MAX_NEWTON - used);
         if (result != PM_OK && !reachable)
             result = PM_WARN_UNREACHABLE;
     }
