@@ -240,6 +240,7 @@ struct NPoint {
     double t, d, err;
     double F[2], M[4], H[6];
     double gt, gtt;
+    double da, db; /* the displacement D at (t, d) */
     double dphi; /* the target's azimuth about the mount's pole less p's */
     double pz[3]; /* q_z - p_z, and p's azimuth's and p_z's derivatives: */
     double pa[4]; /* (dA/dt, dA/dd, dz/dt, dz/dd) */
@@ -296,6 +297,8 @@ __attribute__((noinline)) void newton_point(const pm_model *m, const Iso<double>
     const V3<double> ptd = v3(-pd.y - cwt.x, pd.x - cwt.y, -cwt.z);
     o->t = t;
     o->d = d;
+    o->da = a;
+    o->db = b;
     o->F[0] = dot(W, f.e1);
     o->F[1] = dot(W, f.e2);
     o->M[0] = dot(pt, f.e1);
@@ -379,14 +382,20 @@ inline bool fold_step(const pm_model *m, const NPoint &c, int want, double *ht, 
         const double qq = -0.5 * (a1 + (a1 >= 0 ? m_sqrt(disc) : -m_sqrt(disc)));
         al = qq != 0 ? a0 / qq : 0; /* the nearer root */
         if (want && a2 != 0 && qq != 0) {
-            /* the other root where only it lies on the side wanted */
-            const double far = qq / a2;
-            if (m_fabs(far) <= 0.05 &&
-                side_of(m, c.d + al * v2[1] + b0 * v1[1]) != want &&
-                side_of(m, c.d + far * v2[1] + b0 * v1[1]) == want)
+            /* the other root where only it lies on the side wanted, and
+            ** the nearer one lies beyond the pole's edge by more than a
+            ** tenth of the way to it (else the nearer one, cut at the edge,
+            ** is as good: a solution on the edge itself) */
+            const double far = qq / a2, dn = c.d + al * v2[1] + b0 * v1[1];
+            PM_TRACE("roots", far, m_cos(dn - m->coef[4]), m_cos(c.d + far * v2[1] + b0 * v1[1] - m->coef[4]));
+            if (m_fabs(far) <= 0.2 && side_of(m, dn) != want &&
+                side_of(m, c.d + far * v2[1] + b0 * v1[1]) == want &&
+                m_fabs(m_cos(dn - m->coef[4])) > 0.05 * m_fabs((far - al) * v2[1]))
                 al = far;
         }
     }
+    PM_TRACE("fold", disc, al, s2 / s1);
+    PM_TRACE("fold2", a2, a1, a0);
     /* beta with the second-order part at (alpha, b0) */
     const double hh[2] = {al * v2[0] + b0 * v1[0], al * v2[1] + b0 * v1[1]};
     const double be = -(f1 + 0.5 * hess(c, u1, hh, hh)) / s1;
@@ -525,8 +534,9 @@ __attribute__((noinline)) pm_status newton(const pm_model *m, const Iso<double> 
             }
         }
         finish_angles(turn, &nt, &nd);
-        if (nt == cur.t && nd == cur.d)
-            break; /* no step left: the nearest point */
+        if (want && m_fabs(nt - cur.t) <= 1e-15 * m_fabs(cur.t) &&
+            m_fabs(nd - cur.d) <= 1e-15 * m_fabs(cur.d))
+            break; /* no step left (a few ulp): the nearest point */
         newton_point(m, k, ctx, f, nt, nd, &trial);
         evals++;
         if (better(m, trial, cur, want)) {
@@ -950,8 +960,20 @@ __attribute__((noinline)) pm_status pole_rescue(const pm_model *m, const Iso<dou
     const double qz = k.h[2] * q.x + k.h[5] * q.y + k.h[8] * q.z;
     const int hemi = qz >= 0 ? 1 : -1;
     const Frame f = frame_of(k, a);
-    /* the PM_INVERT_POLE_RUNS best edge points, best first */
+    const Target<double> tg = target_of(k, a.q);
+    /* The PM_INVERT_POLE_RUNS best edge points, best first; and at each
+    ** edge point the closed form for its displacement on both branches:
+    ** a solution is a fixed point t = t(F(D(t))) of the hour angle (the
+    ** displacement varies little between the pole's edge and a solution
+    ** near it), so a change of sign of t(F(D(t_j))) - t_j between two
+    ** neighbouring points brackets one: the closed form for the
+    ** interpolated displacement is a start close to it, where the edge
+    ** point with the smallest miss may lie near the solution on the other
+    ** side (the two are within the anisotropic amplitude of the pole's
+    ** edge, which the miss does not tell apart). */
     NPoint edge[PM_INVERT_POLE_RUNS + 1];
+    double sa[PM_INVERT_POLE_STARTS], sb[PM_INVERT_POLE_STARTS];
+    double res[2][PM_INVERT_POLE_STARTS];
     int n_edge = 0;
     for (int j = 0; j < PM_INVERT_POLE_STARTS; j++) {
         double tj = -PI + 2 * PI * (j + 0.5) / PM_INVERT_POLE_STARTS;
@@ -961,18 +983,63 @@ __attribute__((noinline)) pm_status pole_rescue(const pm_model *m, const Iso<dou
         finish_angles(turn, &tj, &dj);
         int i = n_edge < PM_INVERT_POLE_RUNS ? n_edge++ : PM_INVERT_POLE_RUNS;
         newton_point(m, k, ctx, f, tj, dj, &edge[i]);
+        sa[j] = edge[i].da;
+        sb[j] = edge[i].db;
+        for (int br = 0; br < 2; br++) {
+            Trig<double> g;
+            res[br][j] = 9; /* (none) */
+            if (iso_inverse<double>(k, tg, sa[j], sb[j], br ? -1 : 1, &g)) {
+                on_turn(m, k, a, &g, turn[0], turn[1]);
+                if (side_of(m, g.d) == side)
+                    res[br][j] = wrap_pi(g.t - tj);
+                PM_TRACE("ring", br * 10 + side_of(m, g.d), g.t, g.d - m->coef[4]);
+            } else PM_TRACE("ringx", br, tj, 0);
+        }
         for (; i > 0 && (edge[i].err < edge[i - 1].err || !(edge[i - 1].err >= 0)); i--) {
             NPoint x = edge[i];
             edge[i] = edge[i - 1];
             edge[i - 1] = x;
         }
     }
-    for (int r = 0; r < n_edge && !found; r++) {
-        if (!(edge[r].err >= 0))
-            break;
-        double tj = edge[r].t, dj = edge[r].d, ej;
-        pm_status sj = newton(m, k, ctx, a, turn, &tj, &dj, &ej, side,
-                              PM_INVERT_POLE_NEWTON, &edge[r]);
+    /* the tightest bracket (the smallest residuals either side); else the
+    ** point with the smallest residual */
+    int bb = -1, bj = -1;
+    double bscore = 2 * PI, w = 0;
+    for (int br = 0; br < 2; br++)
+        for (int j = 0; j < PM_INVERT_POLE_STARTS; j++) {
+            const double r0 = res[br][j], r1 = res[br][(j + 1) % PM_INVERT_POLE_STARTS];
+            double sc = m_fabs(r0) + PI; /* (no bracket) */
+            if (m_fabs(r0) < PI / 2 && m_fabs(r1) < PI / 2 && !(r0 * r1 > 0))
+                sc = m_fabs(r0) + m_fabs(r1);
+            if (sc < bscore) {
+                bscore = sc;
+                bb = br;
+                bj = j;
+                w = sc < PI && r0 != r1 ? r0 / (r0 - r1) : 0;
+            }
+        }
+    for (int r = 0; r < PM_INVERT_POLE_RUNS && !found; r++) {
+        double tj, dj, ej;
+        pm_status sj;
+        if (r == 0 && bb >= 0) {
+            /* Newton from the closed form in the bracket */
+            const int jn = (bj + 1) % PM_INVERT_POLE_STARTS;
+            Trig<double> g;
+            iso_inverse<double>(k, tg, sa[bj] + w * (sa[jn] - sa[bj]),
+                                sb[bj] + w * (sb[jn] - sb[bj]), bb ? -1 : 1, &g);
+            on_turn(m, k, a, &g, turn[0], turn[1]);
+            tj = g.t;
+            dj = g.d;
+            sj = newton(m, k, ctx, a, turn, &tj, &dj, &ej, side, PM_INVERT_POLE_NEWTON);
+        } else {
+            const int e = bb >= 0 ? r - 1 : r;
+            if (e >= n_edge || !(edge[e].err >= 0))
+                break;
+            tj = edge[e].t;
+            dj = edge[e].d;
+            sj = newton(m, k, ctx, a, turn, &tj, &dj, &ej, side, PM_INVERT_POLE_NEWTON,
+                        &edge[e]);
+        }
         if (side_of(m, dj) != side)
             continue;
         if (sj == PM_OK) {
