@@ -325,14 +325,25 @@ __attribute__((noinline)) void newton_point(const pm_model *m, const Iso<double>
     PM_TRACE("npt", t, d - m->coef[4], o->err);
 }
 
-/* H(x, y) of point c: the second-order part of F along steps x and y
-** (x_t y_t H_tt + (x_t y_d + x_d y_t) H_td + x_d y_d H_dd), projected on
-** u. */
-inline double hess(const NPoint &c, const double *u, const double *x, const double *y)
+/* The second-order part of F left out of the analytic H (the
+** displacement's own curvature), measured along the last step of the
+** iteration: a secant, C (ux, uy) along dir (a unit step).  H + (dir .
+** x)(dir . y) C then matches the change of F over that step to second
+** order (a symmetric rank-one correction). */
+struct Curv {
+    double dir[2], C[2];
+};
+
+/* H(x, y) of point c with the correction cv: the second-order part of F
+** along steps x and y (x_t y_t H_tt + (x_t y_d + x_d y_t) H_td + x_d y_d
+** H_dd), projected on u. */
+inline double hess(const NPoint &c, const Curv &cv, const double *u, const double *x,
+                   const double *y)
 {
     const double tt = x[0] * y[0], td = x[0] * y[1] + x[1] * y[0], dd = x[1] * y[1];
-    return u[0] * (tt * c.H[0] + td * c.H[2] + dd * c.H[4]) +
-           u[1] * (tt * c.H[1] + td * c.H[3] + dd * c.H[5]);
+    const double kk = (cv.dir[0] * x[0] + cv.dir[1] * x[1]) * (cv.dir[0] * y[0] + cv.dir[1] * y[1]);
+    return u[0] * (tt * c.H[0] + td * c.H[2] + dd * c.H[4] + kk * cv.C[0]) +
+           u[1] * (tt * c.H[1] + td * c.H[3] + dd * c.H[5] + kk * cv.C[1]);
 }
 
 /* The step h of the Newton iteration from point c: a root of the
@@ -348,7 +359,8 @@ inline double hess(const NPoint &c, const double *u, const double *x, const doub
 ** nearer), and where the quadratic has no root (the target is beyond the
 ** fold: unreachable here) its vertex, the fold's point nearest the
 ** target.  False where M is degenerate. */
-inline bool fold_step(const pm_model *m, const NPoint &c, int want, double *ht, double *hd)
+inline bool fold_step(const pm_model *m, const NPoint &c, const Curv &cv, int want, double *ht,
+                      double *hd)
 {
     const double A = c.M[0], B = c.M[1], C = c.M[2], D = c.M[3];
     const double j00 = A * A + C * C, j01 = A * B + C * D, j11 = B * B + D * D;
@@ -372,7 +384,8 @@ inline bool fold_step(const pm_model *m, const NPoint &c, int want, double *ht, 
     const double s2 = u2[0] * (A * v2[0] + B * v2[1]) + u2[1] * (C * v2[0] + D * v2[1]);
     const double f1 = u1[0] * c.F[0] + u1[1] * c.F[1], f2 = u2[0] * c.F[0] + u2[1] * c.F[1];
     const double b0 = -f1 / s1;
-    const double h11 = hess(c, u2, v1, v1), h12 = hess(c, u2, v1, v2), h22 = hess(c, u2, v2, v2);
+    const double h11 = hess(c, cv, u2, v1, v1), h12 = hess(c, cv, u2, v1, v2),
+                 h22 = hess(c, cv, u2, v2, v2);
     const double a2 = 0.5 * h22, a1 = s2 + b0 * h12, a0 = f2 + 0.5 * b0 * b0 * h11;
     const double disc = a1 * a1 - 4 * a2 * a0;
     double al;
@@ -390,7 +403,7 @@ inline bool fold_step(const pm_model *m, const NPoint &c, int want, double *ht, 
             PM_TRACE("roots", far, m_cos(dn - m->coef[4]), m_cos(c.d + far * v2[1] + b0 * v1[1] - m->coef[4]));
             if (m_fabs(far) <= 0.2 && side_of(m, dn) != want &&
                 side_of(m, c.d + far * v2[1] + b0 * v1[1]) == want &&
-                m_fabs(m_cos(dn - m->coef[4])) > 0.05 * m_fabs((far - al) * v2[1]))
+                m_fabs(m_cos(dn - m->coef[4])) > 0.01 * m_fabs((far - al) * v2[1]))
                 al = far;
         }
     }
@@ -398,7 +411,7 @@ inline bool fold_step(const pm_model *m, const NPoint &c, int want, double *ht, 
     PM_TRACE("fold2", a2, a1, a0);
     /* beta with the second-order part at (alpha, b0) */
     const double hh[2] = {al * v2[0] + b0 * v1[0], al * v2[1] + b0 * v1[1]};
-    const double be = -(f1 + 0.5 * hess(c, u1, hh, hh)) / s1;
+    const double be = -(f1 + 0.5 * hess(c, cv, u1, hh, hh)) / s1;
     *ht = al * v2[0] + be * v1[0];
     *hd = al * v2[1] + be * v1[1];
     return finite(*ht) && finite(*hd);
@@ -475,6 +488,7 @@ __attribute__((noinline)) pm_status newton(const pm_model *m, const Iso<double> 
     }
     double lam = 1, edge_t = 0, edge_g = 0;
     bool have_edge = false;
+    Curv cv = {{0, 0}, {0, 0}};
     while (!(cur.err <= PM_INVERT_TOL && (!want || side_of(m, cur.d) == want)) &&
            evals < budget) {
         double ht, hd;
@@ -490,7 +504,7 @@ __attribute__((noinline)) pm_status newton(const pm_model *m, const Iso<double> 
                 ht = cur.dphi / cur.pa[0];
                 hd = 0;
             }
-        } else if (!fold_step(m, cur, want, &ht, &hd))
+        } else if (!fold_step(m, cur, cv, want, &ht, &hd))
             break;
         /* a trust region: the quadratic model holds over a fraction of a
         ** radian at most (near the mount's pole, where the hour angle is
@@ -509,7 +523,7 @@ __attribute__((noinline)) pm_status newton(const pm_model *m, const Iso<double> 
             const double pole = m_sin(nd - m->coef[4]) >= 0 ? PI / 2 : -PI / 2;
             const double step_d = nd - cur.d;
             nd = edge_of(m, turn, pole, want);
-            if (nd != cur.d) {
+            if (!(m_fabs(nd - cur.d) <= 1e-15 * m_fabs(nd))) {
                 /* the step as far as the edge */
                 double frac = (nd - cur.d) / step_d;
                 frac = frac > 0 ? (frac < 1 ? frac : 1) : 0;
@@ -539,6 +553,26 @@ __attribute__((noinline)) pm_status newton(const pm_model *m, const Iso<double> 
             break; /* no step left (a few ulp): the nearest point */
         newton_point(m, k, ctx, f, nt, nd, &trial);
         evals++;
+        {
+            /* the secant of the curvature along this step (where it is
+            ** long enough for F's change to show it above rounding) */
+            const double h[2] = {wrap_pi(nt - cur.t), nd - cur.d};
+            const double hn2 = h[0] * h[0] + h[1] * h[1];
+            if (hn2 > 1e-12 && hn2 < 1) {
+                const double hn = m_sqrt(hn2);
+                const Curv zero = {{0, 0}, {0, 0}};
+                cv.dir[0] = h[0] / hn;
+                cv.dir[1] = h[1] / hn;
+                for (int i = 0; i < 2; i++) {
+                    const double u[2] = {i == 0 ? 1.0 : 0.0, i == 1 ? 1.0 : 0.0};
+                    const double s = trial.F[i] - cur.F[i] -
+                                     (cur.M[2 * i] * h[0] + cur.M[2 * i + 1] * h[1]);
+                    cv.C[i] = 2 * s / hn2 - hess(cur, zero, u, cv.dir, cv.dir);
+                }
+                if (!finite(cv.C[0]) || !finite(cv.C[1]))
+                    cv = zero;
+            }
+        }
         if (better(m, trial, cur, want)) {
             cur = trial;
             lam = 1;
@@ -923,6 +957,45 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
     return result;
 }
 
+/* The pole rescue's parametrisation: at encoder hour angle t (st, ct its
+** sine and cosine) and displacement (a, b), the rotation Pd(d') about the
+** declination axis that brings the pointing into the plane of the target
+** and that axis is (sdp, cdp) = (sin d', cos d') times |v_xz| |u_xz|
+** (u = (Pt(t') X)^T H^T q the target, v = T(i) expmap(a, b) the pointing,
+** both in the frame of the declination axis, y): exact.  Returns the miss
+** left along the axis, v_y - u_y: zero at a solution. */
+inline double ring_point(const Iso<double> &k, const V3<double> &q0, double st, double ct,
+                         double a, double b, double *sdp, double *cdp)
+{
+    const double stp = st * k.cc + ct * k.sc, ctp = ct * k.cc - st * k.sc;
+    const V3<double> u = rot_xt<double>(k.sd, k.cd, rot_zt<double>(stp, ctp, q0));
+    const V3<double> v = expmap_z<double>(k.si, k.ci, a, b);
+    *cdp = u.x * v.x + u.z * v.z;
+    *sdp = u.z * v.x - u.x * v.z;
+    return v.y - u.y;
+}
+
+/* The root in [0, 1] of the parabola through (x0 - 1, y0), (x0, y1),
+** (x0 + 1, y2), with x0 = 0 or 1, where the root is bracketed in [0, 1]
+** (the middle one of y0, y1 and y1, y2 of opposite signs). */
+inline double bracket_root(double y0, double y1, double y2, int x0)
+{
+    /* y = c0 + c1 u + c2 u^2, u = x - x0 */
+    const double c0 = y1, c1 = 0.5 * (y2 - y0), c2 = 0.5 * (y2 + y0) - y1;
+    const double ya = x0 ? y0 : y1, yb = x0 ? y1 : y2; /* at x = 0, 1 */
+    double r = ya != yb ? ya / (ya - yb) : 0; /* the straight line's */
+    const double disc = c1 * c1 - 4 * c2 * c0;
+    if (c2 != 0 && disc >= 0) {
+        const double sq = m_sqrt(disc);
+        const double u1 = (-c1 + sq) / (2 * c2) + x0, u2 = (-c1 - sq) / (2 * c2) + x0;
+        if (u1 >= 0 && u1 <= 1)
+            r = u1;
+        else if (u2 >= 0 && u2 <= 1)
+            r = u2;
+    }
+    return r;
+}
+
 /* The pole rescue of pm_model_invert (pm.h, Note 2), after both branches
 ** failed to give a PM_OK point on the requested side: (t, d, err) the
 ** first branch's point and status `result`, (t2, d2, err2) the second's
@@ -960,79 +1033,89 @@ __attribute__((noinline)) pm_status pole_rescue(const pm_model *m, const Iso<dou
     const double qz = k.h[2] * q.x + k.h[5] * q.y + k.h[8] * q.z;
     const int hemi = qz >= 0 ? 1 : -1;
     const Frame f = frame_of(k, a);
-    const Target<double> tg = target_of(k, a.q);
-    /* The PM_INVERT_POLE_RUNS best edge points, best first; and at each
-    ** edge point the closed form for its displacement on both branches:
-    ** a solution is a fixed point t = t(F(D(t))) of the hour angle (the
-    ** displacement varies little between the pole's edge and a solution
-    ** near it), so a change of sign of t(F(D(t_j))) - t_j between two
-    ** neighbouring points brackets one: the closed form for the
-    ** interpolated displacement is a start close to it, where the edge
-    ** point with the smallest miss may lie near the solution on the other
-    ** side (the two are within the anisotropic amplitude of the pole's
-    ** edge, which the miss does not tell apart). */
+    const V3<double> q0 = mat_tmul<double>(k.h, a.q);
+    /* A pole-aware parametrisation: for an hour angle t, the declination
+    ** d(t) that turns the pointing into the plane of the target and the
+    ** polar axis (exact, ring_point) leaves one equation, E(t) = 0 (the
+    ** pointing's miss along the declination axis), on the circle of hour
+    ** angles.  PM_INVERT_POLE_STARTS points round it: d(t_j) for no
+    ** displacement, one evaluation there (the displacement D_j, the
+    ** miss), d(t_j) and E(t_j) again with D_j.  A change of sign of E
+    ** between neighbours brackets a solution (the displacement changes
+    ** little between them): the interpolated hour angle and displacement
+    ** give a start close to it, on the side requested.  Newton runs from
+    ** the best bracket and then from the points with the smallest miss,
+    ** PM_INVERT_POLE_RUNS runs in all. */
+    const double step = 2 * PI / PM_INVERT_POLE_STARTS;
     NPoint edge[PM_INVERT_POLE_RUNS + 1];
-    double sa[PM_INVERT_POLE_STARTS], sb[PM_INVERT_POLE_STARTS];
-    double res[2][PM_INVERT_POLE_STARTS];
+    double sa[PM_INVERT_POLE_STARTS], sb[PM_INVERT_POLE_STARTS], se[PM_INVERT_POLE_STARTS];
     int n_edge = 0;
     for (int j = 0; j < PM_INVERT_POLE_STARTS; j++) {
-        double tj = -PI + 2 * PI * (j + 0.5) / PM_INVERT_POLE_STARTS;
-        /* dec - e' = +-(pi/2 - 1e-9) on the normal side, +-(pi/2 +
-        ** 1e-9) beyond the pole */
-        double dj = hemi * (PI / 2 - side * 1e-9) + m->coef[4];
+        double tj = -PI + step * (j + 0.5), st, ct, sdp, cdp;
+        sincos_d(tj, &st, &ct);
+        ring_point(k, q0, st, ct, 0.0, 0.0, &sdp, &cdp);
+        double dj = m_atan2(sdp, cdp) + m->coef[4];
         finish_angles(turn, &tj, &dj);
         int i = n_edge < PM_INVERT_POLE_RUNS ? n_edge++ : PM_INVERT_POLE_RUNS;
         newton_point(m, k, ctx, f, tj, dj, &edge[i]);
         sa[j] = edge[i].da;
         sb[j] = edge[i].db;
-        for (int br = 0; br < 2; br++) {
-            Trig<double> g;
-            res[br][j] = 9; /* (none) */
-            if (iso_inverse<double>(k, tg, sa[j], sb[j], br ? -1 : 1, &g)) {
-                on_turn(m, k, a, &g, turn[0], turn[1]);
-                if (side_of(m, g.d) == side)
-                    res[br][j] = wrap_pi(g.t - tj);
-                PM_TRACE("ring", br * 10 + side_of(m, g.d), g.t, g.d - m->coef[4]);
-            } else PM_TRACE("ringx", br, tj, 0);
-        }
+        se[j] = ring_point(k, q0, st, ct, sa[j], sb[j], &sdp, &cdp);
+        if (!finite(se[j]))
+            se[j] = 0;
+        PM_TRACE("ring", tj, dj - m->coef[4], se[j]);
         for (; i > 0 && (edge[i].err < edge[i - 1].err || !(edge[i - 1].err >= 0)); i--) {
             NPoint x = edge[i];
             edge[i] = edge[i - 1];
             edge[i - 1] = x;
         }
     }
-    /* the tightest bracket (the smallest residuals either side); else the
-    ** point with the smallest residual */
-    int bb = -1, bj = -1;
-    double bscore = 2 * PI, w = 0;
-    for (int br = 0; br < 2; br++)
-        for (int j = 0; j < PM_INVERT_POLE_STARTS; j++) {
-            const double r0 = res[br][j], r1 = res[br][(j + 1) % PM_INVERT_POLE_STARTS];
-            double sc = m_fabs(r0) + PI; /* (no bracket) */
-            if (m_fabs(r0) < PI / 2 && m_fabs(r1) < PI / 2 && !(r0 * r1 > 0))
-                sc = m_fabs(r0) + m_fabs(r1);
-            if (sc < bscore) {
-                bscore = sc;
-                bb = br;
-                bj = j;
-                w = sc < PI && r0 != r1 ? r0 / (r0 - r1) : 0;
-            }
+    /* the brackets on the side requested, by the smaller |E| of their ends
+    ** (a solution near a point where the displacement was evaluated) */
+    double bt[PM_INVERT_POLE_RUNS], bd[PM_INVERT_POLE_RUNS], bs[PM_INVERT_POLE_RUNS];
+    int n_b = 0;
+    for (int j = 0; j < PM_INVERT_POLE_STARTS; j++) {
+        const int jn = (j + 1) % PM_INVERT_POLE_STARTS;
+        const double e0 = se[j], e1 = se[jn];
+        if (e0 * e1 > 0)
+            continue;
+        /* the root in [0, 1] of the parabolas through the bracket and
+        ** either neighbour (E varies with the displacement, by the
+        ** harmonics of t: a straight line misses roots near a turning
+        ** point), averaged */
+        const double em = se[(j + PM_INVERT_POLE_STARTS - 1) % PM_INVERT_POLE_STARTS],
+                     ep = se[(jn + 1) % PM_INVERT_POLE_STARTS];
+        const double w = 0.5 * (bracket_root(em, e0, e1, 0) + bracket_root(e0, e1, ep, 1));
+        double tj = -PI + step * (j + 0.5 + w), st, ct, sdp, cdp;
+        sincos_d(tj, &st, &ct);
+        ring_point(k, q0, st, ct, sa[j] + w * (sa[jn] - sa[j]), sb[j] + w * (sb[jn] - sb[j]),
+                   &sdp, &cdp);
+        double dj = m_atan2(sdp, cdp) + m->coef[4];
+        finish_angles(turn, &tj, &dj);
+        if (side_of(m, dj) != side)
+            continue;
+        const double sc = m_fabs(e0) < m_fabs(e1) ? m_fabs(e0) : m_fabs(e1);
+        int i = n_b < PM_INVERT_POLE_RUNS ? n_b++ : PM_INVERT_POLE_RUNS - 1;
+        if (i == PM_INVERT_POLE_RUNS - 1 && n_b == PM_INVERT_POLE_RUNS && !(sc < bs[i]))
+            continue;
+        for (; i > 0 && sc < bs[i - 1]; i--) {
+            bt[i] = bt[i - 1];
+            bd[i] = bd[i - 1];
+            bs[i] = bs[i - 1];
         }
+        bt[i] = tj;
+        bd[i] = dj;
+        bs[i] = sc;
+    }
     for (int r = 0; r < PM_INVERT_POLE_RUNS && !found; r++) {
         double tj, dj, ej;
         pm_status sj;
-        if (r == 0 && bb >= 0) {
-            /* Newton from the closed form in the bracket */
-            const int jn = (bj + 1) % PM_INVERT_POLE_STARTS;
-            Trig<double> g;
-            iso_inverse<double>(k, tg, sa[bj] + w * (sa[jn] - sa[bj]),
-                                sb[bj] + w * (sb[jn] - sb[bj]), bb ? -1 : 1, &g);
-            on_turn(m, k, a, &g, turn[0], turn[1]);
-            tj = g.t;
-            dj = g.d;
+        if (r < n_b) {
+            tj = bt[r];
+            dj = bd[r];
             sj = newton(m, k, ctx, a, turn, &tj, &dj, &ej, side, PM_INVERT_POLE_NEWTON);
         } else {
-            const int e = bb >= 0 ? r - 1 : r;
+            const int e = r - n_b;
             if (e >= n_edge || !(edge[e].err >= 0))
                 break;
             tj = edge[e].t;
