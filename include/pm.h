@@ -80,9 +80,9 @@ extern "C" {
 ** the best of them and their length. */
 #define PM_INVERT_MAX_FIXED 4
 #define PM_INVERT_MAX_NEWTON 9
-#define PM_INVERT_POLE_STARTS 8
-#define PM_INVERT_POLE_RUNS 2
-#define PM_INVERT_POLE_NEWTON 16
+#define PM_INVERT_POLE_STARTS 12
+#define PM_INVERT_POLE_RUNS 3
+#define PM_INVERT_POLE_NEWTON 12
 /* Worst-case model evaluations per call, whatever the inputs:
 ** pm_model_invert_near one branch, fixed point then Newton (13);
 ** pm_model_invert two branches, then the pole rescue (66).

@@ -1010,7 +1010,6 @@ __attribute__((noinline)) pm_status pole_rescue(const pm_model *m, const Iso<dou
                                                 double *errp)
 {
     double t = *tp, d = *dp, err = *errp;
-    const V3<double> &q = a.q;
     /* Close to the mount's pole a solution on the requested side
     ** can lie between the pole and the fold, out of both branches'
     ** reach: Newton from PM_INVERT_POLE_STARTS points on the edge
@@ -1030,8 +1029,6 @@ __attribute__((noinline)) pm_status pole_rescue(const pm_model *m, const Iso<dou
         best_t = t2;
         best_d = d2;
     }
-    const double qz = k.h[2] * q.x + k.h[5] * q.y + k.h[8] * q.z;
-    const int hemi = qz >= 0 ? 1 : -1;
     const Frame f = frame_of(k, a);
     const V3<double> q0 = mat_tmul<double>(k.h, a.q);
     /* A pole-aware parametrisation: for an hour angle t, the declination
