@@ -3,7 +3,7 @@
 **  18, round 3): statuses and model evaluations, deterministic (the core
 **  with the evaluation counter of tests/probe.h).
 **
-**    pmbench_inv_stress real [N] [SEED]   N cold pm_model_invert calls
+**    pmbench_inv_stress real [N] [SEED] [RHO_MAX] [RHO_MIN]   N cold pm_model_invert calls
 **        (default 20,000) on realistic models near the mount's pole: order
 **        L = 0..2, isotropic terms uniform within +-10 deg, harmonic terms
 **        within +-10', both pier sides, the true encoder position within
@@ -31,7 +31,7 @@ static unsigned long probe_count;
 void pm_probe_hit(void) { probe_count++; }
 extern int pm_trace_on __attribute__((weak));
 
-static void real_sample(long n, unsigned long long seed)
+static void real_sample(long n, unsigned long long seed, double rho_max, double rho_min)
 {
     tu_rng r;
     long i, ok = 0, bad = 0, hist[PM_INVERT_MAX_EVALS + 2];
@@ -41,34 +41,14 @@ static void real_sample(long n, unsigned long long seed)
     memset(hist, 0, sizeof hist);
     tu_seed(&r, seed);
     for (i = 0; i < n; i++) {
-        double rho, t, d, ah, ad, eh, ed, bh, bd, e, rt, u;
-        int hemi, side, order, j, kind;
+        double rho, t, d, ah, ad, eh, ed, bh, bd, e, rt;
+        int side, kind;
         unsigned long evals;
         pm_status st;
-        if (i % 10 == 0) {
-            order = (int)(tu_uniform(&r) * 3);
-            if (pm_model_init(&m, PM_MOUNT_EQUATORIAL, order) != PM_OK)
-                abort();
-            for (j = 0; j < m.n_terms; j++)
-                m.coef[j] = (2 * tu_uniform(&r) - 1) * (j < 6 ? 10 * DEG : 10 * ARCSEC * 60);
-            if (pm_model_prepare(&m) != PM_OK)
-                abort();
-        }
+        if (i % 10 == 0 && hc_real_model(&m, &r) != 0)
+            abort();
         e = m.coef[4];
-        u = tu_uniform(&r);
-        kind = u < 0.4 ? 0 : u < 0.7 ? 1 : u < 0.9 ? 2 : 3;
-        if (kind == 0)
-            rho = sqrt(tu_uniform(&r)) * 0.5 * DEG;
-        else if (kind == 1)
-            rho = tu_uniform(&r) * 0.5 * DEG;
-        else if (kind == 2)
-            rho = pow(10, -10 + 7 * tu_uniform(&r));
-        else
-            rho = 0;
-        hemi = tu_uniform(&r) < 0.5 ? 1 : -1;
-        side = tu_uniform(&r) < 0.5 ? PM_SIDE_NORMAL : PM_SIDE_FLIPPED;
-        t = (2 * tu_uniform(&r) - 1) * M_PI;
-        d = e + hemi * (side == PM_SIDE_NORMAL ? M_PI / 2 - rho : M_PI / 2 + rho);
+        rho = hc_real_position(&m, &r, rho_max, rho_min, &side, &t, &d, &kind);
         if (pm_model_apply(&m, NULL, t, d, &ah, &ad) != PM_OK)
             abort();
         probe_count = 0;
@@ -102,9 +82,9 @@ static void real_sample(long n, unsigned long long seed)
         } else {
             if (bad < (getenv("STRESS_ALL") ? 1000000 : 20))
                 printf("  fail %ld: status %d, %lu evals, order %d, rho %.3e rad (kind %d), "
-                       "hemi %d side %d, t %.6f; round trip %.3e; result (%.9f, %.9f) "
+                       "side %d, t %.6f; round trip %.3e; result (%.9f, %.9f) "
                        "cos(dec-e') %.3e; coef d %.3e i %.3e a %.3e b %.3e\n",
-                       i, (int)st, evals, m.order, rho, kind, hemi, side, t, rt, eh, ed,
+                       i, (int)st, evals, m.order, rho, kind, side, t, rt, eh, ed,
                        cos(ed - e), m.coef[3], m.coef[5], m.coef[0], m.coef[1]);
             bad++;
         }
@@ -119,9 +99,9 @@ static void real_sample(long n, unsigned long long seed)
             if (!p99 && acc * 100 >= 99 * n)
                 p99 = (long)k;
         }
-        printf("real near the pole: %ld cold calls (seed %llu): %ld PM_OK, %ld not; evaluations "
+        printf("real, %g..%g rad from the pole: %ld cold calls (seed %llu): %ld PM_OK, %ld not; evaluations "
                "median %ld, p99 %ld, worst %lu (bound %d); worst PM_OK round trip %.2e rad\n",
-               n, seed, ok, bad, med, p99, worst, PM_INVERT_MAX_EVALS, worst_rt);
+               rho_min, rho_max, n, seed, ok, bad, med, p99, worst, PM_INVERT_MAX_EVALS, worst_rt);
     }
 }
 
@@ -207,7 +187,8 @@ int main(int argc, char **argv)
     if (argc >= 2 && !strcmp(argv[1], "real")) {
         long n = argc >= 3 ? atol(argv[2]) : 20000;
         unsigned long long seed = argc >= 4 ? strtoull(argv[3], 0, 10) : 1;
-        real_sample(n, seed);
+        double rmax = argc >= 5 ? atof(argv[4]) : 0.5 * DEG, rmin = argc >= 6 ? atof(argv[5]) : 0;
+        real_sample(n, seed, rmax, rmin);
         return 0;
     }
     if (argc >= 2 && !strcmp(argv[1], "hard")) {

@@ -117,4 +117,43 @@ static void hc_hard_start(tu_rng *r, const double *sol, double *sh, double *sd)
     }
 }
 
+/* A realistic model near the mount's pole (issue 18): equatorial, order
+** L = 0..2, every isotropic term uniform within +-10 deg, every harmonic
+** term within +-10'.  Returns 0, or -1 if the library refused it. */
+static int hc_real_model(pm_model *m, tu_rng *r)
+{
+    int order = (int)(tu_uniform(r) * 3), j;
+    if (pm_model_init(m, PM_MOUNT_EQUATORIAL, order) != PM_OK)
+        return -1;
+    for (j = 0; j < m->n_terms; j++)
+        m->coef[j] = (2 * tu_uniform(r) - 1) * (j < 6 ? 10 * DEG : 10 * ARCSEC * 60);
+    return pm_model_prepare(m) == PM_OK ? 0 : -1;
+}
+
+/* A true encoder position of realistic model m within rho_max rad of the
+** mount's pole (either pole, side PM_SIDE_*, hour angle all round): the
+** distance uniform in area (40%), uniform (30%), log-uniform from 1e-10
+** rad (20%), or exactly on the pole's edge (10%: rho = 0).  Returns the
+** distance (*kind: which of the four). */
+static double hc_real_position(const pm_model *m, tu_rng *r, double rho_max, double rho_min,
+                               int *side, double *t, double *d, int *kind)
+{
+    double u = tu_uniform(r), rho;
+    int hemi;
+    *kind = u < 0.4 ? 0 : u < 0.7 ? 1 : u < 0.9 ? 2 : 3;
+    if (*kind == 0)
+        rho = sqrt(rho_min * rho_min + tu_uniform(r) * (rho_max * rho_max - rho_min * rho_min));
+    else if (*kind == 1)
+        rho = rho_min + tu_uniform(r) * (rho_max - rho_min);
+    else if (*kind == 2)
+        rho = rho_min > 0 ? rho_min : pow(10, -10 + 7 * tu_uniform(r));
+    else
+        rho = rho_min;
+    hemi = tu_uniform(r) < 0.5 ? 1 : -1;
+    *side = tu_uniform(r) < 0.5 ? PM_SIDE_NORMAL : PM_SIDE_FLIPPED;
+    *t = (2 * tu_uniform(r) - 1) * M_PI;
+    *d = m->coef[4] + hemi * (*side == PM_SIDE_NORMAL ? M_PI / 2 - rho : M_PI / 2 + rho);
+    return rho;
+}
+
 #endif
