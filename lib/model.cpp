@@ -7,11 +7,6 @@
 #include "pm_detail.hpp"
 
 using namespace pm::detail;
-#ifndef PM_TRACE
-#define PM_TRACE(s, a, b, c) ((void)0)
-#else
-extern "C" void pm_trace(const char *, double, double, double);
-#endif
 
 namespace {
 
@@ -239,11 +234,8 @@ inline Frame frame_of(const Iso<double> &k, const Aim &a)
 struct NPoint {
     double t, d, err;
     double F[2], M[4], H[6];
-    double gt, gtt;
+    double gt;
     double da, db; /* the displacement D at (t, d) */
-    double dphi; /* the target's azimuth about the mount's pole less p's */
-    double pz[3]; /* q_z - p_z, and p's azimuth's and p_z's derivatives: */
-    double pa[4]; /* (dA/dt, dA/dd, dz/dt, dz/dd) */
 };
 
 __attribute__((noinline)) void newton_point(const pm_model *m, const Iso<double> &k,
@@ -312,17 +304,8 @@ __attribute__((noinline)) void newton_point(const pm_model *m, const Iso<double>
     o->H[4] = -dot(cdd, f.e1);
     o->H[5] = -dot(cdd, f.e2);
     o->gt = dot(pt, f.q);
-    o->gtt = dot(ptt, f.q);
     const V3<double> x = cross<double>(W, f.q);
     o->err = m_atan2(m_sqrt(dot<double>(x, x)), dot<double>(W, f.q));
-    o->dphi = m_atan2(x.z, W.x * f.q.x + W.y * f.q.y);
-    const double ir2 = 1 / (W.x * W.x + W.y * W.y);
-    o->pz[0] = f.q.z - W.z;
-    o->pa[0] = (W.x * pt.y - W.y * pt.x) * ir2;
-    o->pa[1] = (W.x * pd.y - W.y * pd.x) * ir2;
-    o->pa[2] = pt.z;
-    o->pa[3] = pd.z;
-    PM_TRACE("npt", t, d - m->coef[4], o->err);
 }
 
 /* The second-order part of F left out of the analytic H (the
@@ -400,15 +383,12 @@ inline bool fold_step(const pm_model *m, const NPoint &c, const Curv &cv, int wa
             ** tenth of the way to it (else the nearer one, cut at the edge,
             ** is as good: a solution on the edge itself) */
             const double far = qq / a2, dn = c.d + al * v2[1] + b0 * v1[1];
-            PM_TRACE("roots", far, m_cos(dn - m->coef[4]), m_cos(c.d + far * v2[1] + b0 * v1[1] - m->coef[4]));
             if (m_fabs(far) <= 0.2 && side_of(m, dn) != want &&
                 side_of(m, c.d + far * v2[1] + b0 * v1[1]) == want &&
                 m_fabs(m_cos(dn - m->coef[4])) > 0.01 * m_fabs((far - al) * v2[1]))
                 al = far;
         }
     }
-    PM_TRACE("fold", disc, al, s2 / s1);
-    PM_TRACE("fold2", a2, a1, a0);
     /* beta with the second-order part at (alpha, b0) */
     const double hh[2] = {al * v2[0] + b0 * v1[0], al * v2[1] + b0 * v1[1]};
     const double be = -(f1 + 0.5 * hess(c, cv, u1, hh, hh)) / s1;
@@ -451,9 +431,6 @@ inline bool better(const pm_model *m, const NPoint &x, const NPoint &c, int want
     return gx0 * gx0 + gx1 * gx1 < gc0 * gc0 + gc1 * gc1;
 }
 
-#ifndef AZ_STEP
-#define AZ_STEP 100
-#endif
 #ifndef NEWTON_MAX_STEP
 #define NEWTON_MAX_STEP 1.0
 #endif
@@ -492,19 +469,7 @@ __attribute__((noinline)) pm_status newton(const pm_model *m, const Iso<double> 
     while (!(cur.err <= PM_INVERT_TOL && (!want || side_of(m, cur.d) == want)) &&
            evals < budget) {
         double ht, hd;
-        if (m_fabs(cur.dphi) > AZ_STEP) {
-            /* far round the mount's pole from the target: the turn about
-            ** the polar axis that brings p to the target's azimuth (the
-            ** quadratic model does not hold over such a turn) */
-            const double det = cur.pa[0] * cur.pa[3] - cur.pa[1] * cur.pa[2];
-            if (m_fabs(det) > 1e-6 * m_fabs(cur.pa[0] * cur.pa[3])) {
-                ht = (cur.pa[3] * cur.dphi - cur.pa[1] * cur.pz[0]) / det;
-                hd = (cur.pa[0] * cur.pz[0] - cur.pa[2] * cur.dphi) / det;
-            } else {
-                ht = cur.dphi / cur.pa[0];
-                hd = 0;
-            }
-        } else if (!fold_step(m, cur, cv, want, &ht, &hd))
+        if (!fold_step(m, cur, cv, want, &ht, &hd))
             break;
         /* a trust region: the quadratic model holds over a fraction of a
         ** radian at most (near the mount's pole, where the hour angle is
@@ -845,7 +810,6 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
         if (!finite(dt * dt + dd * dd))
             break; /* the forward model overflows here: not converged */
         change = m_sqrt((dt - dh_t) * (dt - dh_t) + (dd - dh_d) * (dd - dh_d));
-        PM_TRACE("fix", side, it, change);
         if (change < best_change) {
             best_change = change;
             best = g;
@@ -1060,7 +1024,6 @@ __attribute__((noinline)) pm_status pole_rescue(const pm_model *m, const Iso<dou
         se[j] = ring_point(k, q0, st, ct, sa[j], sb[j], &sdp, &cdp);
         if (!finite(se[j]))
             se[j] = 0;
-        PM_TRACE("ring", tj, dj - m->coef[4], se[j]);
         for (; i > 0 && (edge[i].err < edge[i - 1].err || !(edge[i - 1].err >= 0)); i--) {
             NPoint x = edge[i];
             edge[i] = edge[i - 1];
@@ -1092,8 +1055,12 @@ __attribute__((noinline)) pm_status pole_rescue(const pm_model *m, const Iso<dou
         if (side_of(m, dj) != side)
             continue;
         const double sc = m_fabs(e0) < m_fabs(e1) ? m_fabs(e0) : m_fabs(e1);
-        int i = n_b < PM_INVERT_POLE_RUNS ? n_b++ : PM_INVERT_POLE_RUNS - 1;
-        if (i == PM_INVERT_POLE_RUNS - 1 && n_b == PM_INVERT_POLE_RUNS && !(sc < bs[i]))
+        int i;
+        if (n_b < PM_INVERT_POLE_RUNS)
+            i = n_b++;
+        else if (sc < bs[PM_INVERT_POLE_RUNS - 1])
+            i = PM_INVERT_POLE_RUNS - 1; /* (replaces the last) */
+        else
             continue;
         for (; i > 0 && sc < bs[i - 1]; i--) {
             bt[i] = bt[i - 1];
@@ -1175,7 +1142,6 @@ pm_status invert(const pm_model *m, const pm_context *ctx, double app_ha,
     double turn[2], t, d, err;
     turn_of(start, side, m->coef[4], turn);
     pm_status result = solve_branch(m, k, ctx, a, side, start ? 0 : side, start, turn, &t, &d, &err);
-    PM_TRACE("branch1", result, side_of(m, d), err);
     if (!start && (result != PM_OK || side_of(m, d) != side)) {
         /* Within the anisotropic amplitude of the mount's pole the closed
         ** form's branches (sign of cos(dec - e' + displacement angle)) and
@@ -1183,7 +1149,6 @@ pm_status invert(const pm_model *m, const pm_context *ctx, double app_ha,
         ** branch may hold the solution on the requested side. */
         double t2, d2, err2;
         pm_status r2 = solve_branch(m, k, ctx, a, -side, side, 0, turn, &t2, &d2, &err2);
-        PM_TRACE("branch2", r2, side_of(m, d2), err2);
         if (r2 == PM_OK && side_of(m, d2) == side) {
             result = r2;
             t = t2;
