@@ -320,7 +320,7 @@ struct Curv {
 /* H(x, y) of point c with the correction cv: the second-order part of F
 ** along steps x and y (x_t y_t H_tt + (x_t y_d + x_d y_t) H_td + x_d y_d
 ** H_dd), projected on u. */
-inline double hess(const NPoint &c, const Curv &cv, const double *u, const double *x,
+__attribute__((noinline)) double hess(const NPoint &c, const Curv &cv, const double *u, const double *x,
                    const double *y)
 {
     const double tt = x[0] * y[0], td = x[0] * y[1] + x[1] * y[0], dd = x[1] * y[1];
@@ -342,7 +342,7 @@ inline double hess(const NPoint &c, const Curv &cv, const double *u, const doubl
 ** nearer), and where the quadratic has no root (the target is beyond the
 ** fold: unreachable here) its vertex, the fold's point nearest the
 ** target.  False where M is degenerate. */
-inline bool fold_step(const pm_model *m, const NPoint &c, const Curv &cv, int want, double *ht,
+__attribute__((noinline)) bool fold_step(const pm_model *m, const NPoint &c, const Curv &cv, int want, double *ht,
                       double *hd)
 {
     const double A = c.M[0], B = c.M[1], C = c.M[2], D = c.M[3];
@@ -928,7 +928,7 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
 ** (u = (Pt(t') X)^T H^T q the target, v = T(i) expmap(a, b) the pointing,
 ** both in the frame of the declination axis, y): exact.  Returns the miss
 ** left along the axis, v_y - u_y: zero at a solution. */
-inline double ring_point(const Iso<double> &k, const V3<double> &q0, double st, double ct,
+__attribute__((noinline)) double ring_point(const Iso<double> &k, const V3<double> &q0, double st, double ct,
                          double a, double b, double *sdp, double *cdp)
 {
     const double stp = st * k.cc + ct * k.sc, ctp = ct * k.cc - st * k.sc;
@@ -942,7 +942,7 @@ inline double ring_point(const Iso<double> &k, const V3<double> &q0, double st, 
 /* The root in [0, 1] of the parabola through (x0 - 1, y0), (x0, y1),
 ** (x0 + 1, y2), with x0 = 0 or 1, where the root is bracketed in [0, 1]
 ** (the middle one of y0, y1 and y1, y2 of opposite signs). */
-inline double bracket_root(double y0, double y1, double y2, int x0)
+__attribute__((noinline)) double bracket_root(double y0, double y1, double y2, int x0)
 {
     /* y = c0 + c1 u + c2 u^2, u = x - x0 */
     const double c0 = y1, c1 = 0.5 * (y2 - y0), c2 = 0.5 * (y2 + y0) - y1;
