@@ -15,6 +15,13 @@
 **        cases (tests/hard_cases.h, the same sequence as the test): PM_OK
 **        counts of the double pm_model_invert and pm_model_invert_near
 **
+**    pmbench_inv_stress float ISO_DEG ANISO_ARCMIN RHO0_DEG RHO1_DEG   20,000
+**        pm_model_invert_f calls, L = 2 models with every isotropic term
+**        uniform within +-ISO_DEG and every harmonic term within
+**        +-ANISO_ARCMIN, the true position RHO0..RHO1 deg from the mount's
+**        pole (normal side): statuses, round trips through the float and
+**        the double forward models, the float forward's own jitter
+**
 **  Prints one summary line per sample and the failures (up to 20).
 */
 #include <math.h>
@@ -182,8 +189,67 @@ static void hard_sample(void)
            PM_INVERT_NEAR_MAX_EVALS);
 }
 
+static void float_sample(double iso, double an, double r0, double r1)
+{
+    int n = 20000, bad = 0, big = 0, i, j, k;
+    tu_rng r;
+    pm_model m;
+    pm_model_f mf;
+    double worst_ok = 0, worst_noise = 0, worst_warn = 0, worst_dbl = 0;
+    tu_seed(&r, 7);
+    for (i = 0; i < n; i++) {
+        double rho, t, d, ah, ad, eh, ed, bh, bd, ch, cd, h0, d0, rt, e;
+        pm_status st;
+        if (i % 10 == 0) {
+            if (pm_model_init(&m, PM_MOUNT_EQUATORIAL, 2) != PM_OK)
+                abort();
+            for (j = 0; j < m.n_terms; j++)
+                m.coef[j] = (2 * tu_uniform(&r) - 1) * (j < 6 ? iso : an);
+            if (pm_model_prepare(&m) != PM_OK || pm_model_f_prepare(&mf, &m) != PM_OK)
+                abort();
+        }
+        rho = (r0 + (r1 - r0) * tu_uniform(&r)) * DEG;
+        t = (2 * tu_uniform(&r) - 1) * M_PI;
+        d = m.coef[4] + M_PI / 2 - rho;
+        pm_model_apply(&m, NULL, t, d, &ah, &ad);
+        st = pm_model_invert_f(&mf, NULL, ah, ad, PM_SIDE_NORMAL, &eh, &ed);
+        /* the float forward's jitter near the true point (steps of 1e-12 rad) */
+        pm_model_apply_f(&mf, NULL, t, d, &h0, &d0);
+        for (k = 1; k < 8; k++) {
+            double h1, d1;
+            pm_model_apply_f(&mf, NULL, t + k * 1e-12, d + k * 1e-12, &h1, &d1);
+            e = tu_angle(h1, d1, h0, d0);
+            if (e > worst_noise)
+                worst_noise = e;
+        }
+        pm_model_apply_f(&mf, NULL, eh, ed, &bh, &bd);
+        rt = tu_angle(bh, bd, ah, ad);
+        pm_model_apply(&m, NULL, eh, ed, &ch, &cd);
+        e = tu_angle(ch, cd, ah, ad);
+        if (e > worst_dbl)
+            worst_dbl = e;
+        if (st != PM_OK) {
+            bad++;
+            big += rt > 1e-7;
+            if (rt > worst_warn)
+                worst_warn = rt;
+        } else if (rt > worst_ok)
+            worst_ok = rt;
+    }
+    printf("float, isotropic %g deg, harmonic %g', %g..%g deg from the pole: %d of %d not PM_OK "
+           "(%d beyond 1e-7 rad); round trip through the float forward: PM_OK worst %.2e, "
+           "warnings worst %.2e; through the double forward %.2e; float forward jitter %.2e\n",
+           iso / DEG, an / (ARCSEC * 60), r0, r1, bad, n, big, worst_ok, worst_warn, worst_dbl,
+           worst_noise);
+}
+
 int main(int argc, char **argv)
 {
+    if (argc >= 6 && !strcmp(argv[1], "float")) {
+        float_sample(atof(argv[2]) * DEG, atof(argv[3]) * ARCSEC * 60, atof(argv[4]),
+                     atof(argv[5]));
+        return 0;
+    }
     if (argc >= 2 && !strcmp(argv[1], "real")) {
         long n = argc >= 3 ? atol(argv[2]) : 20000;
         unsigned long long seed = argc >= 4 ? strtoull(argv[3], 0, 10) : 1;
@@ -195,6 +261,7 @@ int main(int argc, char **argv)
         hard_sample();
         return 0;
     }
-    fprintf(stderr, "usage: pmbench_inv_stress real [N] [SEED] | hard\n");
+    fprintf(stderr, "usage: pmbench_inv_stress real [N] [SEED] [RHO_MAX] [RHO_MIN] | hard | "
+                    "float ISO_DEG ANISO_ARCMIN RHO0_DEG RHO1_DEG\n");
     return 2;
 }
