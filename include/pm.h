@@ -75,9 +75,10 @@ extern "C" {
 /* Hard iteration bounds of pm_model_invert (see its Notes 1 and 2), in
 ** model evaluations (each about one pm_model_apply, the Jacobian
 ** included): the closed form's fixed point on one branch, the Newton
-** iteration that takes over where it does not converge, the points of the
-** mount's pole's edge the pole rescue ranks, the Newton runs it makes from
-** the best of them and their length. */
+** iteration that takes over where it does not converge (it also gets the
+** evaluations the fixed point left), the points of the ring round the
+** mount's pole the pole rescue samples, the Newton runs it makes from the
+** best starts they give and their length. */
 #define PM_INVERT_MAX_FIXED 4
 #define PM_INVERT_MAX_NEWTON 9
 #define PM_INVERT_POLE_STARTS 12
@@ -85,9 +86,9 @@ extern "C" {
 #define PM_INVERT_POLE_NEWTON 12
 /* Worst-case model evaluations per call, whatever the inputs:
 ** pm_model_invert_near one branch, fixed point then Newton (13);
-** pm_model_invert two branches, then the pole rescue (66).
-** pm_model_apply makes exactly one.  tests/check_bounded.c counts them on
-** adversarial inputs. */
+** pm_model_invert two branches, then the pole rescue (2 x 13 + 12 +
+** 3 x 12 = 74).  pm_model_apply makes exactly one.  tests/check_bounded.c
+** counts them on adversarial inputs. */
 #define PM_INVERT_NEAR_MAX_EVALS (PM_INVERT_MAX_FIXED + PM_INVERT_MAX_NEWTON)
 #define PM_INVERT_MAX_EVALS \
     (2 * (PM_INVERT_MAX_FIXED + PM_INVERT_MAX_NEWTON) + PM_INVERT_POLE_STARTS + \
@@ -111,26 +112,28 @@ extern "C" {
 ** 12 -O2, the library at PM_MAX_L = 4:
 **   tracking beyond 0.5 deg of the mount's pole, 10 Hz or faster, terms
 **   within 10 deg / 10' (PM_INVERT_TRACK_MAX_EVALS): the Cortex-M7
-**   double inverse took at most 3,855 instructions at its worst measured
+**   double inverse took at most 3,870 instructions at its worst measured
 **   3 evaluations; PM_BUDGET_M7_TRACK_INSNS adds 5 more evaluations of
 **   PM_BUDGET_M7_INSNS_PER_EVAL each, for the bound of 8.
 **   PM_BUDGET_M7_INSNS_PER_EVAL: an evaluation of the Newton iteration
 **   (the displacement with its Jacobian, sin/cos of the point, the
-**   rotations and their derivatives) is the dearest kind: the worst
-**   measured call of a harmonic L = 2 model near the pole (96,315
-**   instructions, at most 63 evaluations) is within 2,000 + 63 x 1,500;
-**   2,000 leaves room for a call that takes that count with fewer
-**   evaluations (the bench does not pair them).  So a call of
-**   pm_model_invert_near stays within 2,000 + 13 x 2,000 instructions,
-**   one of pm_model_invert within 2,000 + 66 x 2,000 (harmonic and AUX
-**   terms at L = 2; added periodic or zenith terms cost more).
+**   rotations and their first and second derivatives, the step's
+**   singular directions) is the dearest kind: the worst measured call of
+**   a harmonic L = 2 model near the pole (98,400 instructions, at most 41
+**   evaluations) is within 2,000 + 41 x 2,350; 2,500 leaves room for a
+**   call that takes that count with fewer evaluations (the bench does not
+**   pair them).  So a call of pm_model_invert_near stays within 2,000 +
+**   13 x 2,500 instructions, one of pm_model_invert within 2,000 + 74 x
+**   2,500 (harmonic and AUX terms at L = 2; added periodic or zenith
+**   terms cost more).
 **   The float build on the Cortex-M4F (pm_model_invert_near_f): at most
 **   PM_INVERT_F_MAX_EVALS evaluations; PM_BUDGET_M4F_F_INSNS_PER_EVAL the
 **   most one costs (2,926 measured near the pole).  It is no faster than
-**   the double build's bound near the pole or with 10' terms (its inverse
-**   fails to converge there more often: docs/performance.md). */
-#define PM_BUDGET_M7_INSNS_PER_EVAL 2000
-#define PM_BUDGET_M7_TRACK_INSNS (3855 + 5 * PM_BUDGET_M7_INSNS_PER_EVAL)
+**   the double build's bound near the pole or with isotropic terms of
+**   degrees (its inverse fails to converge there more often:
+**   pm_model_invert_f Note 3). */
+#define PM_BUDGET_M7_INSNS_PER_EVAL 2500
+#define PM_BUDGET_M7_TRACK_INSNS (3870 + 5 * PM_BUDGET_M7_INSNS_PER_EVAL)
 #define PM_BUDGET_M4F_F_INSNS_PER_EVAL 3000
 
 /* ---------------------------------------------------------------------- */
@@ -448,45 +451,71 @@ pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
 **     |F_D| ~ 1/cos of the distance, with 10' terms): hence
 **     PM_INVERT_TRACK_MAX_EVALS = 8 (measured worst 4 with ticks up to
 **     0.1 s, 6 with 1 s ticks within a degree of the pole).  At most
-**     PM_INVERT_MAX_FIXED (4) such steps: where they have not converged by
-**     then (within about the anisotropic amplitude of the mount's pole,
-**     where the closed form's branch is ill-conditioned, or for
-**     displacements of degrees) Newton steps on the full forward model
-**     take over from the best point: the residual is the tangent offset
-**     of the model's position from the target, its Jacobian analytic (the
-**     rotations' derivatives and J, every term kind differentiated), so
-**     each trial point costs one evaluation; a trial that does not reduce
-**     the miss shortens the step to a quarter, and steps are capped at 1
-**     rad (a trust region: near the pole the hour angle is ill-determined
-**     and the linear model holds over little).  Newton converges
-**     quadratically from the points the fixed point hands it; at most
-**     PM_INVERT_MAX_NEWTON (9) trial points.  So pm_model_invert_near
-**     needs at most PM_INVERT_NEAR_MAX_EVALS = PM_INVERT_MAX_FIXED +
-**     PM_INVERT_MAX_NEWTON = 13 evaluations, whatever the inputs (the
-**     misses of the points it returns are those measured on the way: no
-**     evaluation to check them).  The round-trip error
-**     |apply(invert(x)) - x| is below PM_INVERT_TOL on return with PM_OK.
+**     PM_INVERT_MAX_FIXED (4) such steps (where Newton's steps on D do not
+**     contract -- a term that varies fast makes the first evaluation's J a
+**     poor guide -- plain fixed-point steps D^' = D(x) from the best point,
+**     within the same 4): where they have not converged by then (within
+**     about the anisotropic amplitude of the mount's pole, where the
+**     closed form's branch is ill-conditioned, or for displacements of
+**     degrees) Newton steps on the full forward model take over from the
+**     best point, with the evaluations the fixed point left: the residual
+**     is the tangent offset F of the model's position from the target, its
+**     Jacobian M analytic (the rotations' derivatives and J, every term
+**     kind differentiated), so each trial point costs one evaluation.  The
+**     step solves the quadratic model F + M h + H(h,h)/2 = 0 (H: the
+**     rotations' second derivatives, analytic, plus the displacement's,
+**     measured along the last step by the secant): in M's singular
+**     directions a Newton step along the regular one and a quadratic along
+**     the near-null one.  At the fold of the mount's pole (the edge of the
+**     cap the tube cannot reach, where M is singular and the two
+**     solutions either side of the edge merge) plain Newton halves its
+**     distance to the fold per step; the quadratic gives both solutions,
+**     and the one on the side asked for is taken (the other root where
+**     only it lies on that side), its vertex where the target is beyond
+**     the fold (the nearest point).  A trial that is not better (on the
+**     side asked for, then a smaller miss) shortens the step to a quarter;
+**     steps are capped at 1 rad (a trust region: near the pole the hour
+**     angle is ill-determined); a step beyond the pole's edge from the
+**     side asked for stops at the edge, and from the edge the step is
+**     along it (Gauss-Newton, then the secant of dp/dt . q: the nearest
+**     point of the edge where the target is out of reach).  At most
+**     PM_INVERT_MAX_FIXED + PM_INVERT_MAX_NEWTON evaluations in all: so
+**     pm_model_invert_near needs at most PM_INVERT_NEAR_MAX_EVALS = 13
+**     evaluations, whatever the inputs (the misses of the points it
+**     returns are those measured on the way: no evaluation to check them).
+**     The round-trip error |apply(invert(x)) - x| is below PM_INVERT_TOL
+**     on return with PM_OK.
 **  2) Within a few arcminutes of the mount's pole the closed form's two
 **     branches need not match the two sides of the pole (the anisotropic
 **     terms fold the sky there), so pm_model_invert tries the other
-**     branch (fixed point and Newton again: 13 more), then the pole
-**     rescue: PM_INVERT_POLE_STARTS (8) points on the edge of the mount's
-**     pole nearer the target (the other pole is about 180 deg away), on
-**     the requested side, are evaluated (8) and Newton, locked to that
-**     side (a trial point beyond the pole is moved back onto its edge, and
-**     there the step is the secant of the hour angle along the edge, so
-**     that an unreachable target gets the nearest point), runs from the
-**     PM_INVERT_POLE_RUNS (2) best of them for PM_INVERT_POLE_NEWTON (16)
-**     trial points each (32).  Hard bound, whatever the inputs:
-**     PM_INVERT_MAX_EVALS = 2 x 13 + 8 + 2 x 16 = 66 model evaluations;
-**     elsewhere a few.  For tracking use pm_model_invert_near, which never
-**     needs the rescue (at most 13).
+**     branch (fixed point and Newton again, for the side asked for: 13
+**     more), then the pole rescue, a pole-aware parametrisation: for an
+**     hour angle t the declination d(t) that turns the pointing into the
+**     plane of the target and the polar axis is exact (one rotation about
+**     the declination axis), which leaves one equation E(t) = 0 (the miss
+**     along that axis) on the circle of hour angles.  E is sampled at
+**     PM_INVERT_POLE_STARTS (12) hour angles round the pole (one
+**     evaluation each, for the displacement there), its changes of sign
+**     bracket the solutions (roots by the parabolas through the
+**     neighbours), and Newton, locked to the side asked for, runs from the
+**     brackets on that side, then from the samples with the least miss:
+**     PM_INVERT_POLE_RUNS (3) runs of PM_INVERT_POLE_NEWTON (12) trial
+**     points (36).  Hard bound, whatever the inputs: PM_INVERT_MAX_EVALS =
+**     2 x 13 + 12 + 3 x 12 = 74 model evaluations; elsewhere a few.
+**     Realistic models (L <= 2, isotropic terms within 10 deg, harmonic
+**     terms within 10') reach every target a mount can reach with PM_OK:
+**     none of 800,000 cold calls within 0.5 deg of the mount's pole, down
+**     to its very edge, failed (bench/inv_stress.c; tests/check_bounded.c
+**     asserts 48,000 of them).  For tracking use pm_model_invert_near,
+**     which never needs the rescue (at most 13).
 **  3) PM_WARN_NOT_CONVERGED: a bound was reached; the best position found
 **     is returned.  PM_WARN_UNREACHABLE: no position on the requested side
 **     points at the target: it lies in the cap around the mount's pole
 **     that collimation, non-perpendicularity and the anisotropic terms
 **     make unreachable from that side; the nearest position found on that
-**     side is returned.
+**     side is returned (where the miss is stationary: the fold's vertex or
+**     the edge's nearest point, within 1e-9 rad of a brute-force scan in
+**     tests/check_model.c).
 **  4) The round trip holds at the angles returned, as rounded to doubles.
 **     The fixed point is judged before that rounding, with PM_INVERT_TOL/2
 **     to spare; where the rounding times how fast the anisotropic
@@ -634,8 +663,22 @@ pm_status pm_model_f_prepare(pm_model_f *mf, const pm_model *m);
 **     PM_INVERT_F_TOL (0.002", above the float forward's own noise of
 **     ~0.0002"), not 1e-13.
 **     PM_WARN_NOT_CONVERGED if the bound is reached or the solution found
-**     is on the other side of the mount's pole; this happens only within
-**     about a degree of the mount's pole (use the double build there).
+**     is on the other side of the mount's pole.
+**  3) What to expect (bench/inv_stress.c "float", L = 2, harmonic terms
+**     within 10', 20,000 targets per row, docs/performance.md): the float
+**     forward's own rounding grows with the correction it carries, about
+**     1e-7 of it (isotropic terms of 1 deg: 3e-9 rad; of 10 deg: up to
+**     4e-8 rad, above PM_INVERT_F_TOL).  With isotropic terms within 1
+**     deg every inverse 5 to 90 deg from the mount's pole returns PM_OK.
+**     With terms of several degrees some end PM_WARN_NOT_CONVERGED at
+**     that noise floor (the position returned within 5e-8 rad of the
+**     target: 10 deg terms, 3% of targets beyond 20 deg from the pole,
+**     15% at 10-20 deg), and within about |d| + |i| of the mount's pole
+**     the float inverse (it has no pole rescue) can miss altogether (10
+**     deg terms, 5-10 deg from the pole: 2% of targets beyond 1e-7 rad).
+**     A float firmware with large isotropic terms should judge a warning
+**     by the round trip it needs and, near the mount's pole, use the
+**     double pm_model_invert (about 90,000 instructions on the M4F).
 */
 #define PM_INVERT_F_FIXED 6
 #define PM_INVERT_F_MAX 12
