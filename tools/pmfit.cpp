@@ -207,8 +207,9 @@ void usage(FILE *f)
         "  index terms (c', e') suffices or a full refit is needed (cross-validated)\n"
         "\n"
         "usage: pmfit report RUN -o PAGE.html [--order L] [--add EFFECT ...] [--compare OLD]\n"
-        "                    [--next K] [--alpha P] [--gear [ha:|dec:]G ...] [--no-refraction]\n"
-        "                    [--skip-bad] [--format NAME] [--equinox J2000|JNow]\n"
+        "                    [--next K] [--min-el DEG] [--horizon FILE] [--alpha P]\n"
+        "                    [--gear [ha:|dec:]G ...] [--no-refraction] [--skip-bad]\n"
+        "                    [--format NAME] [--equinox J2000|JNow]\n"
         "                    [--quiet | --progress]\n"
         "\n"
         "  one self-contained HTML page (inline SVG, no script, no network): the fit and its\n"
@@ -318,6 +319,10 @@ Options parse_report(Options o, int argc, char **argv)
             o.compare = need("OLD: a saved model or a run");
         } else if (a == "--next") {
             o.next = (int)number(a, need("a count"), 1, 1000);
+        } else if (a == "--min-el") {
+            o.min_el = number(a, need("degrees"), -10, 80);
+        } else if (a == "--horizon") {
+            o.horizon = need("a horizon file");
         } else if (a == "--alpha") {
             o.alpha = number(a, need("a probability"), 1e-12, 0.5);
         } else if (a == "--gear") {
@@ -1350,6 +1355,8 @@ int cmd_report(const Options &o, const Run &run, int argc, char **argv)
     ro.gears_ha = o.gears_ha;
     ro.gears_dec = o.gears_dec;
     ro.next = o.next;
+    ro.min_el_deg = o.min_el;
+    ro.horizon = o.horizon;
     ro.compare = o.compare;
     ro.refraction = o.refraction;
     ro.skip_bad = o.skip_bad;
