@@ -218,6 +218,7 @@ include bench/bench.mk
 # time; rules: fuzz/fuzz.mk) and make sanitize (the Check suite under ASan +
 # UBSan).
 -include fuzz/fuzz.mk
+include indi/indi.mk  # INDI alignment math plugin: make indi, indi-install (docs/indi.md)
 
 firmware: deps
 	@$(MAKE) --no-print-directory firmware-run
