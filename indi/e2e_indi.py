@@ -33,6 +33,7 @@ import socket
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -156,6 +157,44 @@ def lst_rad():
 
 def ra_hours(lst, h):
     return (lst - h) % (2 * math.pi) / (15 * D2R)
+
+
+def stop_server(srv):
+    """Stop indiserver and its driver (their own process group)."""
+    try:
+        os.killpg(srv.pid, 15)
+    except ProcessLookupError:
+        pass
+    try:
+        srv.wait(timeout=10)
+    except subprocess.TimeoutExpired:
+        os.killpg(srv.pid, 9)
+        srv.wait()
+
+
+def die_with_parent():
+    """In the server's process: SIGTERM when this script dies (Linux)."""
+    try:
+        ctypes.CDLL(None).prctl(1, 15)   # PR_SET_PDEATHSIG, SIGTERM
+    except (OSError, AttributeError):
+        pass
+
+
+def watchdog(srv, deadline, home):
+    """Stop the server and exit if the process that started this script goes
+    away (a killed test) or the run takes longer than deadline seconds."""
+    parent, end = os.getppid(), time.time() + deadline
+
+    def watch():
+        while srv.poll() is None:
+            if os.getppid() != parent or time.time() > end:
+                print("ERROR: %s: server stopped" % ("deadline passed" if time.time() > end else "parent gone"))
+                sys.stdout.flush()
+                stop_server(srv)
+                shutil.rmtree(home, ignore_errors=True)
+                os._exit(2)
+            time.sleep(1)
+    threading.Thread(target=watch, daemon=True).start()
 
 
 def free_port():
@@ -312,29 +351,44 @@ def run(args):
     home = tempfile.mkdtemp(prefix="pm-indi-e2e-")
     lst = lst_rad()
     pts = sync_grid()
-    port = free_port()
     env = dict(os.environ, HOME=home, LD_PRELOAD=shim, PM_INDI_FROZEN_JD=repr(JD0),
                PM_INDI_SYSTEM_PLUGIN_DIR=args.plugin_dir, PM_INDI_PLUGIN_DIR=plugdir)
     log_path = os.path.join(build, "indi", "e2e-server.log")
     log = open(log_path, "w")
-    srv = subprocess.Popen(["indiserver", "-v", "-p", str(port), DRIVER], env=env, stdout=log,
-                           stderr=subprocess.STDOUT, start_new_session=True)
-    result = {"port": port, "server_log": log_path, "jd": JD0, "site": [LAT, LON],
+    result = {"server_log": log_path, "jd": JD0, "site": [LAT, LON],
               "truth": {k: v * ARCSEC for k, v in TRUTH.items()}}
     c = None
+    srv = None
     t_start = time.time()
     try:
-        c = None
-        for _ in range(50):
-            try:
-                c = Client("127.0.0.1", port)
-                break
-            except OSError:
-                if srv.poll() is not None:
-                    raise RunError("indiserver exited (code %s); see %s" % (srv.returncode, log_path))
-                time.sleep(0.1)
+        # a free port (and a local socket of our own: -u); another process
+        # may take the port between the probe and the bind: then again
+        for attempt in range(5):
+            port = free_port()
+            srv = subprocess.Popen(["indiserver", "-v", "-r", "0", "-p", str(port),
+                                    "-u", os.path.join(home, "indiserver.sock"), DRIVER],
+                                   env=env, stdout=log, stderr=subprocess.STDOUT, start_new_session=True,
+                                   preexec_fn=die_with_parent)
+            watchdog(srv, args.deadline, home)
+            for _ in range(100):
+                try:
+                    c = Client("127.0.0.1", port)
+                    break
+                except OSError:
+                    if srv.poll() is not None:
+                        break
+                    time.sleep(0.1)
+            if c is not None:
+                time.sleep(0.3)
+                if srv.poll() is None:
+                    break
+                c.close()   # ours exited: that port was someone else's
+                c = None
+            stop_server(srv)
+            srv = None
         if c is None:
-            raise RunError("cannot connect to indiserver on port %d" % port)
+            raise RunError("cannot start indiserver on a free port; see %s" % log_path)
+        result["port"] = port
         m = Mount(c)
         c.wait_prop(DEV, "SIMULATION", 20)
         c.set_switch(DEV, "SIMULATION", ["ENABLE"], ["DISABLE"])
@@ -443,17 +497,22 @@ def run(args):
     finally:
         if c is not None:
             c.close()
-        try:
-            os.killpg(srv.pid, 15)
-        except ProcessLookupError:
-            pass
-        try:
-            srv.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            os.killpg(srv.pid, 9)
-            srv.wait()
+        if srv is not None:
+            stop_server(srv)
         log.close()
         shutil.rmtree(home, ignore_errors=True)
+    # plain lines for tests/check_indi.c, then the JSON
+    print("e2e: sync_points %d" % result["n_sync"])
+    for p in args.plugins:
+        v = result["summary"][p]
+        refused = sum(1 for r in result["gotos"] if r.get(p) is None)
+        print("e2e: plugin '%s' max_arcsec %.6f rms_arcsec %.6f gotos %d refused %d" %
+              (p, v["max_arcsec"], v["rms_arcsec"], v["n"], refused))
+    for t in result["pm_messages"]:
+        print("e2e: model %s" % t)
+    print("e2e: bad_entry_reported %d" % any("skipped" in t for t in result["bad_entry_messages"]))
+    a = result["after_bad_entry_goto_arcsec"]
+    print("e2e: after_bad_entry_arcsec %.6f" % (a if a is not None else -1.0))
     print(json.dumps(result))
     return 0
 
@@ -466,6 +525,7 @@ def main():
                     default=["pm Math Plugin", "INBUILT_MATH_PLUGIN"],
                     help="plugins to compare (the names INDI offers; all four: docs/indi.md)")
     ap.add_argument("--targets", type=int, default=6, help="GOTO targets (1..6)")
+    ap.add_argument("--deadline", type=float, default=840, help="stop everything after this many seconds")
     args = ap.parse_args()
     try:
         return run(args)

@@ -3,7 +3,8 @@
 #   make indi-install   install it where INDI looks for math plugins
 #                       (INDI_PLUGIN_DIR; DESTDIR honoured; as root)
 #   make indi-e2e       the end-to-end run against indiserver and the
-#                       AstroTrac simulator (what tests/check_indi.c runs)
+#                       AstroTrac simulator, all four plugins compared
+#                       (tests/check_indi.c runs it for pm and the built-in)
 # Needs libindi-dev, libnova-dev (tools/deps.sh).
 INDI_PC         := $(shell pkg-config --exists libindi 2>/dev/null && echo yes)
 INDI_LIBDIR     := $(shell pkg-config --variable=libdir libindi 2>/dev/null)
@@ -43,18 +44,37 @@ $(INDI_SHIM): indi/testshim.c
 $(B)/indi/MathPlugins/.stamp: $(INDI_PLUGIN)
 	@rm -rf $(@D) && mkdir -p $(@D)
 	@for f in $(INDI_PLUGIN_DIR)/*.so; do [ -e "$$f" ] && ln -s "$$f" $(@D)/; done; true
-	ln -s $(CURDIR)/$(INDI_PLUGIN) $(@D)/
+	ln -s $(abspath $(INDI_PLUGIN)) $(@D)/
 	@touch $@
 
-indi: $(INDI_PLUGIN) $(INDI_SHIM) $(B)/indi/MathPlugins/.stamp
+# Loads the plugin as INDI does and checks its transforms (tests/check_indi.c).
+$(B)/indi/pm_indi_probe: indi/pm_indi_probe.cpp | indi-check-deps
+	@mkdir -p $(@D)
+	$(CXX) $(HOST_CXXFLAGS) $(INDI_INC) $< -o $@ -lindiAlignmentDriver -lindidriver -lnova -ldl -lm
+
+indi: $(INDI_PLUGIN) $(INDI_SHIM) $(B)/indi/MathPlugins/.stamp $(B)/indi/pm_indi_probe
 
 indi-install: $(INDI_PLUGIN)
 	install -d $(DESTDIR)$(INDI_PLUGIN_DIR)
 	install -m 755 $(INDI_PLUGIN) $(DESTDIR)$(INDI_PLUGIN_DIR)/
 	@echo "installed $(notdir $(INDI_PLUGIN)) into $(DESTDIR)$(INDI_PLUGIN_DIR)"
 
+INDI_E2E_PLUGINS ?= "pm Math Plugin" INBUILT_MATH_PLUGIN "Nearest Math Plugin" "SVD Math Plugin"
 indi-e2e: indi
-	$(PYTHON) indi/e2e_indi.py --build $(B) --plugin-dir $(INDI_PLUGIN_DIR)
+	$(PYTHON) indi/e2e_indi.py --build $(B) --plugin-dir $(INDI_PLUGIN_DIR) --plugins $(INDI_E2E_PLUGINS)
+
+# make demo: the plugin's transforms in-process (seconds); the end-to-end run
+# with indiserver is make indi-e2e (minutes).
+.PHONY: indi-demo
+demo-run: indi-demo
+indi-demo:
+	@if [ -f /usr/include/libindi/alignment/MathPlugin.h ] && [ -f /usr/include/libnova/sidereal_time.h ]; then \
+	  $(MAKE) --no-print-directory -s indi && \
+	  echo "== INDI math plugin ($(INDI_PLUGIN); docs/indi.md): transforms against a known mount" && \
+	  for m in eq altaz; do LD_PRELOAD=$(INDI_SHIM) PM_INDI_FROZEN_JD=2460310.75 $(B)/indi/pm_indi_probe $(INDI_PLUGIN) $$m \
+	    2>/dev/null | grep '^probe: '; done; \
+	  echo "   (end to end with indiserver and the AstroTrac simulator: make indi-e2e; install: make indi-install)"; \
+	else echo "(INDI headers missing: the INDI math plugin is skipped; sh tools/deps.sh installs them)"; fi
 
 # tests/check_indi.c: the fitting logic linked in.
 $(B)/tests/check_indi: tests/check_indi.c $(B)/indi/pm_indi.o $(B)/libpmhost.a $(B)/libpm.a $(wildcard tests/*.h)

@@ -31,3 +31,6 @@ exit 0
 #pkg valgrind                 instruction counts (bench)
 #pkg clang-14                 make sanitize, make fuzz
 #pkg libclang-rt-14-dev       make sanitize, make fuzz
+#pkg libindi-dev              the INDI math plugin (make indi; tests/check_indi.c)
+#pkg libnova-dev              the INDI math plugin: sidereal time as INDI's drivers compute it
+#pkg indi-bin                 indiserver and the AstroTrac simulator (tests/check_indi.c end to end)
