@@ -517,10 +517,20 @@ def run(args):
     return 0
 
 
+def default_plugin_dir():
+    try:
+        lib = subprocess.run(["pkg-config", "--variable=libdir", "libindi"], capture_output=True, text=True,
+                             check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        lib = ""
+    return os.path.join(lib or "/usr/lib/x86_64-linux-gnu", "indi", "MathPlugins")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--build", default="build")
-    ap.add_argument("--plugin-dir", default="/usr/lib/x86_64-linux-gnu/indi/MathPlugins")
+    ap.add_argument("--plugin-dir", default=default_plugin_dir(),
+                    help="where this INDI looks for math plugins (make indi-e2e passes INDI_PLUGIN_DIR)")
     ap.add_argument("--plugins", nargs="+",
                     default=["pm Math Plugin", "INBUILT_MATH_PLUGIN"],
                     help="plugins to compare (the names INDI offers; all four: docs/indi.md)")
