@@ -59,6 +59,7 @@ TRUTH = {
     "polar_x": 0.25 * D2R,         # polar axis tilted about the E-W axis
     "polar_y": -0.15 * D2R,        # polar axis tilted about the meridian axis
     "flexure": 15.0 / ARCSEC,      # tube sag toward the horizon, times cos(altitude)
+    "gear": 0.5 / ARCSEC,          # hour-angle gear error, 3 cycles per turn: beyond pm's order 2
 }
 
 
@@ -99,6 +100,9 @@ def truth_sky(h_m, d_m, t=TRUTH):
     tube = rot("x", t["nonperp"]) @ tube          # dec axis tilted
     tube = rot("z", -th1) @ tube                  # hour-angle rotation (westward)
     v = rot("y", t["polar_y"]) @ rot("x", t["polar_x"]) @ tube
+    # gear error: along the hour angle, sin(3 * encoder angle)
+    h, _ = angles(v)
+    v = v + t["gear"] * math.sin(3 * th1) * np.array([-math.sin(h), -math.cos(h), 0.0])
     # flexure: toward the horizon by F cos(alt)
     s = float(v @ ZENITH)
     up = ZENITH - s * v

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <vector>
 
 namespace
 {
@@ -59,6 +60,26 @@ pm_status start_model(pm_model *m, int mount, int order, const pm_model *src, do
         m->coef[ie] = e;
     }
     return pm_model_prepare(m);
+}
+
+/* Leave-one-out rms per axis (Note 1 of pm_indi_fit). */
+double loo_rms(const pm_fit *fit, const pm_fit_result *fr, const pm_model *m, long n, const double *e1,
+               const double *e2, const double *a1, const double *a2)
+{
+    pm_fit_result unit = *fr;
+    double sum = 0;
+    unit.sigma = 1.0;
+    for (long i = 0; i < n; i++) {
+        double s, cov[3], r[2];
+        if (pm_fit_pointing_sigma(fit, &unit, m, nullptr, e1[i], e2[i], &s, cov) != PM_OK ||
+                pm_model_residual(m, nullptr, e1[i], e2[i], a1[i], a2[i], r) != PM_OK)
+            return HUGE_VAL;
+        double h = 0.5 * (cov[0] + cov[2]);
+        if (!(h < 0.999))
+            return HUGE_VAL;
+        sum += (r[0] * r[0] + r[1] * r[1]) / ((1 - h) * (1 - h));
+    }
+    return n > 0 ? std::sqrt(sum / (2.0 * (double)n)) : 0.0;
 }
 
 } // namespace
@@ -114,6 +135,8 @@ pm_status pm_indi_fit(int mount, long n, const double *enc1, const double *enc2,
 
     pm_indi_result r;
     std::memset(&r, 0, sizeof r);
+    for (int L = 0; L <= PM_INDI_MAX_ORDER; L++)
+        r.cv[L] = -1;
     r.order = -1;
     r.chosen_order = -1;
     r.spread = pm_indi_spread(n, app1, app2);
@@ -130,12 +153,15 @@ pm_status pm_indi_fit(int mount, long n, const double *enc1, const double *enc2,
     r.chosen_order = n > 0 ? pm_indi_choose_order(n, r.spread) : -1;
     /* Fit up the ladder 0 .. chosen (each start from the one below); a
     ** singular or diverging fit ends the climb at the last good one. */
-    pm_model lower = best;
-    bool have_lower = false;
+    std::vector<pm_model> fitted(PM_INDI_MAX_ORDER + 1);
+    double sig[PM_INDI_MAX_ORDER + 1] = {0};
+    int npar[PM_INDI_MAX_ORDER + 1] = {0};
+    int top = -1;
     for (int L = 0; L <= r.chosen_order; L++) {
-        pm_model m;
+        pm_model &m = fitted[L];
+        const pm_model *lower = L > 0 ? &fitted[L - 1] : nullptr;
         pm_fit_result fr;
-        st = start_model(&m, mount, L, have_lower ? &lower : nullptr, wrap_pi(c), e);
+        st = start_model(&m, mount, L, lower, wrap_pi(c), e);
         if (st == PM_OK)
             st = pm_fit_run(fit, &m, nullptr, n, enc1, enc2, app1, app2, kMaxIter, &fr);
         if (st != PM_OK) {
@@ -147,14 +173,20 @@ pm_status pm_indi_fit(int mount, long n, const double *enc1, const double *enc2,
                 std::snprintf(r.bad_term, sizeof r.bad_term, "status %d", (int)st);
             break;
         }
-        lower = m;
-        have_lower = true;
-        best = m;
-        r.kind = PM_INDI_FIT;
-        r.order = L;
-        r.sigma = fr.sigma;
-        r.n_par = fr.n_par;
+        r.cv[L] = loo_rms(fit, &fr, &m, n, enc1, enc2, app1, app2);
+        sig[L] = fr.sigma;
+        npar[L] = fr.n_par;
+        top = L;
     }
+    /* the fitted order that predicts best (a higher one must earn it) */
+    for (int L = 0; L <= top; L++)
+        if (r.kind != PM_INDI_FIT || r.cv[L] + PM_INDI_CV_FLOOR < PM_INDI_CV_GAIN * r.cv[r.order]) {
+            best = fitted[L];
+            r.kind = PM_INDI_FIT;
+            r.order = L;
+            r.sigma = sig[L];
+            r.n_par = npar[L];
+        }
     *out = best;
     *res = r;
     return PM_OK;
@@ -186,12 +218,26 @@ void pm_indi_describe(const pm_indi_result *r, long n, long skipped, char *buf, 
                       "over %.0f deg)%s",
                       n, r->spread * 180.0 / kPi, PM_SH_TERMS(0), PM_INDI_SPREAD_L0 * 180.0 / kPi, extra);
         break;
-    default:
-        std::snprintf(buf, len, "%ld sync points over %.1f deg: order %d fit, %d terms, sigma %.3f arcsec%s%s", n,
-                      r->spread * 180.0 / kPi, r->order, r->n_par, r->sigma * arcsec, extra,
+    default: {
+        char cv[160] = "";
+        for (int L = 0, k = 0; L <= PM_INDI_MAX_ORDER; L++) {
+            if (r->cv[L] < 0)
+                continue;
+            if (r->cv[L] < 1e6)
+                k += std::snprintf(cv + k, sizeof cv - (size_t)k, "%s%d: %.3f", k ? ", " : "", L, r->cv[L] * arcsec);
+            else
+                k += std::snprintf(cv + k, sizeof cv - (size_t)k, "%s%d: undetermined", k ? ", " : "", L);
+            if (k >= (int)sizeof cv)
+                break;
+        }
+        std::snprintf(buf, len,
+                      "%ld sync points over %.1f deg: order %d fit, %d terms, sigma %.3f arcsec "
+                      "(leave-one-out arcsec, order %s)%s%s", n,
+                      r->spread * 180.0 / kPi, r->order, r->n_par, r->sigma * arcsec, cv, extra,
                       r->sigma * arcsec > 1800.0 ? " (the sync points disagree by degrees: check the "
                       "site, the time and the sync targets)" : "");
         break;
+    }
     }
 }
 

@@ -21,6 +21,12 @@ extern "C" {
                             too small a patch of sky for a fit */
 #define PM_INDI_FIT 2    /* a fitted pm model of order pm_indi_result.order */
 
+/* A higher order is kept only if its leave-one-out rms is below
+** PM_INDI_CV_GAIN times the lower one's minus PM_INDI_CV_FLOOR (radians;
+** 1e-9 rad = 0.0002": noise-free data tie at rounding). */
+#define PM_INDI_CV_GAIN 0.8
+#define PM_INDI_CV_FLOOR 1e-9
+
 /* Highest order the rule chooses. */
 #define PM_INDI_MAX_ORDER 2
 
@@ -38,6 +44,9 @@ typedef struct pm_indi_result {
     double sigma;      /* fit residual (radians; 0 for NONE/OFFSET) */
     int n_par;         /* parameters of the model used */
     int fallbacks;     /* orders given up (singular or diverged fits) */
+    double cv[PM_INDI_MAX_ORDER + 1]; /* leave-one-out rms per axis of each
+                          order fitted (radians; -1 not fitted, HUGE_VAL
+                          when a point alone determines terms) */
     char bad_term[48]; /* the term that made the last given-up fit singular */
 } pm_indi_result;
 
@@ -67,14 +76,25 @@ int pm_indi_choose_order(long n, double spread);
 **     fit      pm_fit*      workspace
 **  Returned:
 **     out      pm_model*    the model (prepared): identity for n = 0,
-**                           index offsets when no fit is allowed, else the
-**                           fit of the chosen order, lowered while the fit
-**                           is singular or diverges
+**                           index offsets when no fit is allowed, else of
+**                           the orders up to the rule's that fit (singular
+**                           or diverging fits end the climb), the one whose
+**                           leave-one-out error is smallest; a higher order
+**                           must beat a lower one by PM_INDI_CV_GAIN and
+**                           PM_INDI_CV_FLOOR (Note 1)
 **     res      pm_indi_result*  what was done
 **  Returned (function value):
 **              pm_status    PM_OK; PM_ERR_ARG (NULL, n < 0, bad mount);
 **                           PM_ERR_NONFINITE (a non-finite position).
 **                           On error *out and *res are unchanged.
+**  Notes:
+**  1) The leave-one-out error of a point is its residual / (1 - h), h the
+**     mean of its two rows' leverages (the diagonal block of
+**     J (J^T J)^-1 J^T, from pm_fit_pointing_sigma at sigma 1): exact for a
+**     linear fit, and what the model would miss there without the point.
+**     It catches an order the coverage nearly cannot determine (a pivot
+**     just above pm's singular threshold), which fits the sync points and
+**     errs between them.
 */
 pm_status pm_indi_fit(int mount, long n, const double *enc1, const double *enc2,
                       const double *app1, const double *app2, pm_fit *fit,

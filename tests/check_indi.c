@@ -72,10 +72,13 @@ static void vec(double a, double b, double v[3])
     v[2] = sin(b);
 }
 
-/* index offsets o1, o2, then rotations about x (rx) and y (ry) */
-static void mount_fwd(double m1, double m2, const double k[4], double *s1, double *s2)
+/* k: index offsets o1, o2, then rotations about x (rx) and y (ry); k[4] a
+** flexure k[4] * cos(alt) toward the zenith of latitude 45 deg (an order-1
+** field); k[5] a gear error k[5] * sin(3 * axis 1) along axis 1 (beyond
+** order 2) */
+static void mount_fwd(double m1, double m2, const double k[6], double *s1, double *s2)
 {
-    double v[3], a[3], b[3];
+    double v[3], a[3], b[3], z[3], sz, n;
     vec(m1 + k[0], m2 + k[1], v);
     a[0] = v[0];
     a[1] = cos(k[2]) * v[1] - sin(k[2]) * v[2];
@@ -83,8 +86,18 @@ static void mount_fwd(double m1, double m2, const double k[4], double *s1, doubl
     b[0] = cos(k[3]) * a[0] + sin(k[3]) * a[2];
     b[1] = a[1];
     b[2] = -sin(k[3]) * a[0] + cos(k[3]) * a[2];
+    vec(0, 45 * D2R, z);
+    sz = b[0] * z[0] + b[1] * z[1] + b[2] * z[2];
+    for (int i = 0; i < 3; i++)
+        b[i] -= k[4] * (z[i] - sz * b[i]);
+    {
+        double h = atan2(b[1], b[0]), g = k[5] * sin(3 * (m1 + k[0]));
+        b[0] -= g * sin(h);
+        b[1] += g * cos(h);
+    }
+    n = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
     *s1 = atan2(b[1], b[0]);
-    *s2 = asin(b[2]);
+    *s2 = asin(b[2] / n);
 }
 
 static double sep(double a1, double b1, double a2, double b2)
@@ -102,7 +115,7 @@ static double sep(double a1, double b1, double a2, double b2)
 static double e1[NMAX], e2[NMAX], a1[NMAX], a2[NMAX];
 
 /* n points on a grid of the mount's axes (ha -80..80, dec -20..80 deg) */
-static long grid(const double k[4], int nha, int ndec)
+static long grid(const double k[6], int nha, int ndec)
 {
     long n = 0;
     for (int i = 0; i < nha; i++)
@@ -117,7 +130,7 @@ static long grid(const double k[4], int nha, int ndec)
 
 /* worst distance between the model's and the known mount's sky positions,
 ** at places between the grid's */
-static double worst_apply(const pm_model *m, const double k[4])
+static double worst_apply(const pm_model *m, const double k[6])
 {
     double worst = 0;
     for (int i = 0; i < 9; i++)
@@ -197,7 +210,7 @@ END_TEST
 START_TEST(test_pm_indi_fit_one_point_offsets_exact)
 {
     /* one sync point: the index offsets put it exactly where it belongs */
-    const double k[4] = {0.3 * D2R, -0.2 * D2R, 0, 0};
+    const double k[6] = {0.3 * D2R, -0.2 * D2R, 0, 0, 0, 0};
     pm_model m;
     pm_indi_result r;
     double x, y;
@@ -216,7 +229,7 @@ END_TEST
 
 START_TEST(test_pm_indi_fit_few_points_offsets)
 {
-    const double k[4] = {0.3 * D2R, -0.2 * D2R, 0.1 * D2R, 0.05 * D2R};
+    const double k[6] = {0.3 * D2R, -0.2 * D2R, 0.1 * D2R, 0.05 * D2R, 0, 0};
     pm_model m;
     pm_indi_result r;
     long n = grid(k, 5, 5);
@@ -232,16 +245,18 @@ END_TEST
 START_TEST(test_pm_indi_fit_rotation_exact)
 {
     /* a tilted mount with index errors (exactly the isotropic model): the
-    ** order the rule allows holds it to rounding, also between the points */
-    const double k[4] = {0.4 * D2R, -0.25 * D2R, 0.2 * D2R, -0.12 * D2R};
+    ** rule allows order 1 for 45 points, order 0 already holds it to
+    ** rounding, also between the points, so order 0 is kept */
+    const double k[6] = {0.4 * D2R, -0.25 * D2R, 0.2 * D2R, -0.12 * D2R, 0, 0};
     pm_model m;
     pm_indi_result r;
     long n = grid(k, 9, 5); /* 45 points over a hemisphere */
     ck_assert_int_eq(pm_indi_fit(PM_MOUNT_EQUATORIAL, n, e1, e2, a1, a2, &fit, &m, &r), PM_OK);
     ck_assert_int_eq(r.kind, PM_INDI_FIT);
     ck_assert_int_eq(r.chosen_order, 1);
-    ck_assert_int_eq(r.order, 1);
+    ck_assert_int_eq(r.order, 0);
     ck_assert_int_eq(r.fallbacks, 0);
+    ck_assert(r.cv[0] < TOL_FIT_RAD && r.cv[1] < TOL_FIT_RAD);
     ck_assert(r.sigma < TOL_FIT_RAD);
     ck_assert(worst_apply(&m, k) < TOL_FIT_RAD);
     /* 12 points (three declinations: two would leave collimation and
@@ -254,12 +269,46 @@ START_TEST(test_pm_indi_fit_rotation_exact)
 }
 END_TEST
 
+START_TEST(test_pm_indi_fit_flexure_needs_order1)
+{
+    /* add a 15" tube flexure (an order-1 field): order 0 misses it, order 1
+    ** holds it; leave-one-out picks order 1 */
+    const double k[6] = {0.4 * D2R, -0.25 * D2R, 0.2 * D2R, -0.12 * D2R, 15 * ARCSEC, 0};
+    pm_model m;
+    pm_indi_result r;
+    long n = grid(k, 9, 5);
+    ck_assert_int_eq(pm_indi_fit(PM_MOUNT_EQUATORIAL, n, e1, e2, a1, a2, &fit, &m, &r), PM_OK);
+    ck_assert_int_eq(r.order, 1);
+    ck_assert(r.cv[0] > 1 * ARCSEC);
+    ck_assert(r.cv[1] < TOL_FIT_RAD);
+    ck_assert(worst_apply(&m, k) < TOL_FIT_RAD);
+}
+END_TEST
+
+START_TEST(test_pm_indi_fit_near_singular_order_rejected)
+{
+    /* 54 points on six declinations (the rule allows order 2) and a 0.5"
+    ** gear error no order holds: order 2 is barely determined there (it fits
+    ** the points and errs between them); leave-one-out keeps order 1 */
+    const double k[6] = {0.4 * D2R, -0.25 * D2R, 0.2 * D2R, -0.12 * D2R, 15 * ARCSEC, 0.5 * ARCSEC};
+    pm_model m;
+    pm_indi_result r;
+    long n = grid(k, 9, 6);
+    ck_assert_int_eq(pm_indi_fit(PM_MOUNT_EQUATORIAL, n, e1, e2, a1, a2, &fit, &m, &r), PM_OK);
+    ck_assert_int_eq(r.chosen_order, 2);
+    ck_assert_int_eq(r.order, 1);
+    printf("near-singular order 2: leave-one-out rms order 1 %.3f\", order 2 %.3g\"\n", r.cv[1] / ARCSEC, r.cv[2] / ARCSEC);
+    ck_assert_msg(r.cv[2] > r.cv[1], "cv %g %g", r.cv[1], r.cv[2]);
+    ck_assert(worst_apply(&m, k) < 1.0 * ARCSEC);
+}
+END_TEST
+
 START_TEST(test_pm_indi_fit_ring_singular_falls_back)
 {
     /* 30 points on one declination: hour-angle index, collimation and
     ** non-perpendicularity cannot be told apart: the fit is singular at every
     ** order, the plugin keeps the offsets and names the term */
-    const double k[4] = {0.3 * D2R, -0.2 * D2R, 0.1 * D2R, 0.05 * D2R};
+    const double k[6] = {0.3 * D2R, -0.2 * D2R, 0.1 * D2R, 0.05 * D2R, 0, 0};
     pm_model m;
     pm_indi_result r;
     for (int i = 0; i < 30; i++) {
@@ -279,7 +328,7 @@ END_TEST
 START_TEST(test_pm_indi_fit_small_patch_offsets)
 {
     /* 40 points within 4 deg: too small a patch for any fit */
-    const double k[4] = {0.3 * D2R, -0.2 * D2R, 0.1 * D2R, 0.05 * D2R};
+    const double k[6] = {0.3 * D2R, -0.2 * D2R, 0.1 * D2R, 0.05 * D2R, 0, 0};
     pm_model m;
     pm_indi_result r;
     for (int i = 0; i < 40; i++) {
@@ -297,7 +346,7 @@ START_TEST(test_pm_indi_fit_altaz_half_turn)
 {
     /* an alt-az driver whose azimuth counts from the south: 180 deg apart
     ** from the plugin's, plus a tilt; the offsets start the fit there */
-    const double k[4] = {PI + 0.5 * D2R, -0.3 * D2R, 0.15 * D2R, 0.1 * D2R};
+    const double k[6] = {PI + 0.5 * D2R, -0.3 * D2R, 0.15 * D2R, 0.1 * D2R, 0, 0};
     pm_model m;
     pm_indi_result r;
     long n = grid(k, 9, 5);
@@ -310,7 +359,7 @@ END_TEST
 
 START_TEST(test_pm_indi_fit_bad_input_untouched)
 {
-    const double k[4] = {0.3 * D2R, -0.2 * D2R, 0, 0};
+    const double k[6] = {0.3 * D2R, -0.2 * D2R, 0, 0, 0, 0};
     pm_model m, before;
     pm_indi_result r, rbefore;
     long n = grid(k, 5, 5);
@@ -344,9 +393,13 @@ START_TEST(test_pm_indi_describe_says_what)
     r.spread = 70 * D2R;
     r.fallbacks = 1;
     strcpy(r.bad_term, "d*Y(2,0)");
+    r.cv[0] = 9.5 * ARCSEC;
+    r.cv[1] = 0.6 * ARCSEC;
+    r.cv[2] = -1;
     pm_indi_describe(&r, 46, 2, buf, sizeof buf);
     ck_assert_msg(strstr(buf, "46 sync points") && strstr(buf, "order 1 fit") && strstr(buf, "22 terms") &&
-                  strstr(buf, "sigma 0.500 arcsec") && strstr(buf, "d*Y(2,0)") && strstr(buf, "2 sync point(s) skipped"),
+                  strstr(buf, "sigma 0.500 arcsec") && strstr(buf, "d*Y(2,0)") && strstr(buf, "2 sync point(s) skipped") &&
+                  strstr(buf, "order 0: 9.500, 1: 0.600)"),
                   "got: %s", buf);
     r.kind = PM_INDI_OFFSET;
     pm_indi_describe(&r, 3, 0, buf, sizeof buf);
@@ -513,6 +566,8 @@ static Suite *suite(void)
     tcase_add_test(tc, test_pm_indi_fit_one_point_offsets_exact);
     tcase_add_test(tc, test_pm_indi_fit_few_points_offsets);
     tcase_add_test(tc, test_pm_indi_fit_rotation_exact);
+    tcase_add_test(tc, test_pm_indi_fit_flexure_needs_order1);
+    tcase_add_test(tc, test_pm_indi_fit_near_singular_order_rejected);
     tcase_add_test(tc, test_pm_indi_fit_ring_singular_falls_back);
     tcase_add_test(tc, test_pm_indi_fit_small_patch_offsets);
     tcase_add_test(tc, test_pm_indi_fit_altaz_half_turn);
