@@ -34,3 +34,4 @@ exit 0
 #pkg libindi-dev              the INDI math plugin (make indi; tests/check_indi.c)
 #pkg libnova-dev              the INDI math plugin: sidereal time as INDI's drivers compute it
 #pkg indi-bin                 indiserver and the AstroTrac simulator (tests/check_indi.c end to end)
+#pkg libindi-plugins          INDI's Nearest and SVD math plugins (make indi-e2e compares them)
