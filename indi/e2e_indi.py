@@ -19,8 +19,10 @@ model): so each GOTO starts from the target's true encoder position, where the
 lead is that of the plugin's own error (0.5" * sqrt(error / 1") in hour angle)
 and is included in the reported error, not removed.
 
-Prints one JSON object (last line) and exits 0 when it ran (the caller judges
-the numbers), 2 on a failure to run, 77 when INDI is absent.
+Prints "e2e: ..." lines (what tests/check_indi.c reads) and then everything as
+one JSON object (the last line); exits 0 when it ran (the caller judges the
+numbers), 2 on a failure to run (with the driver's last messages), 77 when
+indiserver or the driver is not installed.
 """
 import argparse
 import ctypes

@@ -107,7 +107,7 @@ bool finite3(const TelescopeDirectionVector &v)
 class PmMathPlugin : public AlignmentSubsystemForMathPlugins
 {
   public:
-    PmMathPlugin() : fit_(new (std::nothrow) pm_fit), kind_(PM_INDI_NONE), order_(-1), n_used_(0)
+    PmMathPlugin() : fit_(new (std::nothrow) pm_fit), kind_(PM_INDI_NONE)
     {
         pm_model_init(&model_, PM_MOUNT_EQUATORIAL, 0);
         summary_[0] = 0;
@@ -130,8 +130,6 @@ class PmMathPlugin : public AlignmentSubsystemForMathPlugins
     bool TransformTelescopeToCelestial(const TelescopeDirectionVector &ApparentTelescopeDirectionVector,
                                        double &RightAscension, double &Declination) override;
 
-    const char *summary() const { return summary_; }
-
   private:
     bool altaz() const { return ApproximateMountAlignment == ZENITH; }
     bool site(double *lat, double *lon);
@@ -145,8 +143,6 @@ class PmMathPlugin : public AlignmentSubsystemForMathPlugins
     pm_model model_;
     pm_fit *fit_;
     int kind_; /* PM_INDI_*: what model_ is */
-    int order_;
-    long n_used_;
     char summary_[512];
 };
 
@@ -276,8 +272,6 @@ bool PmMathPlugin::Initialise(InMemoryDatabase *db)
         return false;
     }
     kind_ = r.kind;
-    order_ = r.order;
-    n_used_ = n;
     pm_indi_describe(&r, n, skipped, summary_, sizeof summary_);
     note("%s mount: %s", altaz() ? "alt-az" : "equatorial", summary_);
     return true;
