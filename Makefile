@@ -227,6 +227,7 @@ include tools/plan.mk
 # The Python package (docs/python.md): make python, make bench-python; make
 # test runs its pytest suite (rules: python/python.mk).
 include python/python.mk
+include indi/indi.mk  # INDI alignment math plugin: make indi, indi-install (docs/indi.md)
 
 firmware: deps
 	@$(MAKE) --no-print-directory firmware-run
