@@ -127,6 +127,7 @@ demo-run: all
 	  done; done; \
 	else echo "(no $(DATA): the real recorded runs are skipped)"; fi
 	@$(MAKE) --no-print-directory python-demo
+	@echo; $(MAKE) --no-print-directory indi-demo
 
 # The README's C example, compiled as strict C89 and run on a synthetic run.
 check-example: $(B)/libpm.a

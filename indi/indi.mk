@@ -63,10 +63,9 @@ INDI_E2E_PLUGINS ?= "pm Math Plugin" INBUILT_MATH_PLUGIN "Nearest Math Plugin" "
 indi-e2e: indi
 	$(PYTHON) indi/e2e_indi.py --build $(B) --plugin-dir $(INDI_PLUGIN_DIR) --plugins $(INDI_E2E_PLUGINS)
 
-# make demo: the plugin's transforms in-process (seconds); the end-to-end run
+# make demo ends with the plugin's transforms in-process (seconds); the end-to-end run
 # with indiserver is make indi-e2e (minutes).
 .PHONY: indi-demo
-demo-run: indi-demo
 indi-demo:
 	@if [ -f /usr/include/libindi/alignment/MathPlugin.h ] && [ -f /usr/include/libnova/sidereal_time.h ]; then \
 	  $(MAKE) --no-print-directory -s indi && \
