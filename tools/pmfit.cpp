@@ -267,6 +267,19 @@ bool parse_int(const char *s, int *v)
 }
 
 // pmfit report's options (its own list: a page, not a table on stdout).
+// An option's number, in lo..hi, or a clear error naming the option.
+double number(const std::string &opt, const char *v, double lo, double hi)
+{
+    char *end = nullptr;
+    double x = std::strtod(v, &end);
+    if (!*v || *end || !(x >= lo && x <= hi)) {
+        char range[64];
+        std::snprintf(range, sizeof range, "%g..%g", lo, hi);
+        die(opt + ": expected a number in " + range + ", got '" + v + "'");
+    }
+    return x;
+}
+
 // --format NAME and --equinox E (every command that reads a run).
 void set_format(Options &o, const std::string &v)
 {
@@ -291,14 +304,6 @@ void set_equinox(Options &o, const std::string &v)
 
 Options parse_report(Options o, int argc, char **argv)
 {
-    auto number = [&](const std::string &opt, const char *v, double lo, double hi) {
-        char *end = nullptr;
-        double x = std::strtod(v, &end);
-        if (!*v || *end || !(x >= lo && x <= hi))
-            die(opt + ": expected a number in " + std::to_string(lo) + ".." + std::to_string(hi) +
-                ", got '" + v + "'");
-        return x;
-    };
     for (int i = 2; i < argc; i++) {
         std::string a = argv[i];
         auto need = [&](const char *what) -> const char * {
@@ -382,14 +387,6 @@ Options parse_args(int argc, char **argv)
             "' (expected: fit, explain, eval, compare, plan, report or simulate); see pmfit --help");
     bool sim = o.cmd == "simulate", eval = o.cmd == "eval", expl = o.cmd == "explain";
     bool cmp = o.cmd == "compare", pln = o.cmd == "plan";
-    auto number = [&](const std::string &opt, const char *v, double lo, double hi) {
-        char *end = nullptr;
-        double x = std::strtod(v, &end);
-        if (!*v || *end || !(x >= lo && x <= hi))
-            die(opt + ": expected a number in " + std::to_string(lo) + ".." + std::to_string(hi) +
-                ", got '" + v + "'");
-        return x;
-    };
     for (int i = 2; i < argc; i++) {
         std::string a = argv[i];
         auto need = [&](const char *what) -> const char * {
