@@ -974,19 +974,11 @@ int cmd_plan(const Options &o)
 // a run (fitted at --order with --add, and its errors count).
 int cmd_compare(const Options &o, const Run &run)
 {
-    std::FILE *f = std::fopen(o.model.c_str(), "rb");
-    if (!f)
-        die(o.model + ": cannot open: " + std::strerror(errno), 1);
-    char line[256] = "";
-    bool is_model = false;
-    while (std::fgets(line, sizeof line, f)) {
-        const char *p = line + std::strspn(line, " \t\r\n");
-        if (!*p || *p == '#')
-            continue;
-        is_model = std::strncmp(p, "pm-model", 8) == 0;
-        break;
-    }
-    std::fclose(f);
+    char ferr[1024];
+    int kind = is_model_file(o.model, ferr, sizeof ferr);
+    if (kind < 0)
+        die(ferr, 1);
+    bool is_model = kind == 1;
     pm_model old_model;
     std::vector<double> old_err;
     FitOut old_fit;

@@ -11,6 +11,7 @@
 #include "modelfile.h"
 #include "plan.hpp"
 #include "plan_inputs.hpp"
+#include "hostutil.hpp"
 #include "plots.hpp"
 
 #include <algorithm>
@@ -260,19 +261,11 @@ void stage_fit(Data &d)
 void stage_compare(Data &d)
 {
     const std::string &old = d.o.compare;
-    std::FILE *f = std::fopen(old.c_str(), "rb");
-    if (!f)
-        throw std::runtime_error(old + ": cannot open: " + std::strerror(errno));
-    char line[256] = "";
-    bool is_model = false;
-    while (std::fgets(line, sizeof line, f)) {
-        const char *q = line + std::strspn(line, " \t\r\n");
-        if (!*q || *q == '#')
-            continue;
-        is_model = std::strncmp(q, "pm-model", 8) == 0;
-        break;
-    }
-    std::fclose(f);
+    char ferr[1024];
+    int kind = is_model_file(old, ferr, sizeof ferr);
+    if (kind < 0)
+        throw std::runtime_error(ferr);
+    bool is_model = kind == 1;
     pm_model old_model;
     std::vector<double> old_err;
     FitOut old_fit;
