@@ -127,6 +127,7 @@ demo-run: all
 	  done; done; \
 	else echo "(no $(DATA): the real recorded runs are skipped)"; fi
 	@$(MAKE) --no-print-directory python-demo
+	@echo; $(MAKE) --no-print-directory indi-demo
 
 # The README's C example, compiled as strict C89 and run on a synthetic run.
 check-example: $(B)/libpm.a
@@ -227,6 +228,7 @@ include tools/plan.mk
 # The Python package (docs/python.md): make python, make bench-python; make
 # test runs its pytest suite (rules: python/python.mk).
 include python/python.mk
+include indi/indi.mk  # INDI alignment math plugin: make indi, indi-install (docs/indi.md)
 
 firmware: deps
 	@$(MAKE) --no-print-directory firmware-run

@@ -243,6 +243,21 @@ START_TEST(test_report_example)
     ck_assert_ptr_nonnull(p);
     ck_assert_double_eq_tol(after(p, "<tr><td>1</td><td>", "targets"), tu_json_num(out, "ha_deg") / 15, TOL_HA_H);
     free(html);
+    /* with a horizon file and a higher --min-el: pmfit plan's first target
+    ** with the same options (they move it) */
+    snprintf(cmd, sizeof cmd, "--horizon '%s/examples/horizon.hrz' --min-el 25", top());
+    ck_assert_msg(report(run, cmd, "sim_hz.html") == 0, "pmfit report failed: %s", out);
+    snprintf(path, sizeof path, "%s/sim_hz.html", tmp);
+    html = slurp(path);
+    ck_assert_ptr_nonnull(html);
+    ck_assert_msg(strstr(html, "above elevation 25&deg; and the horizon of ") != NULL, "horizon not said");
+    snprintf(cmd, sizeof cmd, "'%s' plan '%s' --next 5 --json --horizon '%s/examples/horizon.hrz' --min-el 25",
+             tu_pmfit_path(), run, top());
+    ck_assert_int_eq(tu_capture(cmd, out, sizeof out), 0);
+    p = strstr(html, "class=\"num targets\"");
+    ck_assert_ptr_nonnull(p);
+    ck_assert_double_eq_tol(after(p, "<tr><td>1</td><td>", "targets"), tu_json_num(out, "ha_deg") / 15, TOL_HA_H);
+    free(html);
 }
 END_TEST
 
@@ -371,6 +386,11 @@ START_TEST(test_report_bad_input)
     snprintf(cmd, sizeof cmd, "%s/short.dat", tmp);
     ck_assert_int_eq(report(cmd, "--order 3", "page.html"), 1);
     ck_assert_msg(strstr(out, "too few observations for the number of terms") != NULL, "%s", out);
+    unchanged("page.html", "an earlier page\n");
+    /* a horizon file that is not there: the user's error, no page */
+    snprintf(cmd, sizeof cmd, "%s/examples/sim_gem.dat", top());
+    ck_assert_int_eq(report(cmd, "--horizon /nonexistent/h.hrz", "page.html"), 1);
+    ck_assert_msg(strstr(out, "/nonexistent/h.hrz: cannot open the horizon file") != NULL, "%s", out);
     unchanged("page.html", "an earlier page\n");
     /* an unknown effect, a missing directory, a missing -o */
     snprintf(cmd, sizeof cmd, "%s/examples/sim_gem.dat", top());

@@ -35,3 +35,7 @@ exit 0
 #pkg python3-dev              the Python package's extension (make python): Python.h
 #pkg python3-pybind11         the Python package's extension (pulls in pybind11-dev)
 #pkg python3-pytest           the Python package's tests (tests/check_python.c)
+#pkg libindi-dev              the INDI math plugin (make indi; tests/check_indi.c)
+#pkg libnova-dev              the INDI math plugin: sidereal time as INDI's drivers compute it
+#pkg indi-bin                 indiserver and the AstroTrac simulator (tests/check_indi.c end to end)
+#pkg libindi-plugins          INDI's Nearest and SVD math plugins (make indi-e2e compares them)

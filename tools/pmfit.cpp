@@ -207,8 +207,9 @@ void usage(FILE *f)
         "  index terms (c', e') suffices or a full refit is needed (cross-validated)\n"
         "\n"
         "usage: pmfit report RUN -o PAGE.html [--order L] [--add EFFECT ...] [--compare OLD]\n"
-        "                    [--next K] [--alpha P] [--gear [ha:|dec:]G ...] [--no-refraction]\n"
-        "                    [--skip-bad] [--format NAME] [--equinox J2000|JNow]\n"
+        "                    [--next K] [--min-el DEG] [--horizon FILE] [--alpha P]\n"
+        "                    [--gear [ha:|dec:]G ...] [--no-refraction] [--skip-bad]\n"
+        "                    [--format NAME] [--equinox J2000|JNow]\n"
         "                    [--quiet | --progress]\n"
         "\n"
         "  one self-contained HTML page (inline SVG, no script, no network): the fit and its\n"
@@ -266,6 +267,19 @@ bool parse_int(const char *s, int *v)
 }
 
 // pmfit report's options (its own list: a page, not a table on stdout).
+// An option's number, in lo..hi, or a clear error naming the option.
+double number(const std::string &opt, const char *v, double lo, double hi)
+{
+    char *end = nullptr;
+    double x = std::strtod(v, &end);
+    if (!*v || *end || !(x >= lo && x <= hi)) {
+        char range[64];
+        std::snprintf(range, sizeof range, "%g..%g", lo, hi);
+        die(opt + ": expected a number in " + range + ", got '" + v + "'");
+    }
+    return x;
+}
+
 // --format NAME and --equinox E (every command that reads a run).
 void set_format(Options &o, const std::string &v)
 {
@@ -290,14 +304,6 @@ void set_equinox(Options &o, const std::string &v)
 
 Options parse_report(Options o, int argc, char **argv)
 {
-    auto number = [&](const std::string &opt, const char *v, double lo, double hi) {
-        char *end = nullptr;
-        double x = std::strtod(v, &end);
-        if (!*v || *end || !(x >= lo && x <= hi))
-            die(opt + ": expected a number in " + std::to_string(lo) + ".." + std::to_string(hi) +
-                ", got '" + v + "'");
-        return x;
-    };
     for (int i = 2; i < argc; i++) {
         std::string a = argv[i];
         auto need = [&](const char *what) -> const char * {
@@ -318,6 +324,10 @@ Options parse_report(Options o, int argc, char **argv)
             o.compare = need("OLD: a saved model or a run");
         } else if (a == "--next") {
             o.next = (int)number(a, need("a count"), 1, 1000);
+        } else if (a == "--min-el") {
+            o.min_el = number(a, need("degrees"), -10, 80);
+        } else if (a == "--horizon") {
+            o.horizon = need("a horizon file");
         } else if (a == "--alpha") {
             o.alpha = number(a, need("a probability"), 1e-12, 0.5);
         } else if (a == "--gear") {
@@ -377,14 +387,6 @@ Options parse_args(int argc, char **argv)
             "' (expected: fit, explain, eval, compare, plan, report or simulate); see pmfit --help");
     bool sim = o.cmd == "simulate", eval = o.cmd == "eval", expl = o.cmd == "explain";
     bool cmp = o.cmd == "compare", pln = o.cmd == "plan";
-    auto number = [&](const std::string &opt, const char *v, double lo, double hi) {
-        char *end = nullptr;
-        double x = std::strtod(v, &end);
-        if (!*v || *end || !(x >= lo && x <= hi))
-            die(opt + ": expected a number in " + std::to_string(lo) + ".." + std::to_string(hi) +
-                ", got '" + v + "'");
-        return x;
-    };
     for (int i = 2; i < argc; i++) {
         std::string a = argv[i];
         auto need = [&](const char *what) -> const char * {
@@ -972,19 +974,11 @@ int cmd_plan(const Options &o)
 // a run (fitted at --order with --add, and its errors count).
 int cmd_compare(const Options &o, const Run &run)
 {
-    std::FILE *f = std::fopen(o.model.c_str(), "rb");
-    if (!f)
-        die(o.model + ": cannot open: " + std::strerror(errno), 1);
-    char line[256] = "";
-    bool is_model = false;
-    while (std::fgets(line, sizeof line, f)) {
-        const char *p = line + std::strspn(line, " \t\r\n");
-        if (!*p || *p == '#')
-            continue;
-        is_model = std::strncmp(p, "pm-model", 8) == 0;
-        break;
-    }
-    std::fclose(f);
+    char ferr[1024];
+    int kind = is_model_file(o.model, ferr, sizeof ferr);
+    if (kind < 0)
+        die(ferr, 1);
+    bool is_model = kind == 1;
     pm_model old_model;
     std::vector<double> old_err;
     FitOut old_fit;
@@ -1350,6 +1344,8 @@ int cmd_report(const Options &o, const Run &run, int argc, char **argv)
     ro.gears_ha = o.gears_ha;
     ro.gears_dec = o.gears_dec;
     ro.next = o.next;
+    ro.min_el_deg = o.min_el;
+    ro.horizon = o.horizon;
     ro.compare = o.compare;
     ro.refraction = o.refraction;
     ro.skip_bad = o.skip_bad;

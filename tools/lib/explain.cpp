@@ -125,10 +125,19 @@ void scan_powers(const Run &run, const std::vector<int> &idx, const std::vector<
     }
 }
 
+// How strongly the data must reject the integer G nearest the best one
+// before a non-integer period is reported: chi^2 of the integer above the
+// best G's by this many times the noise variance (chi^2 with one degree of
+// freedom: 10.83 is its 0.1% tail).  A worm has whole teeth; a period that
+// is not a whole number of cycles (a belt or gear train before the worm)
+// is off the integer by a sizeable fraction of a cycle and passes by far,
+// while at 3.84 (5%) one run in twenty of an integer gear read as, e.g.,
+// 230.2 for 230.
+const double INTEGER_REJECT_CHI2 = 10.83;
+
 // The three highest integer peaks refined to non-integer G; the nearest
-// integer kept (a worm has whole teeth) unless the data reject it: its
-// chi^2 exceeds the best G's by more than 3.84 times the noise variance
-// left once the sinusoid is removed (chi^2 with one degree of freedom).
+// integer kept unless the data reject it (INTEGER_REJECT_CHI2, with the
+// noise variance left once the sinusoid is removed).
 void refine_peak(const Run &run, const FitOut &f, const std::vector<double> &r, int comp,
                  double sigma2, double g_lo, Periodogram &pg)
 {
@@ -152,7 +161,8 @@ void refine_peak(const Run &run, const FitOut &f, const std::vector<double> &r, 
     double red_int = period_power(run, f.idx, r, comp, gi);
     long dof = 2 * f.res.n_obs - f.res.n_par;
     double s2_after = (f.res.chi2 - red_peak) / (double)std::max(1L, dof - 2);
-    if (std::fabs(pg.peak_g - gi) < 0.5 && s2_after > 0 && (red_peak - red_int) / s2_after <= 3.84)
+    if (std::fabs(pg.peak_g - gi) < 0.5 && s2_after > 0 &&
+        (red_peak - red_int) / s2_after <= INTEGER_REJECT_CHI2)
         pg.peak_g = gi;
 }
 
@@ -372,7 +382,7 @@ bool opt_is_scan(const ExplainOptions &opt, int comp)
 // The periodogram decides integer vs non-integer G on the baseline's
 // residuals; a term correlated with the model's own terms can tip it.  The
 // full fits decide: the integer (a worm has whole teeth) unless its chi^2
-// exceeds the non-integer's by more than 3.84 sigma^2.
+// exceeds the non-integer's by more than INTEGER_REJECT_CHI2 sigma^2.
 void prefer_integer(const Run &run, const State &st, const char *prefix, double &G)
 {
     double gi = std::round(G);
@@ -388,7 +398,7 @@ void prefer_integer(const Run &run, const State &st, const char *prefix, double 
     if (!fi.ok || !fg.ok)
         return;
     double s2 = fg.chi2 / (double)std::max(1L, 2 * fg.N - fg.P);
-    if ((fi.chi2 - fg.chi2) / s2 <= 3.84)
+    if ((fi.chi2 - fg.chi2) / s2 <= INTEGER_REJECT_CHI2)
         G = gi;
 }
 

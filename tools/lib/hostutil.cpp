@@ -32,4 +32,24 @@ int write_atomic(const std::string &path, const std::string &text, char *err, si
     return 0;
 }
 
+int is_model_file(const std::string &path, char *err, size_t errlen)
+{
+    std::FILE *f = std::fopen(path.c_str(), "rb");
+    if (!f) {
+        set_err(err, errlen, path + ": cannot open: " + std::strerror(errno));
+        return -1;
+    }
+    char line[256] = "";
+    int model = 0;
+    while (std::fgets(line, sizeof line, f)) {
+        const char *q = line + std::strspn(line, " \t\r\n");
+        if (!*q || *q == '#')
+            continue;
+        model = std::strncmp(q, "pm-model", 8) == 0;
+        break;
+    }
+    std::fclose(f);
+    return model;
+}
+
 } // namespace pmhost

@@ -12,6 +12,12 @@ namespace pmhost {
 // ("path: cannot write: reason").
 int write_atomic(const std::string &path, const std::string &text, char *err, size_t errlen);
 
+// Is the file at path a model file (its first line that is not blank or a
+// '#' comment starts "pm-model") rather than a run?  Returns 1 or 0, or -1
+// with "path: cannot open: reason" in err.  (pmfit compare OLD, report
+// --compare OLD: OLD is either.)
+int is_model_file(const std::string &path, char *err, size_t errlen);
+
 // Copy msg into err (truncated, NUL-terminated) if err is not NULL.
 void set_err(char *err, size_t errlen, const std::string &msg);
 

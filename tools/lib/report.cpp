@@ -10,6 +10,8 @@
 #include "explain_internal.hpp"
 #include "modelfile.h"
 #include "plan.hpp"
+#include "plan_inputs.hpp"
+#include "hostutil.hpp"
 #include "plots.hpp"
 
 #include <algorithm>
@@ -259,19 +261,11 @@ void stage_fit(Data &d)
 void stage_compare(Data &d)
 {
     const std::string &old = d.o.compare;
-    std::FILE *f = std::fopen(old.c_str(), "rb");
-    if (!f)
-        throw std::runtime_error(old + ": cannot open: " + std::strerror(errno));
-    char line[256] = "";
-    bool is_model = false;
-    while (std::fgets(line, sizeof line, f)) {
-        const char *q = line + std::strspn(line, " \t\r\n");
-        if (!*q || *q == '#')
-            continue;
-        is_model = std::strncmp(q, "pm-model", 8) == 0;
-        break;
-    }
-    std::fclose(f);
+    char ferr[1024];
+    int kind = is_model_file(old, ferr, sizeof ferr);
+    if (kind < 0)
+        throw std::runtime_error(ferr);
+    bool is_model = kind == 1;
     pm_model old_model;
     std::vector<double> old_err;
     FitOut old_fit;
@@ -322,6 +316,7 @@ void stage_plan(Data &d)
     po.latitude = d.run.latitude;
     po.next = d.o.next;
     po.noise_arcsec = d.fit.res.sigma * RAD2AS;
+    po.min_el_deg = d.o.min_el_deg;
     try {
         d.plan = plan_targets(d.run, po);
     } catch (const std::exception &x) {
@@ -780,12 +775,16 @@ void section_plan(Page &p, const Data &d)
     }
     const Plan &pl = d.plan;
     para(p, fmt("The %zu stars to take next, in this order, that most reduce the model's predicted error "
-                "averaged over the sky above elevation %.0f&deg; (I-optimal design, docs/model.md, &ldquo;Which "
+                "averaged over the sky above elevation %.0f&deg;%s (I-optimal design, docs/model.md, &ldquo;Which "
                 "star next&rdquo;), for this model (P = %d) and this run's &sigma; = %.3f&Prime;; candidates on a "
                 "%.0f&deg; grid. Predicted mean error now: <b>%s</b>. The same list: <code>",
-                pl.targets.size(), d.plan_opt.min_el_deg, d.fit.model.n_terms, d.plan_opt.noise_arcsec,
-                d.plan_opt.grid_deg, arcsec_text(pl.before_arcsec).c_str()) +
-                h(fmt("pmfit plan %s --next %d --order %d", d.run.path.c_str(), d.o.next, d.o.order)) +
+                pl.targets.size(), d.plan_opt.min_el_deg,
+                d.o.horizon.empty() ? "" : (" and the horizon of " + h(d.o.horizon)).c_str(),
+                d.fit.model.n_terms, d.plan_opt.noise_arcsec, d.plan_opt.grid_deg,
+                arcsec_text(pl.before_arcsec).c_str()) +
+                h(fmt("pmfit plan %s --next %d --order %d --min-el %g%s%s", d.run.path.c_str(), d.o.next,
+                      d.o.order, d.o.min_el_deg, d.o.horizon.empty() ? "" : " --horizon ",
+                      d.o.horizon.c_str())) +
                 (d.o.adds.empty() ? "" : " --add &hellip;") + "</code>.");
     std::vector<std::vector<std::string>> rows;
     std::vector<std::pair<double, double>> marks;
@@ -918,6 +917,8 @@ std::string report_html(const Run &run, const ReportOptions &o, const ReportProg
             progress(name, done);
     };
     Data d(run, o);
+    if (!o.horizon.empty()) // a bad horizon file is the user's error, not the run's
+        d.plan_opt.horizon = read_horizon(o.horizon);
     if (!o.compare.empty()) {
         stage("compare", 0.0);
         stage_compare(d);

@@ -24,6 +24,8 @@ struct ReportOptions {
     double alpha = 0.01;               // explain: false-alarm probability
     std::vector<double> gears_ha, gears_dec; // explain: known gear periods (--gear)
     int next = 5;                      // plan: how many targets
+    double min_el_deg = 15;            // plan: the lowest elevation (pmfit plan --min-el)
+    std::string horizon;               // plan: a horizon file (--horizon; empty: none)
     std::string compare;               // OLD: a model file or a run; empty: no comparison
     bool refraction = true;            // reading OLD when it is a run
     bool skip_bad = false;

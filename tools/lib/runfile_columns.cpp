@@ -290,14 +290,7 @@ private:
         if (tok.size() != cols_.size())
             return ctx_.bad_record(n, format("%zu fields, expected %zu: %s", tok.size(), cols_.size(),
                                              column_list().c_str()));
-        pmrun_obs o;
-        std::memset(&o, 0, sizeof o);
-        o.enc_ha = o.enc_dec = o.app_ha = o.app_dec = 0;
-        o.pier = PMRUN_PIER_UNKNOWN;
-        o.temp_c = o.time_h = nan();
-        o.dir = 0;
-        o.line = n;
-        for (double &a : o.aux) a = nan();
+        pmrun_obs o = blank_obs(n);
         for (size_t i = 0; i < tok.size(); ++i) {
             std::string why;
             if (!field(cols_[i], tok[i], o, why))

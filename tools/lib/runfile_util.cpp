@@ -1,4 +1,5 @@
-// runfile_util.cpp - helpers shared by the RTS2, MW4, CSV and MMT readers:
+// runfile_util.cpp - helpers shared by the readers: a blank record (every
+// reader but TPOINT's) and, for the RTS2, MW4, CSV and MMT readers,
 // sexagesimal angles, ISO 8601 UTC times, the local sidereal time from UTC,
 // the weather for refraction, a German mount's sky place to the encoder
 // convention.  docs/formats.md, sections 4-7.

@@ -1,0 +1,244 @@
+/*
+**  pm_indi.cpp - the INDI math plugin's fitting logic (pm_indi.h): the rule
+**  for the order, the fit and its fallbacks.  Plain pm C API, no INDI.
+*/
+#include "pm_indi.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <vector>
+
+namespace
+{
+
+const double kPi = 3.14159265358979323846;
+const int kMaxIter = 30;
+
+double wrap_pi(double a)
+{
+    a = std::fmod(a, 2 * kPi);
+    if (a > kPi)
+        a -= 2 * kPi;
+    else if (a <= -kPi)
+        a += 2 * kPi;
+    return a;
+}
+
+/* Index offsets: c' the circular mean of app1 - enc1, e' the mean of
+** enc2 - app2 (pm: apparent = (enc1 + c', enc2 - e') for a model of the
+** index terms alone, exactly). */
+void offsets(long n, const double *e1, const double *e2, const double *a1, const double *a2, double *c,
+             double *e)
+{
+    double s = 0, co = 0, d = 0;
+    for (long i = 0; i < n; i++) {
+        double t = a1[i] - e1[i];
+        s += std::sin(t);
+        co += std::cos(t);
+        d += e2[i] - a2[i];
+    }
+    *c = (s == 0 && co == 0) ? 0.0 : std::atan2(s, co);
+    *e = n > 0 ? d / (double)n : 0.0;
+}
+
+/* A model of the given order whose isotropic terms are copied from src
+** (or the offsets when src is NULL). */
+pm_status start_model(pm_model *m, int mount, int order, const pm_model *src, double c, double e)
+{
+    pm_status st = pm_model_init(m, mount, order);
+    if (st != PM_OK)
+        return st;
+    if (src) {
+        for (int k = 0; k < 6; k++)
+            m->coef[k] = src->coef[k];
+    } else {
+        int ic, ie;
+        if (pm_model_find(m, PM_BASE_C, 0, 0, &ic) != PM_OK || pm_model_find(m, PM_BASE_E, 0, 0, &ie) != PM_OK)
+            return PM_ERR_STATE;
+        m->coef[ic] = c;
+        m->coef[ie] = e;
+    }
+    return pm_model_prepare(m);
+}
+
+/* Leave-one-out rms per axis (Note 1 of pm_indi_fit). */
+double loo_rms(const pm_fit *fit, const pm_fit_result *fr, const pm_model *m, long n, const double *e1,
+               const double *e2, const double *a1, const double *a2)
+{
+    pm_fit_result unit = *fr;
+    double sum = 0;
+    unit.sigma = 1.0;
+    for (long i = 0; i < n; i++) {
+        double s, cov[3], r[2];
+        if (pm_fit_pointing_sigma(fit, &unit, m, nullptr, e1[i], e2[i], &s, cov) != PM_OK ||
+                pm_model_residual(m, nullptr, e1[i], e2[i], a1[i], a2[i], r) != PM_OK)
+            return HUGE_VAL;
+        double h = 0.5 * (cov[0] + cov[2]);
+        if (!(h < 0.999))
+            return HUGE_VAL;
+        sum += (r[0] * r[0] + r[1] * r[1]) / ((1 - h) * (1 - h));
+    }
+    return n > 0 ? std::sqrt(sum / (2.0 * (double)n)) : 0.0;
+}
+
+} // namespace
+
+extern "C" {
+
+double pm_indi_spread(long n, const double *a1, const double *a2)
+{
+    double mx = 0, my = 0, mz = 0, worst = 0, len;
+    if (n < 1 || !a1 || !a2)
+        return 0.0;
+    for (long i = 0; i < n; i++) {
+        mx += std::cos(a2[i]) * std::cos(a1[i]);
+        my += std::cos(a2[i]) * std::sin(a1[i]);
+        mz += std::sin(a2[i]);
+    }
+    len = std::sqrt(mx * mx + my * my + mz * mz);
+    if (!(len > 1e-9 * (double)n))
+        return kPi;
+    mx /= len;
+    my /= len;
+    mz /= len;
+    for (long i = 0; i < n; i++) {
+        double x = std::cos(a2[i]) * std::cos(a1[i]), y = std::cos(a2[i]) * std::sin(a1[i]), z = std::sin(a2[i]);
+        double cx = y * mz - z * my, cy = z * mx - x * mz, cz = x * my - y * mx;
+        double ang = std::atan2(std::sqrt(cx * cx + cy * cy + cz * cz), x * mx + y * my + z * mz);
+        if (ang > worst)
+            worst = ang;
+    }
+    return worst;
+}
+
+int pm_indi_choose_order(long n, double spread)
+{
+    static const double need[PM_INDI_MAX_ORDER + 1] = {PM_INDI_SPREAD_L0, PM_INDI_SPREAD_L1, PM_INDI_SPREAD_L2};
+    for (int L = PM_INDI_MAX_ORDER; L >= 0; L--)
+        if (n >= PM_SH_TERMS(L) && spread >= need[L])
+            return L;
+    return -1;
+}
+
+pm_status pm_indi_fit(int mount, long n, const double *enc1, const double *enc2, const double *app1,
+                      const double *app2, pm_fit *fit, pm_model *out, pm_indi_result *res)
+{
+    if (!fit || !out || !res || n < 0 || (mount != PM_MOUNT_EQUATORIAL && mount != PM_MOUNT_ALTAZ))
+        return PM_ERR_ARG;
+    if (n > 0 && (!enc1 || !enc2 || !app1 || !app2))
+        return PM_ERR_ARG;
+    for (long i = 0; i < n; i++)
+        if (!std::isfinite(enc1[i]) || !std::isfinite(enc2[i]) || !std::isfinite(app1[i]) ||
+                !std::isfinite(app2[i]))
+            return PM_ERR_NONFINITE;
+
+    pm_indi_result r;
+    std::memset(&r, 0, sizeof r);
+    for (int L = 0; L <= PM_INDI_MAX_ORDER; L++)
+        r.cv[L] = -1;
+    r.order = -1;
+    r.chosen_order = -1;
+    r.spread = pm_indi_spread(n, app1, app2);
+
+    pm_model best;
+    double c = 0, e = 0;
+    offsets(n, enc1, enc2, app1, app2, &c, &e);
+    pm_status st = start_model(&best, mount, 0, nullptr, wrap_pi(c), e);
+    if (st != PM_OK)
+        return st;
+    r.kind = n > 0 ? PM_INDI_OFFSET : PM_INDI_NONE;
+    r.n_par = n > 0 ? 2 : 0;
+
+    r.chosen_order = n > 0 ? pm_indi_choose_order(n, r.spread) : -1;
+    /* Fit up the ladder 0 .. chosen (each start from the one below); a
+    ** singular or diverging fit ends the climb at the last good one. */
+    std::vector<pm_model> fitted(PM_INDI_MAX_ORDER + 1);
+    double sig[PM_INDI_MAX_ORDER + 1] = {0};
+    int npar[PM_INDI_MAX_ORDER + 1] = {0};
+    int top = -1;
+    for (int L = 0; L <= r.chosen_order; L++) {
+        pm_model &m = fitted[L];
+        const pm_model *lower = L > 0 ? &fitted[L - 1] : nullptr;
+        pm_fit_result fr;
+        st = start_model(&m, mount, L, lower, wrap_pi(c), e);
+        if (st == PM_OK)
+            st = pm_fit_run(fit, &m, nullptr, n, enc1, enc2, app1, app2, kMaxIter, &fr);
+        if (st != PM_OK) {
+            r.fallbacks = r.chosen_order - L + 1;
+            r.bad_term[0] = 0;
+            if (st == PM_ERR_SINGULAR && fit->bad_term >= 0 && fit->bad_term < m.n_terms)
+                pm_term_name(&m, fit->bad_term, r.bad_term, sizeof r.bad_term);
+            else
+                std::snprintf(r.bad_term, sizeof r.bad_term, "status %d", (int)st);
+            break;
+        }
+        r.cv[L] = loo_rms(fit, &fr, &m, n, enc1, enc2, app1, app2);
+        sig[L] = fr.sigma;
+        npar[L] = fr.n_par;
+        top = L;
+    }
+    /* the fitted order that predicts best (a higher one must earn it) */
+    for (int L = 0; L <= top; L++)
+        if (r.kind != PM_INDI_FIT || r.cv[L] + PM_INDI_CV_FLOOR < PM_INDI_CV_GAIN * r.cv[r.order]) {
+            best = fitted[L];
+            r.kind = PM_INDI_FIT;
+            r.order = L;
+            r.sigma = sig[L];
+            r.n_par = npar[L];
+        }
+    *out = best;
+    *res = r;
+    return PM_OK;
+}
+
+void pm_indi_describe(const pm_indi_result *r, long n, long skipped, char *buf, size_t len)
+{
+    char extra[160] = "";
+    const double arcsec = 180.0 / kPi * 3600.0;
+    if (!buf || len == 0)
+        return;
+    if (!r) {
+        buf[0] = 0;
+        return;
+    }
+    if (r->fallbacks > 0)
+        std::snprintf(extra, sizeof extra, "; order lowered %d time(s) (%s)", r->fallbacks, r->bad_term);
+    if (skipped > 0) {
+        size_t k = std::strlen(extra);
+        std::snprintf(extra + k, sizeof extra - k, "; %ld sync point(s) skipped", skipped);
+    }
+    switch (r->kind) {
+    case PM_INDI_NONE:
+        std::snprintf(buf, len, "no sync points: no correction%s", extra);
+        break;
+    case PM_INDI_OFFSET:
+        std::snprintf(buf, len,
+                      "%ld sync point(s) over %.1f deg: index offsets only (order 0 needs %d points "
+                      "over %.0f deg)%s",
+                      n, r->spread * 180.0 / kPi, PM_SH_TERMS(0), PM_INDI_SPREAD_L0 * 180.0 / kPi, extra);
+        break;
+    default: {
+        char cv[160] = "";
+        for (int L = 0, k = 0; L <= PM_INDI_MAX_ORDER; L++) {
+            if (r->cv[L] < 0)
+                continue;
+            if (r->cv[L] < 1e6)
+                k += std::snprintf(cv + k, sizeof cv - (size_t)k, "%s%d: %.3f", k ? ", " : "", L, r->cv[L] * arcsec);
+            else
+                k += std::snprintf(cv + k, sizeof cv - (size_t)k, "%s%d: undetermined", k ? ", " : "", L);
+            if (k >= (int)sizeof cv)
+                break;
+        }
+        std::snprintf(buf, len,
+                      "%ld sync points over %.1f deg: order %d fit, %d terms, sigma %.3f arcsec "
+                      "(leave-one-out arcsec, order %s)%s%s", n,
+                      r->spread * 180.0 / kPi, r->order, r->n_par, r->sigma * arcsec, cv, extra,
+                      r->sigma * arcsec > 1800.0 ? " (the sync points disagree by degrees: check the "
+                      "site, the time and the sync targets)" : "");
+        break;
+    }
+    }
+}
+
+}

@@ -1,0 +1,110 @@
+/*
+**  pm_indi.h - the INDI math plugin's fitting logic, without INDI: which
+**  model a set of sync points supports (order from their number and sky
+**  coverage), the fit with its fallbacks, and a one-line description.
+**  Used by indi/pm_math_plugin.cpp and tested by tests/check_indi.c.
+**  docs/indi.md states the rule.
+*/
+#ifndef PM_INDI_H
+#define PM_INDI_H
+
+#include <stddef.h>
+#include "pm.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* What the plugin's model is. */
+#define PM_INDI_NONE 0   /* no sync points: the identity */
+#define PM_INDI_OFFSET 1 /* index offsets only (c', e'): too few points or
+                            too small a patch of sky for a fit */
+#define PM_INDI_FIT 2    /* a fitted pm model of order pm_indi_result.order */
+
+/* A higher order is kept only if its leave-one-out rms is below
+** PM_INDI_CV_GAIN times the lower one's minus PM_INDI_CV_FLOOR (radians;
+** 1e-9 rad = 0.0002": noise-free data tie at rounding). */
+#define PM_INDI_CV_GAIN 0.8
+#define PM_INDI_CV_FLOOR 1e-9
+
+/* Highest order the rule chooses. */
+#define PM_INDI_MAX_ORDER 2
+
+/* Sky coverage (radians): the largest distance of a sync point from the
+** points' mean direction needed for order 0, 1, 2. */
+#define PM_INDI_SPREAD_L0 (10.0 * 3.14159265358979323846 / 180.0)
+#define PM_INDI_SPREAD_L1 (30.0 * 3.14159265358979323846 / 180.0)
+#define PM_INDI_SPREAD_L2 (60.0 * 3.14159265358979323846 / 180.0)
+
+typedef struct pm_indi_result {
+    int kind;          /* PM_INDI_* */
+    int order;         /* fitted order (PM_INDI_FIT), else -1 */
+    int chosen_order;  /* what the rule asked for (-1: offsets) */
+    double spread;     /* coverage (radians) */
+    double sigma;      /* fit residual (radians; 0 for NONE/OFFSET) */
+    int n_par;         /* parameters of the model used */
+    int fallbacks;     /* orders given up (singular or diverged fits) */
+    double cv[PM_INDI_MAX_ORDER + 1]; /* leave-one-out rms per axis of each
+                          order fitted (radians; -1 not fitted, HUGE_VAL
+                          when a point alone determines terms) */
+    char bad_term[48]; /* the term that made the last given-up fit singular */
+} pm_indi_result;
+
+/*
+**  pm_indi_spread - sky coverage of n positions (axis 1, axis 2, radians):
+**  the largest angle between one of them and their normalised mean
+**  direction (pi when the mean vanishes).  0 for n < 1.
+*/
+double pm_indi_spread(long n, const double *a1, const double *a2);
+
+/*
+**  pm_indi_choose_order - the order the rule allows for n sync points of a
+**  given spread: the highest L <= PM_INDI_MAX_ORDER with n >= PM_SH_TERMS(L)
+**  (twice as many equations as parameters) and spread >= PM_INDI_SPREAD_L<L>;
+**  -1 (offsets only) when even L = 0 is not allowed.
+*/
+int pm_indi_choose_order(long n, double spread);
+
+/*
+**  pm_indi_fit - the model for n sync points.
+**
+**  Given:
+**     mount    int          PM_MOUNT_EQUATORIAL or PM_MOUNT_ALTAZ
+**     n        long         number of points (0 allowed)
+**     enc1, enc2  const double*  the mount's positions (radians)
+**     app1, app2  const double*  the stars' positions (radians)
+**     fit      pm_fit*      workspace
+**  Returned:
+**     out      pm_model*    the model (prepared): identity for n = 0,
+**                           index offsets when no fit is allowed, else of
+**                           the orders up to the rule's that fit (singular
+**                           or diverging fits end the climb), the one whose
+**                           leave-one-out error is smallest; a higher order
+**                           must beat a lower one by PM_INDI_CV_GAIN and
+**                           PM_INDI_CV_FLOOR (Note 1)
+**     res      pm_indi_result*  what was done
+**  Returned (function value):
+**              pm_status    PM_OK; PM_ERR_ARG (NULL, n < 0, bad mount);
+**                           PM_ERR_NONFINITE (a non-finite position).
+**                           On error *out and *res are unchanged.
+**  Notes:
+**  1) The leave-one-out error of a point is its residual / (1 - h), h the
+**     mean of its two rows' leverages (the diagonal block of
+**     J (J^T J)^-1 J^T, from pm_fit_pointing_sigma at sigma 1): exact for a
+**     linear fit, and what the model would miss there without the point.
+**     It catches an order the coverage nearly cannot determine (a pivot
+**     just above pm's singular threshold), which fits the sync points and
+**     errs between them.
+*/
+pm_status pm_indi_fit(int mount, long n, const double *enc1, const double *enc2,
+                      const double *app1, const double *app2, pm_fit *fit,
+                      pm_model *out, pm_indi_result *res);
+
+/* One line for the log: what model, from how many points, its sigma. */
+void pm_indi_describe(const pm_indi_result *res, long n, long skipped, char *buf, size_t len);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
