@@ -503,11 +503,12 @@ pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
 **     points (36).  Hard bound, whatever the inputs: PM_INVERT_MAX_EVALS =
 **     2 x 13 + 12 + 3 x 12 = 74 model evaluations; elsewhere a few.
 **     Realistic models (L <= 2, isotropic terms within 10 deg, harmonic
-**     terms within 10') reach every target a mount can reach with PM_OK:
-**     none of 800,000 cold calls within 0.5 deg of the mount's pole, down
-**     to its very edge, failed (bench/inv_stress.c; tests/check_bounded.c
-**     asserts 48,000 of them).  For tracking use pm_model_invert_near,
-**     which never needs the rescue (at most 13).
+**     terms within 10') get PM_OK for the targets a mount can reach: 2 of
+**     1,200,000 cold calls within 0.5 deg of the mount's pole, down to its
+**     very edge, did not (both where d and i nearly cancel at that pole;
+**     bench/inv_stress.c; tests/check_bounded.c asserts 48,000 calls, all
+**     PM_OK).  For tracking use pm_model_invert_near, which never needs the
+**     rescue (at most 13).
 **  3) PM_WARN_NOT_CONVERGED: a bound was reached; the best position found
 **     is returned.  PM_WARN_UNREACHABLE: no position on the requested side
 **     points at the target: it lies in the cap around the mount's pole
