@@ -736,7 +736,10 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
     ** known the next point's error is bounded before it is evaluated,
     **   |D(x') - D^'| <= |D + J h - D^'| + lip2 (|x - x_J| + |h| / 2) |h|,
     ** h = x' - x: the predicted stop. */
-    Trig<double> g, g2;
+    /* three slots (the current point, the next, the best), passed round by
+    ** pointer: no copies */
+    Trig<double> slot[3];
+    Trig<double> &g = slot[0];
     double dh_t = 0, dh_d = 0; /* D^ of g */
     double J[4] = {0, 0, 0, 0}, Ni[4] = {1, 0, 0, 1}, dist_j = 0;
     bool have_j = false, have_n = false, tried_n = false, reachable;
@@ -785,7 +788,7 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
 
     double change = 0, last_change = 1e300, best_change = 1e300;
     bool converged = false, best_reachable = reachable;
-    Trig<double> best = g;
+    Trig<double> *gp = &slot[0], *bp = &slot[0];
     /* the best point's displacement, its D^ and distance from J's point */
     double b_dt = 0, b_dd = 0, b_ht = 0, b_hd = 0, b_dist = 0;
     bool chord = true; /* Newton steps on D (else plain fixed-point steps) */
@@ -800,9 +803,9 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
                 break;
             used++;
             if (have_j) {
-                aniso<double>(m, k, g, ctx, &dt, &dd);
+                aniso<double>(m, k, *gp, ctx, &dt, &dd);
             } else {
-                aniso_jac(m, k, g, ctx, &dt, &dd, J);
+                aniso_jac(m, k, *gp, ctx, &dt, &dd, J);
                 have_j = true;
                 dist_j = 0;
             }
@@ -812,7 +815,7 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
         change = m_sqrt((dt - dh_t) * (dt - dh_t) + (dd - dh_d) * (dd - dh_d));
         if (change < best_change) {
             best_change = change;
-            best = g;
+            bp = gp;
             best_reachable = reachable;
             b_dt = dt;
             b_dd = dd;
@@ -832,7 +835,7 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
             if (!(chord && have_n))
                 break;
             chord = false;
-            g = best;
+            gp = bp;
             reachable = best_reachable;
             dt = b_dt;
             dd = b_dd;
@@ -845,22 +848,25 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
         double nt = dt, nd = dd, ht, hd;
         if (!tried_n) { /* (F_D once, where the first step needs it) */
             tried_n = true;
-            have_n = newton_prep(k, g, dh_t, dh_d, J, Ni);
+            have_n = newton_prep(k, *gp, dh_t, dh_d, J, Ni);
         }
         if (chord && have_n && change <= 0.01) {
             nt = dh_t + (Ni[0] * (dt - dh_t) + Ni[1] * (dd - dh_d));
             nd = dh_d + (Ni[2] * (dt - dh_t) + Ni[3] * (dd - dh_d));
         }
-        reachable = iso_inverse<double>(k, tg, nt, nd, side, &g2);
+        Trig<double> *g2p = &slot[0];
+        while (g2p == gp || g2p == bp)
+            g2p++;
+        reachable = iso_inverse<double>(k, tg, nt, nd, side, g2p);
         if (raw)
-            on_turn(m, k, a, &g2, ref_t, ref_d);
-        if (lip2 >= 0 && small_step(g2, g, &ht, &hd)) {
+            on_turn(m, k, a, g2p, ref_t, ref_d);
+        if (lip2 >= 0 && small_step(*g2p, *gp, &ht, &hd)) {
             double h2 = ht * ht + hd * hd, hn = m_sqrt(h2) * (1 + h2 * 0.2);
             /* (the second-order part alone first: it fails most steps) */
             if (!(lip2 * (dist_j + 0.5 * hn) * hn > PM_INVERT_TOL * 0.5) &&
                 step_bound(dt, dd, J, ht, hd, nt, nd, lip2, dist_j, hn) <=
                     PM_INVERT_TOL * 0.5) {
-                best = g2;
+                bp = g2p;
                 best_reachable = reachable;
                 converged = true;
                 break;
@@ -869,17 +875,17 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
         } else {
             dist_j = 1e300; /* (a bound fails from here on: J is not evaluated again) */
         }
-        g = g2;
+        gp = g2p;
         dh_t = nt;
         dh_d = nd;
     }
-    g = best;
+    Trig<double> &gb = *bp;
     reachable = best_reachable;
     if (!raw)
-        on_turn(m, k, a, &g, ref_t, ref_d);
+        on_turn(m, k, a, &gb, ref_t, ref_d);
 
-    double t = g.t; /* on the turn of ref_t, ref_d (on_turn) */
-    double d = g.d;
+    double t = gb.t; /* on the turn of ref_t, ref_d (on_turn) */
+    double d = gb.d;
     /* The fixed point judged the position before its angles were rounded
     ** to doubles (atan2, the turn), with PM_INVERT_TOL / 2 to spare.  The
     ** rounding (a few ulp of the larger angle) moves the model's position
@@ -904,7 +910,7 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
         /* A term restricted to one side of the pole jumps at the pole's
         ** edge; where rounding the angles moved the point across it, the
         ** returned angles evaluate a different model: Newton checks them. */
-        else if (sided && !(ctx && ctx->pier) && side_at(k, g) != side_at(k, trig_of(t, d)))
+        else if (sided && !(ctx && ctx->pier) && side_at(k, gb) != side_at(k, trig_of(t, d)))
             converged = false;
     }
     pm_status result = PM_OK;

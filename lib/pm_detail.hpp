@@ -835,21 +835,27 @@ template <typename T, typename W, int LC> struct HarmSums {
     static void sum(int N, const W (*dense)[6], const T *Y, T *S)
     {
         /* (assigned, not zeroed and added: the same sums, and no memset
-        ** call from the compiler on some cores) */
+        ** call from the compiler on some cores; summed in locals and
+        ** stored once: S may alias dense as far as the compiler knows, and
+        ** would otherwise be stored after every product) */
+        T acc[6];
 #pragma GCC unroll 6
         for (int kk = 0; kk < 6; kk++)
-            S[kk] = (T)dense[1][kk] * Y[1];
+            acc[kk] = (T)dense[1][kk] * Y[1];
 #pragma GCC unroll 32
         for (int j = 2; j < N; j++) {
             const T y = Y[j];
 #pragma GCC unroll 6
             for (int kk = 0; kk < 6; kk++)
-                S[kk] += (T)dense[j][kk] * y;
+                acc[kk] += (T)dense[j][kk] * y;
         }
+#pragma GCC unroll 6
+        for (int kk = 0; kk < 6; kk++)
+            S[kk] = acc[kk];
     }
 };
 
-#if defined(__SSE2__) && !PM_SOFT_DOUBLE
+#if defined(__SSE2__) && !PM_SOFT_DOUBLE && !defined(PM_SCALAR_SUMS)
 /* Doubles on x86-64: the six sums as three pairs in SSE2 registers (half
 ** the instructions), the odd and even harmonics summed apart (so the
 ** sums round differently from the scalar version's, by an ulp). */
@@ -942,9 +948,52 @@ inline void sh_sums_jac_n(int Lrt, const Trig<T> &g, const double (*dense)[6], T
     T Y[PM_N_HARM(LC > 0 ? LC : PM_MAX_L)], Yt[PM_N_HARM(LC > 0 ? LC : PM_MAX_L)],
         Yd[PM_N_HARM(LC > 0 ? LC : PM_MAX_L)];
     harmonics_jac_n<T, LC>(L, g, Y, Yt, Yd);
+#if defined(__SSE2__) && !PM_SOFT_DOUBLE && !defined(PM_SCALAR_SUMS)
+    /* (SSE2: three sums of three register pairs each) */
     HarmSums<T, double, LC>::sum((L + 1) * (L + 1), dense, Y, S);
     HarmSums<T, double, LC>::sum((L + 1) * (L + 1), dense, Yt, St);
     HarmSums<T, double, LC>::sum((L + 1) * (L + 1), dense, Yd, Sd);
+#else
+    /* The three sums together, three base vectors at a time (each table
+    ** entry loaded once; 9 sums, 3 harmonics and the entry fit the 16
+    ** double registers of a Cortex-M7), S in the order of HarmSums::sum
+    ** (the same bits).  St leaves out the harmonics of m = 0, whose Yt is
+    ** zero. */
+#pragma GCC unroll 2
+    for (int h = 0; h < 6; h += 3) {
+        T a[3], b[3], c[3];
+#pragma GCC unroll 3
+        for (int kk = 0; kk < 3; kk++) {
+            const T w = (T)dense[1][h + kk];
+            a[kk] = w * Y[1];
+            b[kk] = w * Yt[1];
+            c[kk] = w * Yd[1];
+        }
+#pragma GCC unroll 16
+        for (int l = 1; l <= L; l++) {
+#pragma GCC unroll 33
+            for (int mm = -l; mm <= l; mm++) {
+                const int j = l * l + l + mm;
+                if (j < 2)
+                    continue;
+#pragma GCC unroll 3
+                for (int kk = 0; kk < 3; kk++) {
+                    const T w = (T)dense[j][h + kk];
+                    a[kk] += w * Y[j];
+                    if (mm != 0)
+                        b[kk] += w * Yt[j];
+                    c[kk] += w * Yd[j];
+                }
+            }
+        }
+#pragma GCC unroll 3
+        for (int kk = 0; kk < 3; kk++) {
+            S[h + kk] = a[kk];
+            St[h + kk] = b[kk];
+            Sd[h + kk] = c[kk];
+        }
+    }
+#endif
 }
 
 /* sh_sums_jac_n for order L (0..PM_MAX_L), dispatched as sh_sums. */
