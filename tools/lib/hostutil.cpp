@@ -2,6 +2,7 @@
 #include "hostutil.hpp"
 
 #include <cerrno>
+#include <cstdarg>
 #include <cstdio>
 #include <cstring>
 
@@ -50,6 +51,55 @@ int is_model_file(const std::string &path, char *err, size_t errlen)
     }
     std::fclose(f);
     return model;
+}
+
+std::string fmt(const char *f, ...)
+{
+    va_list ap, aq;
+    va_start(ap, f);
+    va_copy(aq, ap);
+    char buf[512];
+    int n = std::vsnprintf(buf, sizeof buf, f, ap);
+    va_end(ap);
+    std::string out;
+    if (n < 0) {
+        /* an encoding error: nothing */
+    } else if ((size_t)n < sizeof buf) {
+        out.assign(buf, (size_t)n);
+    } else {
+        out.resize((size_t)n + 1);
+        std::vsnprintf(&out[0], out.size(), f, aq);
+        out.resize((size_t)n);
+    }
+    va_end(aq);
+    return out;
+}
+
+std::string xml_escape(const std::string &s)
+{
+    std::string o;
+    for (size_t i = 0; i < s.size(); i++) {
+        unsigned char c = (unsigned char)s[i];
+        if (c == '&') o += "&amp;";
+        else if (c == '<') o += "&lt;";
+        else if (c == '>') o += "&gt;";
+        else if (c == '"') o += "&quot;";
+        else if (c == '\'') o += "&apos;";
+        else if (c < 0x20 || c == 0x7f) o += ' ';
+        else if (c < 0x80) o += (char)c;
+        else {
+            size_t n = c >= 0xC2 && c <= 0xDF ? 1 : c >= 0xE0 && c <= 0xEF ? 2 : c >= 0xF0 && c <= 0xF4 ? 3 : 0;
+            bool ok = n > 0 && i + n < s.size();
+            for (size_t k = 1; ok && k <= n; k++)
+                ok = ((unsigned char)s[i + k] & 0xC0) == 0x80;
+            unsigned char c1 = ok ? (unsigned char)s[i + 1] : 0;
+            ok = ok && !(c == 0xE0 && c1 < 0xA0) && !(c == 0xED && c1 >= 0xA0) &&
+                 !(c == 0xF0 && c1 < 0x90) && !(c == 0xF4 && c1 >= 0x90);
+            if (ok) { o.append(s, i, n + 1); i += n; }
+            else o += '?';
+        }
+    }
+    return o;
 }
 
 } // namespace pmhost

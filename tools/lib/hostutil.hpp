@@ -18,6 +18,14 @@ int write_atomic(const std::string &path, const std::string &text, char *err, si
 // --compare OLD: OLD is either.)
 int is_model_file(const std::string &path, char *err, size_t errlen);
 
+// printf into a std::string, of any length.
+std::string fmt(const char *f, ...) __attribute__((format(printf, 1, 2)));
+
+// Escape text for XML and HTML (SVG figures, the report page): & < > " '
+// as entities, control characters as spaces, invalid UTF-8 bytes as '?'
+// (valid UTF-8 passes through).
+std::string xml_escape(const std::string &s);
+
 // Copy msg into err (truncated, NUL-terminated) if err is not NULL.
 void set_err(char *err, size_t errlen, const std::string &msg);
 

@@ -26,44 +26,8 @@ const double ANGLE_STEP[] = {10, 15, 30, 45, 90, 180};
 bool fin(double v) { return std::isfinite(v); }
 const char *colour(int i) { return COLOUR[((i % 8) + 8) % 8]; }
 
-std::string fmt(const char *f, ...) __attribute__((format(printf, 1, 2)));
-std::string fmt(const char *f, ...)
-{
-    char buf[512];
-    va_list ap;
-    va_start(ap, f);
-    std::vsnprintf(buf, sizeof buf, f, ap);
-    va_end(ap);
-    return buf;
-}
-
-// XML-escape; control characters become spaces and invalid UTF-8 bytes '?'.
-std::string esc(const std::string &s)
-{
-    std::string o;
-    for (size_t i = 0; i < s.size(); i++) {
-        unsigned char c = (unsigned char)s[i];
-        if (c == '&') o += "&amp;";
-        else if (c == '<') o += "&lt;";
-        else if (c == '>') o += "&gt;";
-        else if (c == '"') o += "&quot;";
-        else if (c == '\'') o += "&apos;";
-        else if (c < 0x20 || c == 0x7f) o += ' ';
-        else if (c < 0x80) o += (char)c;
-        else {
-            size_t n = c >= 0xC2 && c <= 0xDF ? 1 : c >= 0xE0 && c <= 0xEF ? 2 : c >= 0xF0 && c <= 0xF4 ? 3 : 0;
-            bool ok = n > 0 && i + n < s.size();
-            for (size_t k = 1; ok && k <= n; k++)
-                ok = ((unsigned char)s[i + k] & 0xC0) == 0x80;
-            unsigned char c1 = ok ? (unsigned char)s[i + 1] : 0;
-            ok = ok && !(c == 0xE0 && c1 < 0xA0) && !(c == 0xED && c1 >= 0xA0) &&
-                 !(c == 0xF0 && c1 < 0x90) && !(c == 0xF4 && c1 >= 0x90);
-            if (ok) { o.append(s, i, n + 1); i += n; }
-            else o += '?';
-        }
-    }
-    return o;
-}
+using pmhost::fmt;
+using pmhost::xml_escape;
 
 // Approximate width in pixels of text in a DejaVu-like sans-serif font.
 double text_w(const std::string &s, double size)
@@ -93,7 +57,7 @@ struct Svg {
         s = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
         s += fmt("<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" viewBox=\"0 0 %d %d\" "
                  "font-family=\"%s\">\n", w, h, w, h, FONT);
-        s += "<title>" + esc(title) + "</title>\n";
+        s += "<title>" + xml_escape(title) + "</title>\n";
         s += fmt("<rect x=\"0\" y=\"0\" width=\"%d\" height=\"%d\" fill=\"#ffffff\"/>\n", w, h);
         if (!title.empty())
             text(w / 2.0, 30, title, 18, "middle", "#111111", " font-weight=\"bold\"");
@@ -102,7 +66,7 @@ struct Svg {
               const char *fill = INK, const std::string &extra = "")
     {
         s += fmt("<text x=\"%.1f\" y=\"%.1f\" font-size=\"%g\" text-anchor=\"%s\" fill=\"%s\"", x, y, size, anchor, fill);
-        s += extra + ">" + esc(t) + "</text>\n";
+        s += extra + ">" + xml_escape(t) + "</text>\n";
     }
     void line(double x1, double y1, double x2, double y2, const char *stroke, double w, const std::string &extra = "")
     {
