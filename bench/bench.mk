@@ -24,7 +24,7 @@ DIST_CG_EVERY ?= 4
 # each Cortex-M bench ELF measures both the double and the float build
 BENCH_TARGETS := m4f m7
 BENCH_CFLAGS  := -std=gnu99 $(OPT) -g -Wall -Wextra -Iinclude -Ibench -Ifirmware_demo
-BENCH_SRC_H   := bench/bench_common.h bench/naive.h include/pm.h
+BENCH_SRC_H   := bench/bench_common.h bench/naive.h bench/host_timer.h include/pm.h
 
 $(BN)/host/naive.o: bench/naive.c $(BENCH_SRC_H)
 	@mkdir -p $(@D)
@@ -69,7 +69,7 @@ BENCH_ELFS := $(foreach t,$(BENCH_TARGETS),$(BN)/$(t)/bench.elf)
 # (model evaluations: the core with the counter of tests/probe.h, the objects
 # check_bounded uses), <t>/dist.elf (Cortex-M instructions per call).
 DIST_SRC := bench/dist.c bench/bench_common.c
-DIST_H   := bench/dist.h bench/bench_common.h tests/hard_cases.h tests/testutil.h include/pm.h
+DIST_H   := bench/dist.h bench/bench_common.h bench/host_timer.h tests/hard_cases.h tests/testutil.h include/pm.h
 
 $(BN)/pmbench_dist: bench/bench_dist_host.c $(DIST_SRC) $(DIST_H) $(BN)/host/naive.o $(B)/libpm.a
 	@mkdir -p $(@D)

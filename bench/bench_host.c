@@ -26,37 +26,7 @@
 #include "bench_common.h"
 #include "naive.h"
 
-#if defined(__has_include)
-#if __has_include(<valgrind/callgrind.h>)
-#include <valgrind/callgrind.h>
-#define HAVE_CALLGRIND 1
-#endif
-#endif
-#ifndef HAVE_CALLGRIND
-#define CALLGRIND_ZERO_STATS
-#define CALLGRIND_DUMP_STATS_AT(s) ((void)(s))
-#endif
-
-#if defined(__x86_64__) || defined(__i386__)
-#include <x86intrin.h>
-static inline unsigned long long ticks(void)
-{
-    unsigned long long t;
-    _mm_lfence();
-    t = __rdtsc();
-    _mm_lfence();
-    return t;
-}
-#define TICK_UNIT "TSC ticks"
-#else
-static inline unsigned long long ticks(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (unsigned long long)ts.tv_sec * 1000000000ULL + (unsigned long long)ts.tv_nsec;
-}
-#define TICK_UNIT "ns (no TSC on this architecture)"
-#endif
+#include "host_timer.h"
 
 #define ARCSEC (3.14159265358979323846 / 648000.0)
 
@@ -185,17 +155,7 @@ int main(int argc, char **argv)
         return bad ? 1 : 0;
     }
 
-    {
-        /* one core, so the TSC and the caches are those of one CPU */
-        cpu_set_t set;
-        CPU_ZERO(&set);
-        CPU_SET(1, &set);
-        if (sched_setaffinity(0, sizeof set, &set) != 0) {
-            CPU_ZERO(&set);
-            CPU_SET(0, &set);
-            sched_setaffinity(0, sizeof set, &set);
-        }
-    }
+    pin_one_cpu();
     if (out_path && !(out = fopen(out_path, "w"))) {
         perror(out_path);
         return 1;
