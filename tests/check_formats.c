@@ -112,17 +112,6 @@ static void same_records(const char *name, const char *source, const pmrun_optio
     pmrun_free(b);
 }
 
-/* The value of term `name` in pmfit's JSON (fails if absent). */
-static double term_value(const char *json, const char *name)
-{
-    char pat[128];
-    const char *p;
-    snprintf(pat, sizeof pat, "{\"name\": \"%s\", \"value_arcsec\": ", name);
-    p = strstr(json, pat);
-    ck_assert_msg(p != NULL, "no term %s in: %.300s", name, json);
-    return atof(p + strlen(pat));
-}
-
 static double term_error(const char *json, const char *name)
 {
     char pat[128];
@@ -340,7 +329,7 @@ static void fit_matches(const char *name, const char *source, const double truth
     ck_assert_int_eq(pmfit_json(name, args, a, sizeof a), 0);
     ck_assert_int_eq(pmfit_json(source, "--order 0", b, sizeof b), 0);
     for (k = 0; k < 6; ++k) {
-        double v = term_value(a, kIso[k]), s = term_value(b, kIso[k]), e = term_error(a, kIso[k]);
+        double v = tu_term_value(a, kIso[k]), s = tu_term_value(b, kIso[k]), e = term_error(a, kIso[k]);
         ck_assert_msg(fabs(v - s) < TOL_FIT_SAME_AS, "%s: %s = %.5f\", source %.5f\"", name, kIso[k],
                       v, s);
         ck_assert_msg(fabs(v - truth[k]) < 4 * e + TOL_FIT_TRUTH_AS,
@@ -550,7 +539,7 @@ START_TEST(test_mmt_log_fits_as_its_tpoint_conversion)
     unlink(shifted);
     ck_assert_int_eq((int)tu_json_num(a, "n_obs"), 80);
     for (k = 0; k < 6; ++k) {
-        double va = term_value(a, kIso[k]), vb = term_value(b, kIso[k]), vc = term_value(c, kIso[k]);
+        double va = tu_term_value(a, kIso[k]), vb = tu_term_value(b, kIso[k]), vc = tu_term_value(c, kIso[k]);
         if (k == 4)
             ck_assert_msg(fabs((va - vb) + 5.9) < TOL_MMT_EL_OFFSET_AS, "e': log %.4f, TPOINT %.4f", va,
                           vb);

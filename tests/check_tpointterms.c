@@ -225,16 +225,6 @@ static void data_path(char *buf, size_t n, const char *name)
     snprintf(buf, n, "%s/tests/data/%s", top && *top ? top : ".", name);
 }
 
-static double term_value(const char *json, const char *name)
-{
-    char pat[128];
-    const char *p;
-    snprintf(pat, sizeof pat, "{\"name\": \"%s\", \"value_arcsec\": ", name);
-    p = strstr(json, pat);
-    ck_assert_msg(p != NULL, "no term %s in: %.300s", name, json);
-    return atof(p + strlen(pat));
-}
-
 static void read_text(const char *file, char *text, size_t len)
 {
     FILE *f = fopen(file, "r");
@@ -281,10 +271,10 @@ START_TEST(test_pmfit_tpoint_terms_file_equatorial)
     tu_tmpdir(dir, "pm_tpointterms_");
     fit_and_export(dir, "formats_source_eq.dat", "--order 1", text, sizeof text, json, sizeof json);
     for (k = 0; k < 6; ++k)
-        ck_assert_msg(fabs(file_value(text, kEqNames[k]) - sign[k] * term_value(json, pm[k])) <
+        ck_assert_msg(fabs(file_value(text, kEqNames[k]) - sign[k] * tu_term_value(json, pm[k])) <
                           TOL_FILE_AS,
                       "%s %.5f, %s %.5f", kEqNames[k], file_value(text, kEqNames[k]), pm[k],
-                      term_value(json, pm[k]));
+                      tu_term_value(json, pm[k]));
     ck_assert_ptr_nonnull(strstr(text, "!   dh = IH + CH sec d + NP tan d"));
     ck_assert_ptr_nonnull(strstr(text, "\nEND\n"));
     /* the order-1 harmonics: listed apart, and said so */
@@ -306,10 +296,10 @@ START_TEST(test_pmfit_tpoint_terms_file_altaz)
     fit_and_export(dir, "mmt_log.dat", "--order 0 --add tube_flexure --add refraction", text,
                    sizeof text, json, sizeof json);
     for (k = 0; k < 8; ++k)
-        ck_assert_msg(fabs(file_value(text, kAzNames[k]) - sign[k] * term_value(json, pm[k])) <
+        ck_assert_msg(fabs(file_value(text, kAzNames[k]) - sign[k] * tu_term_value(json, pm[k])) <
                           TOL_FILE_AS,
                       "%s %.5f, %s %.5f", kAzNames[k], file_value(text, kAzNames[k]), pm[k],
-                      term_value(json, pm[k]));
+                      tu_term_value(json, pm[k]));
     ck_assert_ptr_nonnull(strstr(text, "A from SOUTH"));
     ck_assert_ptr_nonnull(strstr(text, "!   dE =  IE + AN cos A + AW sin A - TF cos E - TX cot E"));
     ck_assert_ptr_null(strstr(text, "! Terms of the model with no TPOINT name"));

@@ -52,6 +52,18 @@ static inline double tu_json_num(const char *json, const char *key)
     return atof(p + strlen(pat));
 }
 
+/* The value (arcsec) of term `name` in pmfit fit --json's "terms" (fails
+** the test if absent). */
+static inline double tu_term_value(const char *json, const char *name)
+{
+    char pat[128];
+    const char *p;
+    snprintf(pat, sizeof pat, "{\"name\": \"%s\", \"value_arcsec\": ", name);
+    p = strstr(json, pat);
+    ck_assert_msg(p != NULL, "no term %s in: %.300s", name, json);
+    return atof(p + strlen(pat));
+}
+
 /* A fresh directory /tmp/<prefix>XXXXXX into dir (at least 64 bytes). */
 static inline void tu_tmpdir(char *dir, const char *prefix)
 {
