@@ -974,40 +974,15 @@ int cmd_plan(const Options &o)
 // a run (fitted at --order with --add, and its errors count).
 int cmd_compare(const Options &o, const Run &run)
 {
-    char ferr[1024];
-    int kind = is_model_file(o.model, ferr, sizeof ferr);
-    if (kind < 0)
-        die(ferr, 1);
-    bool is_model = kind == 1;
-    pm_model old_model;
-    std::vector<double> old_err;
-    FitOut old_fit;
-    Run old_run_copy;
-    bool have_fit = false;
-    if (is_model) {
-        char err[1024];
-        if (pmmodel_load(o.model.c_str(), &old_model, err, sizeof err) != 0)
-            die(err, 1);
-    } else {
-        Run old_run = load_run(o.model, o.refraction, o.skip_bad, o.format, o.equinox);
-        std::vector<int> all(old_run.obs.size());
-        for (size_t i = 0; i < all.size(); i++)
-            all[i] = (int)i;
-        FitOut fo = do_fit(old_run.obs, all,
-                           build_model(o.order, o.adds, old_run.obs, old_run.mount,
-                                       old_run.latitude, old_run.aux_names));
-        if (fo.status != PM_OK)
-            fail_fit(fo, o.model + " (the old run)");
-        old_model = fo.model;
-        old_err.assign(fo.res.err, fo.res.err + fo.model.n_terms);
-        old_fit = fo;
-        old_run_copy = old_run;
-        have_fit = true;
-    }
+    // (an unreadable OLD throws its file:line message: main prints it, exit 1)
+    OldSide os = load_old(o.model, o.order, o.adds, o.refraction, o.skip_bad, o.format,
+                          o.equinox, 100);
+    if (os.is_run && os.fit.status != PM_OK)
+        fail_fit(os.fit, o.model + " (the old run)");
     Comparison c;
     try {
-        c = compare_models(old_model, old_err, run, have_fit ? &old_fit : nullptr,
-                           have_fit ? &old_run_copy : nullptr);
+        c = compare_models(os.model, os.err, run, os.is_run ? &os.fit : nullptr,
+                           os.is_run ? &os.run : nullptr);
     } catch (const std::exception &x) {
         die(o.model + " vs " + o.run + ": " + x.what(), 1);
     }

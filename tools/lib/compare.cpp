@@ -1,6 +1,8 @@
 // compare.cpp - night-to-night drift (compare.hpp).
 #include "compare.hpp"
 #include "errormap.hpp"
+#include "hostutil.hpp"
+#include "modelfile.h"
 
 #include <algorithm>
 #include <cmath>
@@ -265,6 +267,35 @@ void print_comparison(const Comparison &c, const std::string &old_name, const st
         std::printf("  the old fit's predicted error (1 sigma per axis): %.3f\" at the new run's "
                     "points, %.3f\" at its own\n", c.old_pred_new, c.old_pred_old);
     std::printf("\n  %s\n", c.advice.c_str());
+}
+
+OldSide load_old(const std::string &path, int order, const std::vector<std::string> &adds,
+                 bool refraction, bool skip_bad, int format, int equinox, int max_passes)
+{
+    OldSide o;
+    char err[1024];
+    int kind = is_model_file(path, err, sizeof err);
+    if (kind < 0)
+        throw std::runtime_error(err);
+    if (kind == 1) {
+        if (pmmodel_load(path.c_str(), &o.model, err, sizeof err) != 0)
+            throw std::runtime_error(err);
+        return o;
+    }
+    o.is_run = true;
+    o.run = load_run(path, refraction, skip_bad, format, equinox);
+    std::vector<int> all(o.run.obs.size());
+    for (size_t i = 0; i < all.size(); i++)
+        all[i] = (int)i;
+    o.fit = do_fit(o.run.obs, all,
+                   build_model(order, adds, o.run.obs, o.run.mount, o.run.latitude,
+                               o.run.aux_names),
+                   max_passes);
+    if (o.fit.status == PM_OK) {
+        o.model = o.fit.model;
+        o.err.assign(o.fit.res.err, o.fit.res.err + o.fit.model.n_terms);
+    }
+    return o;
 }
 
 } // namespace pmhost

@@ -45,6 +45,20 @@ Comparison compare_models(const pm_model &old_model, const std::vector<double> &
                           const Run &run, const FitOut *old_fit = nullptr,
                           const Run *old_run = nullptr);
 
+// OLD of pmfit compare and pmfit report --compare: a model file, or a run
+// fitted at order + adds (do_fit with max_passes).
+struct OldSide {
+    bool is_run = false;
+    pm_model model;            // the model file's, or the run's fit (on success)
+    std::vector<double> err;   // the run's fit's 1-sigma errors; empty for a model file
+    FitOut fit;                // a run: its fit; check fit.status (the caller words a failure)
+    Run run;                   // a run: the run
+};
+// Throws std::runtime_error with the file's message when OLD cannot be
+// opened or read (its file:line).
+OldSide load_old(const std::string &path, int order, const std::vector<std::string> &adds,
+                 bool refraction, bool skip_bad, int format, int equinox, int max_passes);
+
 std::string comparison_json(const Comparison &c);
 void print_comparison(const Comparison &c, const std::string &old_name, const std::string &run_name);
 

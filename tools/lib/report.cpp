@@ -236,34 +236,15 @@ void stage_fit(Data &d)
 void stage_compare(Data &d)
 {
     const std::string &old = d.o.compare;
-    char ferr[1024];
-    int kind = is_model_file(old, ferr, sizeof ferr);
-    if (kind < 0)
-        throw std::runtime_error(ferr);
-    bool is_model = kind == 1;
-    pm_model old_model;
-    std::vector<double> old_err;
-    FitOut old_fit;
-    Run old_run;
-    if (is_model) {
-        char err[1024];
-        if (pmmodel_load(old.c_str(), &old_model, err, sizeof err) != 0)
-            throw std::runtime_error(err);
-        d.old_what = "the model file " + old;
-    } else {
-        old_run = load_run(old, d.o.refraction, d.o.skip_bad, d.o.format, d.o.equinox);
-        old_fit = do_fit(old_run.obs, all_of(old_run.obs.size()),
-                         build_model(d.o.order, d.o.adds, old_run.obs, old_run.mount,
-                                     old_run.latitude, old_run.aux_names), d.o.max_passes);
-        if (old_fit.status != PM_OK)
-            fit_failed(old_fit, old + " (the old run)");
-        old_model = old_fit.model;
-        old_err.assign(old_fit.res.err, old_fit.res.err + old_fit.model.n_terms);
-        d.old_what = fmt("the run %s (fitted at order %d)", old.c_str(), d.o.order);
-    }
+    OldSide os = load_old(old, d.o.order, d.o.adds, d.o.refraction, d.o.skip_bad, d.o.format,
+                          d.o.equinox, d.o.max_passes);
+    if (os.is_run && os.fit.status != PM_OK)
+        fit_failed(os.fit, old + " (the old run)");
+    d.old_what = os.is_run ? fmt("the run %s (fitted at order %d)", old.c_str(), d.o.order)
+                           : "the model file " + old;
     try {
-        d.cmp = compare_models(old_model, old_err, d.run, is_model ? nullptr : &old_fit,
-                               is_model ? nullptr : &old_run);
+        d.cmp = compare_models(os.model, os.err, d.run, os.is_run ? &os.fit : nullptr,
+                               os.is_run ? &os.run : nullptr);
     } catch (const std::exception &x) {
         throw std::runtime_error(old + " vs " + d.run.path + ": " + x.what());
     }
