@@ -316,159 +316,220 @@ std::vector<int> parse_bases(const std::string &spec, const std::string &list,
     return ks;
 }
 
-// The model to fit: the harmonic set of the order plus the --add effects.
-pm_model build_model(int order, const std::vector<std::string> &adds,
-                     const std::vector<Obs> &obs, int mount, double lat,
-                     const std::vector<std::string> &aux_names)
+// One --add specification taken apart: its ':' fields and the pier side of
+// an '@E' / '@W' suffix (0: both sides).
+struct AddSpec {
+    std::string spec, body;
+    std::vector<std::string> f;
+    int side = 0;
+};
+
+static AddSpec split_add(const std::string &spec)
 {
+    AddSpec a;
+    a.spec = spec;
+    a.body = spec;
+    if (a.body.size() > 2 && a.body[a.body.size() - 2] == '@') {
+        char c = a.body.back();
+        a.side = c == 'E' || c == 'e' ? 1 : (c == 'W' || c == 'w' ? -1 : 0);
+        if (!a.side)
+            throw std::runtime_error("--add " + spec + ": expected @E or @W for a pier side");
+        a.body = a.body.substr(0, a.body.size() - 2);
+    }
+    size_t pos = 0, c;
+    while ((c = a.body.find(':', pos)) != std::string::npos) {
+        a.f.push_back(a.body.substr(pos, c - pos));
+        pos = c + 1;
+    }
+    a.f.push_back(a.body.substr(pos));
+    return a;
+}
+
+// The model being built, and how a term joins it.
+struct ModelBuilder {
     pm_model m;
-    pm_model_init(&m, mount, order);
-    m.latitude = std::isnan(lat) ? 0.0 : lat;
-    pm_model_prepare(&m);
-    auto add = [&](const std::string &spec, pm_term t) {
+    int mount;
+    double lat;
+    void add(const std::string &spec, pm_term t)
+    {
         int st = pm_model_add_term(&m, &t, 0.0, nullptr);
         if (st == PM_ERR_CAPACITY)
             throw std::runtime_error("--add " + spec + ": more than " + std::to_string(PM_MAX_TERMS) +
                 " terms (this build's PM_MAX_TERMS)");
         if (st != PM_OK)
             throw std::runtime_error("--add " + spec + ": not a valid term for this model");
-    };
+    }
+};
+
+// ha_periodic:G[:H], dec_periodic:G[:H]: G cycles per revolution of the
+// axis, harmonics 1..H, a sine and a cosine each.
+static void add_periodic(ModelBuilder &b, const AddSpec &a, pm_term t)
+{
+    const std::string &name = a.f[0];
+    if (a.f.size() < 2 || a.f.size() > 3)
+        throw std::runtime_error("--add " + a.spec + ": expected " + name + ":G[:H]");
+    char *end;
+    double G = std::strtod(a.f[1].c_str(), &end);
+    if (*end || !(G > 0 && G <= 100000))
+        throw std::runtime_error("--add " + a.spec + ": G must be cycles per revolution, > 0");
+    long H = a.f.size() == 3 ? std::strtol(a.f[2].c_str(), &end, 10) : 1;
+    if (a.f.size() == 3 && (*end || H < 1 || H > 8))
+        throw std::runtime_error("--add " + a.spec + ": H must be 1..8 harmonics");
+    t.kind = PM_TERM_FOURIER;
+    t.l = (signed char)(name == "ha_periodic" ? 1 : 2);
+    t.k = (unsigned char)(name == "ha_periodic" ? PM_BASE_C : PM_BASE_E);
+    for (long h = 1; h <= H; h++)
+        for (int sc = 0; sc < 2; sc++) {
+            t.param = G * (double)h;
+            t.m = (signed char)sc;
+            b.add(a.spec, t);
+        }
+}
+
+// ha_periodic_paper:G: the paper's Y(G, +-G) form, integer G.
+static void add_periodic_paper(ModelBuilder &b, const AddSpec &a, pm_term t)
+{
+    char *end;
+    long G = a.f.size() == 2 ? std::strtol(a.f[1].c_str(), &end, 10) : 0;
+    if (a.f.size() != 2 || *end || G < 1 || G > 100000)
+        throw std::runtime_error("--add " + a.spec + ": expected ha_periodic_paper:G with an integer G");
+    t.kind = PM_TERM_SECTORAL;
+    t.k = PM_BASE_C;
+    t.param = (double)G;
+    for (int sc = 0; sc < 2; sc++) {
+        t.m = (signed char)sc;
+        b.add(a.spec, t);
+    }
+}
+
+// refraction, tube_flexure: cot(el) or cos(el) toward the zenith.
+static void add_zenith(ModelBuilder &b, const AddSpec &a, pm_term t)
+{
+    if (a.f.size() != 1)
+        throw std::runtime_error("--add " + a.spec + ": takes no arguments");
+    if (b.mount == PM_MOUNT_EQUATORIAL && std::isnan(b.lat))
+        throw std::runtime_error("--add " + a.spec + ": needs the site latitude, which the run file does not "
+            "give (a '# latitude: DEG' line or a TPOINT run line)");
+    t.kind = PM_TERM_ZENITH;
+    t.l = (signed char)(a.f[0] == "refraction" ? 0 : 1);
+    b.add(a.spec, t);
+}
+
+// The mean of an auxiliary input over the run (the term's reference, so that
+// it is decorrelated from the index); every observation must give a value,
+// and the slew direction must be known for nine in ten.
+static double aux_mean(const AddSpec &a, int input, const std::vector<Obs> &obs)
+{
+    double sum = 0;
+    size_t no_dir = 0;
+    for (const Obs &ob : obs) {
+        const pm_context &c = ob.ctx;
+        double x = input == PM_AUX_TEMP ? c.temp_c
+                   : input == PM_AUX_TIME ? c.time_h
+                   : input == PM_AUX_DIR ? (double)c.dir : c.aux[input - PM_AUX_USER];
+        if (!std::isfinite(x))
+            throw std::runtime_error("--add " + a.spec + ": the run gives no value for the observation at "
+                "line " + std::to_string(ob.line));
+        no_dir += input == PM_AUX_DIR && x == 0;
+        sum += x;
+    }
+    if (no_dir * 10 > obs.size()) // 0 = unknown; the first point always is
+        throw std::runtime_error("--add " + a.spec + ": the slew direction is unknown for " +
+            std::to_string(no_dir) + " of " + std::to_string(obs.size()) + " observations");
+    return obs.empty() ? 0 : sum / (double)obs.size();
+}
+
+// temperature, time_drift, hysteresis, aux:NAME, each [:BASES]: the input
+// (minus its mean) times the chosen base vectors.
+static void add_aux(ModelBuilder &b, const AddSpec &a, pm_term t, const std::vector<Obs> &obs,
+                    const std::vector<std::string> &aux_names)
+{
+    const std::string &name = a.f[0];
+    int input;
+    std::vector<int> def = {PM_BASE_C, PM_BASE_E};
+    size_t bases_at = 1;
+    if (name == "temperature")
+        input = PM_AUX_TEMP;
+    else if (name == "time_drift")
+        input = PM_AUX_TIME;
+    else if (name == "hysteresis") {
+        input = PM_AUX_DIR;
+        def = {PM_BASE_C};
+    } else {
+        if (a.f.size() < 2)
+            throw std::runtime_error("--add " + a.spec + ": expected aux:NAME[:BASES]");
+        int j = -1;
+        for (size_t q = 0; q < aux_names.size(); q++)
+            if (aux_names[q] == a.f[1])
+                j = (int)q;
+        if (j < 0)
+            throw std::runtime_error("--add " + a.spec + ": the run has no column '" + a.f[1] + "'");
+        if (j >= PM_MAX_AUX)
+            throw std::runtime_error("--add " + a.spec + ": column '" + a.f[1] + "' is beyond the first " +
+                std::to_string(PM_MAX_AUX) + " auxiliary columns the core takes");
+        input = PM_AUX_USER + j;
+        bases_at = 2;
+    }
+    if (a.f.size() > bases_at + 1)
+        throw std::runtime_error("--add " + a.spec + ": too many ':' fields");
+    std::vector<int> ks = parse_bases(a.spec, a.f.size() > bases_at ? a.f[bases_at] : std::string(), def);
+    t.kind = PM_TERM_AUX;
+    t.aux = (unsigned char)input;
+    t.param = aux_mean(a, input, obs);
+    for (int k : ks) {
+        t.k = (unsigned char)k;
+        b.add(a.spec, t);
+    }
+}
+
+// A harmonic term of the model by name (c'*Y(1,0)@E ...), for one pier side.
+static void add_side_harmonic(ModelBuilder &b, const AddSpec &a)
+{
+    int found = -1;
+    for (int i = 0; i < b.m.n_base; i++)
+        if (term_name(b.m, i) == a.body)
+            found = i;
+    if (found < 0)
+        throw std::runtime_error("--add " + a.spec + ": unknown effect or term (see pmfit --help)");
+    if (!a.side)
+        throw std::runtime_error("--add " + a.spec + ": " + a.body + " is already in the model; add it for one "
+            "pier side with " + a.body + "@E or " + a.body + "@W");
+    pm_term t = b.m.term[found];
+    t.side = (signed char)a.side;
+    b.add(a.spec, t);
+}
+
+// The model to fit: the harmonic set of the order plus the --add effects.
+pm_model build_model(int order, const std::vector<std::string> &adds,
+                     const std::vector<Obs> &obs, int mount, double lat,
+                     const std::vector<std::string> &aux_names)
+{
+    ModelBuilder b;
+    b.mount = mount;
+    b.lat = lat;
+    if (pm_model_init(&b.m, mount, order) != PM_OK)
+        throw std::runtime_error("order " + std::to_string(order) + ": not a valid order for this build (0.." +
+            std::to_string(PM_MAX_L) + ")");
+    b.m.latitude = std::isnan(lat) ? 0.0 : lat;
+    pm_model_prepare(&b.m);
     for (const std::string &spec : adds) {
-        std::string body = spec;
-        int side = 0;
-        if (body.size() > 2 && body[body.size() - 2] == '@') {
-            char c = body.back();
-            side = c == 'E' || c == 'e' ? 1 : (c == 'W' || c == 'w' ? -1 : 0);
-            if (!side)
-                throw std::runtime_error("--add " + spec + ": expected @E or @W for a pier side");
-            body = body.substr(0, body.size() - 2);
-        }
-        std::vector<std::string> f;
-        {
-            size_t pos = 0, c;
-            while ((c = body.find(':', pos)) != std::string::npos) {
-                f.push_back(body.substr(pos, c - pos));
-                pos = c + 1;
-            }
-            f.push_back(body.substr(pos));
-        }
+        AddSpec a = split_add(spec);
         pm_term t;
         std::memset(&t, 0, sizeof t);
-        t.side = (signed char)side;
-        const std::string &name = f[0];
-        if (name == "ha_periodic" || name == "dec_periodic") {
-            if (f.size() < 2 || f.size() > 3)
-                throw std::runtime_error("--add " + spec + ": expected " + name + ":G[:H]");
-            char *end;
-            double G = std::strtod(f[1].c_str(), &end);
-            if (*end || !(G > 0 && G <= 100000))
-                throw std::runtime_error("--add " + spec + ": G must be cycles per revolution, > 0");
-            long H = f.size() == 3 ? std::strtol(f[2].c_str(), &end, 10) : 1;
-            if (f.size() == 3 && (*end || H < 1 || H > 8))
-                throw std::runtime_error("--add " + spec + ": H must be 1..8 harmonics");
-            t.kind = PM_TERM_FOURIER;
-            t.l = (signed char)(name == "ha_periodic" ? 1 : 2);
-            t.k = (unsigned char)(name == "ha_periodic" ? PM_BASE_C : PM_BASE_E);
-            for (long h = 1; h <= H; h++)
-                for (int sc = 0; sc < 2; sc++) {
-                    t.param = G * (double)h;
-                    t.m = (signed char)sc;
-                    add(spec, t);
-                }
-        } else if (name == "ha_periodic_paper") {
-            char *end;
-            long G = f.size() == 2 ? std::strtol(f[1].c_str(), &end, 10) : 0;
-            if (f.size() != 2 || *end || G < 1 || G > 100000)
-                throw std::runtime_error("--add " + spec + ": expected ha_periodic_paper:G with an integer G");
-            t.kind = PM_TERM_SECTORAL;
-            t.k = PM_BASE_C;
-            t.param = (double)G;
-            for (int sc = 0; sc < 2; sc++) {
-                t.m = (signed char)sc;
-                add(spec, t);
-            }
-        } else if (name == "refraction" || name == "tube_flexure") {
-            if (f.size() != 1)
-                throw std::runtime_error("--add " + spec + ": takes no arguments");
-            if (mount == PM_MOUNT_EQUATORIAL && std::isnan(lat))
-                throw std::runtime_error("--add " + spec + ": needs the site latitude, which the run file does not "
-                    "give (a '# latitude: DEG' line or a TPOINT run line)");
-            t.kind = PM_TERM_ZENITH;
-            t.l = (signed char)(name == "refraction" ? 0 : 1);
-            add(spec, t);
-        } else if (name == "temperature" || name == "time_drift" || name == "hysteresis" ||
-                   name == "aux") {
-            int input;
-            std::vector<int> def = {PM_BASE_C, PM_BASE_E};
-            size_t bases_at = 1;
-            if (name == "temperature")
-                input = PM_AUX_TEMP;
-            else if (name == "time_drift")
-                input = PM_AUX_TIME;
-            else if (name == "hysteresis") {
-                input = PM_AUX_DIR;
-                def = {PM_BASE_C};
-            } else {
-                if (f.size() < 2)
-                    throw std::runtime_error("--add " + spec + ": expected aux:NAME[:BASES]");
-                int j = -1;
-                for (size_t q = 0; q < aux_names.size(); q++)
-                    if (aux_names[q] == f[1])
-                        j = (int)q;
-                if (j < 0)
-                    throw std::runtime_error("--add " + spec + ": the run has no column '" + f[1] + "'");
-                if (j >= PM_MAX_AUX)
-                    throw std::runtime_error("--add " + spec + ": column '" + f[1] + "' is beyond the first " +
-                        std::to_string(PM_MAX_AUX) + " auxiliary columns the core takes");
-                input = PM_AUX_USER + j;
-                bases_at = 2;
-            }
-            if (f.size() > bases_at + 1)
-                throw std::runtime_error("--add " + spec + ": too many ':' fields");
-            std::vector<int> ks =
-                parse_bases(spec, f.size() > bases_at ? f[bases_at] : std::string(), def);
-            // reference: the mean of the input, so the term is decorrelated from the index
-            double sum = 0;
-            size_t no_dir = 0;
-            for (const Obs &ob : obs) {
-                pm_context c = ob.ctx;
-                double x = input == PM_AUX_TEMP ? c.temp_c
-                           : input == PM_AUX_TIME ? c.time_h
-                           : input == PM_AUX_DIR ? (double)c.dir : c.aux[input - PM_AUX_USER];
-                if (!std::isfinite(x))
-                    throw std::runtime_error("--add " + spec + ": the run gives no value for the observation at "
-                        "line " + std::to_string(ob.line));
-                no_dir += input == PM_AUX_DIR && x == 0;
-                sum += x;
-            }
-            if (no_dir * 10 > obs.size()) // 0 = unknown; the first point always is
-                throw std::runtime_error("--add " + spec + ": the slew direction is unknown for " +
-                    std::to_string(no_dir) + " of " + std::to_string(obs.size()) +
-                    " observations");
-            t.kind = PM_TERM_AUX;
-            t.aux = (unsigned char)input;
-            t.param = obs.empty() ? 0 : sum / (double)obs.size();
-            for (int k : ks) {
-                t.k = (unsigned char)k;
-                add(spec, t);
-            }
-        } else {
-            // a harmonic term by name, for one pier side
-            int found = -1;
-            for (int i = 0; i < m.n_base; i++)
-                if (term_name(m, i) == body)
-                    found = i;
-            if (found < 0)
-                throw std::runtime_error("--add " + spec + ": unknown effect or term (see pmfit --help)");
-            if (!side)
-                throw std::runtime_error("--add " + spec + ": " + body + " is already in the model; add it for one "
-                    "pier side with " + body + "@E or " + body + "@W");
-            t = m.term[found];
-            t.side = (signed char)side;
-            add(spec, t);
-        }
+        t.side = (signed char)a.side;
+        const std::string &name = a.f[0];
+        if (name == "ha_periodic" || name == "dec_periodic")
+            add_periodic(b, a, t);
+        else if (name == "ha_periodic_paper")
+            add_periodic_paper(b, a, t);
+        else if (name == "refraction" || name == "tube_flexure")
+            add_zenith(b, a, t);
+        else if (name == "temperature" || name == "time_drift" || name == "hysteresis" || name == "aux")
+            add_aux(b, a, t, obs, aux_names);
+        else
+            add_side_harmonic(b, a);
     }
-    return m;
+    return b.m;
 }
 
 // The model without its side-specific added terms (for the pier F-test).
