@@ -870,17 +870,8 @@ int cmd_plan(const Options &o)
     po.grid_deg = o.grid;
     po.gem = !o.fork;
     po.noise_arcsec = o.noise;
-    if (!o.noise_given && !run.obs.empty()) { // the run's own sigma, when it can be fitted
-        std::vector<int> all(run.obs.size());
-        for (size_t i = 0; i < all.size(); i++)
-            all[i] = (int)i;
-        pm_model m = build_model(o.order, o.adds, run.obs, run.mount, run.latitude, run.aux_names);
-        if (2 * (long)run.obs.size() > (long)m.n_terms + 2) {
-            FitOut f = do_fit(run.obs, all, m);
-            if (f.status == PM_OK)
-                po.noise_arcsec = f.res.sigma * RAD2AS;
-        }
-    }
+    if (!o.noise_given) // the run's own sigma, when it can be fitted
+        po.noise_arcsec = run_noise_arcsec(run, o.order, o.adds, o.noise);
     po.d_optimal = o.d_optimal;
     po.sides = o.sides == "both" ? SIDES_BOTH : o.sides == "meridian" ? SIDES_MERIDIAN : SIDES_RUN;
     po.meridian_limit_deg = o.meridian_limit;
@@ -905,30 +896,11 @@ int cmd_plan(const Options &o)
     } catch (const std::exception &x) {
         die(x.what(), 1);
     }
-    bool az = po.mount == PM_MOUNT_ALTAZ;
-    auto num = [](double v) { return std::isfinite(v) ? std::to_string(v) : std::string("null"); };
     if (o.json) {
-        std::printf("{\"taken\": %zu, \"order\": %d, \"noise_arcsec\": %.6g, \"before_arcsec\": %s, "
-                    "\"criterion\": \"%s\", \"candidates\": %d, \"catalogue_stars\": %d, "
-                    "\"note\": \"%s\", \"targets\": [", run.obs.size(), o.order, po.noise_arcsec,
-                    num(p.before_arcsec).c_str(), po.d_optimal ? "D" : "I", p.n_candidates,
-                    p.n_catalogue, json_escape(p.note).c_str());
-        for (size_t k = 0; k < p.targets.size(); k++) {
-            const Target &t = p.targets[k];
-            std::printf("%s{\"%s\": %.4f, \"%s\": %.4f, \"elevation_deg\": %.4f, \"side\": %d, "
-                        "\"after_arcsec\": %s", k ? ", " : "", az ? "azimuth_deg" : "ha_deg",
-                        t.x_deg, az ? "el_deg" : "dec_deg", t.y_deg, t.el_deg, t.side,
-                        num(t.after_arcsec).c_str());
-            if (!t.name.empty())
-                std::printf(", \"name\": \"%s\", \"ra_h\": %.6f, \"catalogue_dec_deg\": %.5f",
-                            json_escape(t.name).c_str(), t.ra_h, t.dec_deg);
-            if (po.slew.on())
-                std::printf(", \"time_s\": %s", num(t.slew_s).c_str());
-            std::printf("}");
-        }
-        std::printf("]}\n");
+        std::printf("%s\n", plan_json(p, po, run.obs.size()).c_str());
         return 0;
     }
+    bool az = po.mount == PM_MOUNT_ALTAZ;
     std::printf("pmfit plan: %zu points taken, order %d%s, noise %.3g\" per axis; %d candidates "
                 "above %.0f deg elevation%s%s%s\n", run.obs.size(), o.order,
                 o.adds.empty() ? "" : " + terms", po.noise_arcsec, p.n_candidates, po.min_el_deg,

@@ -11,6 +11,7 @@
 // criterion): greedy, the best candidate (per second of slewing and
 // observing when the slew time is weighed), update, repeat.
 #include "plan.hpp"
+#include "hostutil.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -641,6 +642,45 @@ double predicted_mean_error(const std::vector<Target> &points, const PlanOptions
     for (const SkyPlace &p : sky)
         ds.push_back(p.d);
     return o.noise_arcsec * std::sqrt(std::max(0.0, design_criterion(m, pts, ds)));
+}
+
+double run_noise_arcsec(const Run &run, int order, const std::vector<std::string> &adds,
+                        double fallback)
+{
+    if (run.obs.empty())
+        return fallback;
+    std::vector<int> all(run.obs.size());
+    for (size_t i = 0; i < all.size(); i++)
+        all[i] = (int)i;
+    pm_model m = build_model(order, adds, run.obs, run.mount, run.latitude, run.aux_names);
+    if (2 * (long)run.obs.size() <= (long)m.n_terms + 2)
+        return fallback;
+    FitOut f = do_fit(run.obs, all, m);
+    return f.status == PM_OK ? f.res.sigma * RAD2AS : fallback;
+}
+
+std::string plan_json(const Plan &p, const PlanOptions &o, size_t taken)
+{
+    bool az = o.mount == PM_MOUNT_ALTAZ;
+    auto num = [](double v) { return std::isfinite(v) ? std::to_string(v) : std::string("null"); };
+    std::string s = fmt("{\"taken\": %zu, \"order\": %d, \"noise_arcsec\": %.6g, \"before_arcsec\": %s, "
+                        "\"criterion\": \"%s\", \"candidates\": %d, \"catalogue_stars\": %d, "
+                        "\"note\": \"%s\", \"targets\": [", taken, o.order, o.noise_arcsec,
+                        num(p.before_arcsec).c_str(), o.d_optimal ? "D" : "I", p.n_candidates,
+                        p.n_catalogue, json_escape(p.note).c_str());
+    for (size_t k = 0; k < p.targets.size(); k++) {
+        const Target &t = p.targets[k];
+        s += fmt("%s{\"%s\": %.4f, \"%s\": %.4f, \"elevation_deg\": %.4f, \"side\": %d, "
+                 "\"after_arcsec\": %s", k ? ", " : "", az ? "azimuth_deg" : "ha_deg", t.x_deg,
+                 az ? "el_deg" : "dec_deg", t.y_deg, t.el_deg, t.side, num(t.after_arcsec).c_str());
+        if (!t.name.empty())
+            s += fmt(", \"name\": \"%s\", \"ra_h\": %.6f, \"catalogue_dec_deg\": %.5f",
+                     json_escape(t.name).c_str(), t.ra_h, t.dec_deg);
+        if (o.slew.on())
+            s += fmt(", \"time_s\": %s", num(t.slew_s).c_str());
+        s += "}";
+    }
+    return s + "]}";
 }
 
 } // namespace pmhost

@@ -82,6 +82,15 @@ Plan plan_targets(const Run &taken, const PlanOptions &o);
 // comparing a plan with a grid or random points.
 double predicted_mean_error(const std::vector<Target> &points, const PlanOptions &o);
 
+// The noise a plan scales its predictions by when none is given: the
+// run's own sigma (arcsec) fitted at the plan's order and terms, or
+// `fallback` when the run cannot be fitted (too few points, no solution).
+double run_noise_arcsec(const Run &run, int order, const std::vector<std::string> &adds,
+                        double fallback);
+
+// pmfit plan --json: the plan as one JSON object (docs/formats.md).
+std::string plan_json(const Plan &p, const PlanOptions &o, size_t taken);
+
 // ---- the design machinery, for benchmarks choosing among given places
 
 // A place of a design: an encoder position and the inputs of the terms.
