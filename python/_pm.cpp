@@ -12,12 +12,16 @@
 #include <pybind11/stl.h>
 
 #include "pm.h"
+#include "compare.hpp"
 #include "explain.hpp"
 #include "fitrun.hpp"
+#include "hostutil.hpp"
 #include "modelfile.h"
+#include "plan.hpp"
 #include "runfile.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -944,6 +948,149 @@ std::string explain_run(const RunData &d, int order, std::vector<std::string> ad
     return "{\"n_obs\": " + std::to_string(d.run.obs.size()) + ", " + explain_json(d.run, ex, order) + "}";
 }
 
+// A number keyword of plan(): finite and within [lo, hi], else ArgumentError.
+double in_range(const char *name, double v, double lo, double hi, const char *unit)
+{
+    if (!(v >= lo && v <= hi))
+        fail(K_ARGUMENT, std::string(name) + ": expected " + unit + " in [" + fmt("%g", lo) + ", " +
+                             fmt("%g", hi) + "], got " + fmt("%g", v));
+    return v;
+}
+
+// An input file of plan() read by `read`: FileError when it cannot be
+// opened, FormatError (with its file:line) when it cannot be read.
+template <class F> auto input_file(const std::string &path, const F &read) -> decltype(read())
+{
+    std::FILE *f = std::fopen(path.c_str(), "rb");
+    if (!f)
+        fail(K_FILE, path + ": cannot open: " + std::strerror(errno));
+    std::fclose(f);
+    try {
+        return read();
+    } catch (const std::runtime_error &e) {
+        fail(K_FORMAT, e.what());
+    }
+}
+
+// pmfit plan [RUN] --json, as the same JSON text.  d: the run taken so far
+// (null: none).  NaN stands for an option not given (latitude, noise, lst,
+// lon, slew); mount "" for the run's.
+std::string plan_run(const std::shared_ptr<RunData> &d, const std::string &mount, double lat_deg,
+                     int order, std::vector<std::string> adds, int next, double min_el,
+                     double grid, bool fork, double noise, const std::string &criterion,
+                     const std::string &sides, double meridian_limit, double slew, double settle,
+                     double point_time, double flip_time, const std::string &horizon,
+                     const std::string &catalogue, double lst, const std::string &utc, double lon)
+{
+    Run none;
+    const Run &run = d ? d->run : none;
+    PlanOptions po;
+    if (order < 0 || order > PM_MAX_L)
+        fail(K_ARGUMENT, "order " + std::to_string(order) + ": expected 0.." + std::to_string(PM_MAX_L));
+    if (mount != "" && mount != "equatorial" && mount != "altaz")
+        fail(K_ARGUMENT, "mount: expected 'equatorial' or 'altaz', got '" + mount + "'");
+    if (d) {
+        po.mount = run.mount;
+        po.latitude = run.latitude;
+    }
+    if (mount != "")
+        po.mount = mount == "altaz" ? PM_MOUNT_ALTAZ : PM_MOUNT_EQUATORIAL;
+    if (!std::isnan(lat_deg))
+        po.latitude = in_range("latitude", lat_deg, -90, 90, "degrees") * PI / 180;
+    if (po.mount == PM_MOUNT_EQUATORIAL && std::isnan(po.latitude))
+        fail(K_ARGUMENT, "latitude: an equatorial mount needs the site latitude (degrees), which " +
+                             std::string(d ? "the run does not give" : "is not given"));
+    if (next < 1 || next > 1000)
+        fail(K_ARGUMENT, "next: expected a count 1..1000, got " + std::to_string(next));
+    if (criterion != "I" && criterion != "D" && criterion != "i" && criterion != "d")
+        fail(K_ARGUMENT, "criterion: expected 'I' (mean predicted error) or 'D' (determinant), got '" +
+                             criterion + "'");
+    if (sides != "run" && sides != "meridian" && sides != "both")
+        fail(K_ARGUMENT, "sides: expected 'run', 'meridian' or 'both', got '" + sides + "'");
+    bool timed = !std::isnan(lst) || !utc.empty();
+    if (catalogue.empty() && (timed || !std::isnan(lon)))
+        fail(K_ARGUMENT, "lst, utc and lon place the stars of a catalogue; give catalogue= too");
+    if (!catalogue.empty() && (!std::isnan(lst)) == !utc.empty())
+        fail(K_ARGUMENT, "catalogue: needs the time: lst (local sidereal time, hours) or utc "
+                         "('YYYY-MM-DDTHH:MM') with lon (degrees east), one of them");
+    po.order = order;
+    po.adds = adds;
+    po.next = next;
+    po.min_el_deg = in_range("min_el", min_el, -10, 80, "degrees");
+    po.grid_deg = in_range("grid", grid, 1, 30, "degrees");
+    po.gem = !fork;
+    po.d_optimal = criterion == "D" || criterion == "d";
+    po.sides = sides == "both" ? SIDES_BOTH : sides == "meridian" ? SIDES_MERIDIAN : SIDES_RUN;
+    po.meridian_limit_deg = in_range("meridian_limit", meridian_limit, 0, 90, "degrees");
+    if (!std::isnan(slew))
+        po.slew.rate_deg_s = in_range("slew", slew, 0.01, 100, "deg/s");
+    po.slew.settle_s = in_range("settle", settle, 0, 3600, "seconds");
+    po.slew.point_s = in_range("point_time", point_time, 0, 36000, "seconds");
+    po.slew.flip_s = in_range("flip_time", flip_time, 0, 3600, "seconds");
+    Plan p;
+    try {
+        po.noise_arcsec = std::isnan(noise) ? run_noise_arcsec(run, order, adds, 1.0)
+                                            : in_range("noise", noise, 0, 1e5, "arcseconds");
+        if (!horizon.empty())
+            po.horizon = input_file(horizon, [&] { return read_horizon(horizon); });
+        if (!catalogue.empty()) {
+            po.stars = input_file(catalogue, [&] { return read_catalogue(catalogue); });
+            if (!std::isnan(lst))
+                po.when.lst_h = in_range("lst", lst, 0, 23.999999999, "hours");
+            po.when.utc = utc;
+            if (!utc.empty() && std::isnan(lon))
+                fail(K_ARGUMENT, "utc: needs lon, the site's east longitude (degrees)");
+            if (!utc.empty() && std::isnan(po.latitude))
+                fail(K_ARGUMENT, "utc: needs the site latitude (latitude=, or the run's)");
+            po.when.lon_rad = std::isnan(lon) ? 0 : in_range("lon", lon, -180, 360, "degrees") * PI / 180;
+            po.when.lat_rad = po.latitude;
+        }
+        p = plan_targets(run, po);
+    } catch (const std::runtime_error &e) {
+        std::string w = e.what();
+        fail(w.rfind("--add", 0) == 0 ? K_ARGUMENT : K_ERROR, w);
+    }
+    return plan_json(p, po, run.obs.size());
+}
+
+// pmfit compare OLD RUN --json, as the same JSON text.  OLD: a model
+// (old_model), a run already read (old_run, fitted at order + adds) or a
+// file (old_path: a model file or a run file, as pmfit compare reads it).
+std::string compare_run(const Model *old_model, const std::shared_ptr<RunData> &old_run,
+                        const std::string &old_path, const RunData &d, int order,
+                        std::vector<std::string> adds)
+{
+    if (order < 0 || order > PM_MAX_L)
+        fail(K_ARGUMENT, "order " + std::to_string(order) + ": expected 0.." + std::to_string(PM_MAX_L));
+    const int passes = 2000;
+    OldSide os;
+    try {
+        if (old_model) {
+            os.model = old_model->m;
+            if (pm_model_prepare(&os.model) != PM_OK)
+                fail(K_ARGUMENT, "old: the model cannot be prepared (non-finite coefficients?)");
+        } else if (old_run) {
+            os = old_from_run(old_run->run, order, adds, passes);
+        } else {
+            os = load_old(old_path, order, adds, true, false, PMRUN_FORMAT_AUTO, PMRUN_EQUINOX_FILE,
+                          passes);
+        }
+    } catch (const std::runtime_error &e) {
+        std::string w = e.what();
+        fail(w.rfind("--add", 0) == 0 ? K_ARGUMENT : K_FILE, w);
+    }
+    if (os.is_run && os.fit.status != PM_OK)
+        fail_fit(os.fit, (old_path.empty() ? std::string("old run") : old_path) + " (the old run)", passes);
+    Comparison c;
+    try {
+        c = compare_models(os.model, os.err, d.run, os.is_run ? &os.fit : nullptr,
+                           os.is_run ? &os.run : nullptr);
+    } catch (const std::runtime_error &e) {
+        fail(K_ERROR, e.what());
+    }
+    return comparison_json(c);
+}
+
 } // namespace
 
 PYBIND11_MODULE(_pm, mod)
@@ -1025,4 +1172,6 @@ PYBIND11_MODULE(_pm, mod)
         .def("_pointing_sigma", &Fit::pointing_sigma);
     mod.def("fit_run", &fit_run);
     mod.def("explain_run", &explain_run);
+    mod.def("plan_run", &plan_run);
+    mod.def("compare_run", &compare_run);
 }

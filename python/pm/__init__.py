@@ -34,7 +34,7 @@ except ImportError as _e:  # the source tree (python/pm) has no extension
 __all__ = [
     "Error", "FileError", "FormatError", "ArgumentError", "NonFiniteError", "FitError",
     "PointingWarning", "Model", "Run", "FitResult", "SplitFit", "read_run", "load_model",
-    "fit", "fit_run", "explain", "RAD2ARCSEC", "MAX_L", "MAX_TERMS", "MAX_AUX",
+    "fit", "fit_run", "explain", "plan", "compare", "RAD2ARCSEC", "MAX_L", "MAX_TERMS", "MAX_AUX",
 ]
 
 # ---------------------------------------------------------------------------
@@ -658,4 +658,78 @@ def explain(run, *, order=1, add=(), alpha=0.01, gears=(), gears_ha=(), gears_de
         raise ArgumentError("folds: expected an integer")
     text = _pm.explain_run(r._data, _order(order), _adds(add), float(alpha), gh, gd,
                            bool(pairs), int(folds))
+    return _json.loads(text)
+
+
+def _opt_float(name, v):
+    """None -> NaN (the C++ side's 'not given'), else a finite float."""
+    if v is None:
+        return float("nan")
+    f = _as_float(name, v)
+    if f.shape != () or not _np.isfinite(f):
+        raise ArgumentError("%s: expected a finite number, got %r" % (name, v))
+    return float(f)
+
+
+def _opt_path(name, v):
+    return "" if v is None else _path(v, name)
+
+
+def plan(run=None, *, latitude=None, mount=None, order=1, add=(), next=5, min_el=15.0,
+         grid=6.0, fork=False, noise=None, criterion="I", sides="run", meridian_limit=15.0,
+         slew=None, settle=5.0, point_time=30.0, flip_time=60.0, horizon=None, catalogue=None,
+         lst=None, utc=None, lon=None):
+    """Which star next? ``pmfit plan [RUN] --json`` as a dict (keys in
+    docs/formats.md, "pmfit plan --json"; the method in docs/model.md,
+    "Which star next"): the ``next`` targets that most reduce the model's
+    predicted pointing error averaged over the sky above ``min_el``
+    (degrees) and the ``horizon`` file, given the points of ``run`` taken so
+    far (a Run or a path; None: the first points of a run).
+
+    ``latitude`` (degrees; default the run's), ``mount`` ("equatorial" or
+    "altaz"; default the run's, else equatorial), ``order``/``add`` the model
+    planned for, ``noise`` (arcsec per axis; default the run's own sigma, 1
+    without a run), ``grid`` (candidate spacing, degrees) or ``catalogue`` (a
+    star file, placed at ``lst`` hours or at ``utc`` "YYYY-MM-DDTHH:MM" with
+    ``lon`` degrees east), ``fork`` (an equatorial mount that does not flip),
+    ``sides``/``meridian_limit`` (German mounts: "run", "meridian" or
+    "both"), ``criterion`` ("I": mean predicted error, "D": determinant),
+    ``slew`` (deg/s: weight by slew time, with ``settle``, ``point_time``
+    and ``flip_time`` in seconds).  Errors: ArgumentError for a bad keyword,
+    FileError/FormatError for the files (with their file:line)."""
+    r = None if run is None else _run(run)
+    if mount is not None and mount not in ("equatorial", "altaz"):
+        raise ArgumentError("mount: expected 'equatorial' or 'altaz', got %r" % (mount,))
+    if isinstance(next, bool) or not isinstance(next, (int, _np.integer)):
+        raise ArgumentError("next: expected an integer count, got %r" % (next,))
+    for name, v in (("criterion", criterion), ("sides", sides)):
+        if not isinstance(v, str):
+            raise ArgumentError("%s: expected a string, got %r" % (name, v))
+    if utc is not None and not isinstance(utc, str):
+        raise ArgumentError("utc: expected 'YYYY-MM-DDTHH:MM[:SS]', got %r" % (utc,))
+    text = _pm.plan_run(None if r is None else r._data, "" if mount is None else mount,
+                        _opt_float("latitude", latitude), _order(order), _adds(add), int(next),
+                        _opt_float("min_el", min_el), _opt_float("grid", grid), bool(fork),
+                        _opt_float("noise", noise), criterion, sides,
+                        _opt_float("meridian_limit", meridian_limit), _opt_float("slew", slew),
+                        _opt_float("settle", settle), _opt_float("point_time", point_time),
+                        _opt_float("flip_time", flip_time), _opt_path("horizon", horizon),
+                        _opt_path("catalogue", catalogue), _opt_float("lst", lst),
+                        "" if utc is None else utc, _opt_float("lon", lon))
+    return _json.loads(text)
+
+
+def compare(old, run, *, order=1, add=()):
+    """What changed since last night?  ``pmfit compare OLD RUN --json`` as a
+    dict (keys in docs/formats.md, "pmfit compare --json"; docs/model.md,
+    "What changed"): ``old`` is a Model, a Run (fitted at ``order`` with
+    ``add``, so that its errors count), or a path to a model file or a run
+    file; ``run`` (a Run or a path) is the new night."""
+    r = _run(run)
+    if isinstance(old, Model):
+        text = _pm.compare_run(old, None, "", r._data, _order(order), _adds(add))
+    elif isinstance(old, Run):
+        text = _pm.compare_run(None, old._data, "", r._data, _order(order), _adds(add))
+    else:
+        text = _pm.compare_run(None, None, _path(old, "old"), r._data, _order(order), _adds(add))
     return _json.loads(text)

@@ -269,6 +269,26 @@ void print_comparison(const Comparison &c, const std::string &old_name, const st
     std::printf("\n  %s\n", c.advice.c_str());
 }
 
+OldSide old_from_run(const Run &run, int order, const std::vector<std::string> &adds,
+                     int max_passes)
+{
+    OldSide o;
+    o.is_run = true;
+    o.run = run;
+    std::vector<int> all(o.run.obs.size());
+    for (size_t i = 0; i < all.size(); i++)
+        all[i] = (int)i;
+    o.fit = do_fit(o.run.obs, all,
+                   build_model(order, adds, o.run.obs, o.run.mount, o.run.latitude,
+                               o.run.aux_names),
+                   max_passes);
+    if (o.fit.status == PM_OK) {
+        o.model = o.fit.model;
+        o.err.assign(o.fit.res.err, o.fit.res.err + o.fit.model.n_terms);
+    }
+    return o;
+}
+
 OldSide load_old(const std::string &path, int order, const std::vector<std::string> &adds,
                  bool refraction, bool skip_bad, int format, int equinox, int max_passes)
 {
@@ -282,20 +302,8 @@ OldSide load_old(const std::string &path, int order, const std::vector<std::stri
             throw std::runtime_error(err);
         return o;
     }
-    o.is_run = true;
-    o.run = load_run(path, refraction, skip_bad, format, equinox);
-    std::vector<int> all(o.run.obs.size());
-    for (size_t i = 0; i < all.size(); i++)
-        all[i] = (int)i;
-    o.fit = do_fit(o.run.obs, all,
-                   build_model(order, adds, o.run.obs, o.run.mount, o.run.latitude,
-                               o.run.aux_names),
-                   max_passes);
-    if (o.fit.status == PM_OK) {
-        o.model = o.fit.model;
-        o.err.assign(o.fit.res.err, o.fit.res.err + o.fit.model.n_terms);
-    }
-    return o;
+    return old_from_run(load_run(path, refraction, skip_bad, format, equinox), order, adds,
+                        max_passes);
 }
 
 } // namespace pmhost

@@ -59,6 +59,10 @@ struct OldSide {
 OldSide load_old(const std::string &path, int order, const std::vector<std::string> &adds,
                  bool refraction, bool skip_bad, int format, int equinox, int max_passes);
 
+// OLD as a run already read: fitted at order + adds (do_fit with max_passes).
+OldSide old_from_run(const Run &run, int order, const std::vector<std::string> &adds,
+                     int max_passes);
+
 std::string comparison_json(const Comparison &c);
 void print_comparison(const Comparison &c, const std::string &old_name, const std::string &run_name);
 

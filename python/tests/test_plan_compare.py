@@ -1,0 +1,98 @@
+"""pm.plan and pm.compare give what `pmfit plan --json` and `pmfit compare
+--json` give (the same JSON, parsed), for runs, no run, alt-az mounts, a
+horizon and a catalogue, OLD as a Model, a Run or a file; bad keywords and
+bad files raise the package's exceptions with the reason."""
+import json
+import os
+
+import pytest
+
+import pm
+from conftest import PMFIT, TOP, real_run, run_cmd
+
+SIM = os.path.join(TOP, "examples", "sim_gem.dat")
+
+
+def cli(*args):
+    return json.loads(run_cmd(PMFIT, *args).stdout)
+
+
+@pytest.mark.parametrize("kw,args", [
+    (dict(next=4), ["--next", "4"]),
+    (dict(next=3, order=2, criterion="D"), ["--next", "3", "--order", "2", "--criterion", "D"]),
+    (dict(next=3, sides="both", meridian_limit=20, min_el=25, grid=9),
+     ["--next", "3", "--sides", "both", "--meridian-limit", "20", "--min-el", "25", "--grid", "9"]),
+    (dict(next=3, slew=2.5, settle=3, point_time=20, flip_time=90, noise=1.5),
+     ["--next", "3", "--slew", "2.5", "--settle", "3", "--point-time", "20", "--flip-time", "90",
+      "--noise", "1.5"]),
+])
+def test_plan_equals_pmfit_with_a_run(kw, args):
+    assert pm.plan(SIM, **kw) == cli("plan", SIM, "--json", *args)
+    assert pm.plan(pm.read_run(SIM), **kw) == cli("plan", SIM, "--json", *args)
+
+
+def test_plan_without_a_run_and_alt_az(tmp_path):
+    assert pm.plan(latitude=-33.5, next=5, fork=True) == \
+        cli("plan", "--lat", "-33.5", "--fork", "--next", "5", "--json")
+    assert pm.plan(mount="altaz", next=5) == cli("plan", "--mount", "altaz", "--next", "5", "--json")
+    mmt = real_run("mmt/k_and_e.dat")
+    p = pm.plan(mmt, next=3)
+    assert p == cli("plan", mmt, "--next", "3", "--json")
+    assert "azimuth_deg" in p["targets"][0] and p["taken"] == 80
+
+
+def test_plan_horizon_and_catalogue(tmp_path):
+    hrz = tmp_path / "h.hrz"
+    hrz.write_text("0 20\n90 50\n180 10\n270 25\n")
+    assert pm.plan(latitude=47, next=6, horizon=hrz) == \
+        cli("plan", "--lat", "47", "--next", "6", "--horizon", hrz, "--json")
+    cat = tmp_path / "stars.txt"
+    cat.write_text("".join("%02d:%02d:00 %+03d:30:00 star%d\n" % (h, (7 * h) % 60, d, 10 * h + k)
+                           for k, d in enumerate((-20, 10, 40, 70)) for h in range(0, 24, 2)))
+    p = pm.plan(SIM, next=5, catalogue=cat, lst=6)
+    assert p == cli("plan", SIM, "--next", "5", "--catalog", cat, "--lst", "6", "--json")
+    assert p["catalogue_stars"] == 48 and all(t["name"].startswith("star") for t in p["targets"])
+    assert pm.plan(SIM, next=3, catalogue=cat, utc="2024-03-20T04:00", lon=20) == \
+        cli("plan", SIM, "--next", "3", "--catalog", cat, "--utc", "2024-03-20T04:00", "--lon", "20",
+            "--json")
+
+
+def test_plan_errors(tmp_path):
+    for kw, what in [(dict(next=0), "next:"), (dict(min_el=95), "min_el:"),
+                     (dict(criterion="X"), "criterion:"), (dict(sides="east"), "sides:"),
+                     (dict(mount="fork"), "mount:"), (dict(add="nonsense"), "--add nonsense"),
+                     (dict(lst=3), "catalogue"), (dict(order=9), "order"),
+                     (dict(noise=float("nan")), "noise:")]:
+        with pytest.raises(pm.ArgumentError, match=what):
+            pm.plan(SIM, **kw)
+    with pytest.raises(pm.ArgumentError, match="latitude"):
+        pm.plan(next=2)                                  # equatorial, no run, no latitude
+    with pytest.raises(pm.FileError, match="nowhere.hrz"):
+        pm.plan(SIM, horizon=tmp_path / "nowhere.hrz")
+    bad = tmp_path / "bad.hrz"
+    bad.write_text("0 20\n90 fifty\n")
+    with pytest.raises(pm.FormatError, match="bad.hrz:2"):
+        pm.plan(SIM, horizon=bad)
+    cat = tmp_path / "c.txt"
+    cat.write_text("1 2 x\n")
+    with pytest.raises(pm.ArgumentError, match="needs the time"):
+        pm.plan(SIM, catalogue=cat)
+
+
+def test_compare_equals_pmfit(tmp_path):
+    gem = real_run("celestial/gem-28.dat")
+    want = cli("compare", SIM, SIM, "--json")
+    assert pm.compare(SIM, SIM) == want                       # OLD a run file
+    assert pm.compare(pm.read_run(SIM), pm.read_run(SIM)) == want   # OLD a Run
+    model = tmp_path / "m.pm"
+    run_cmd(PMFIT, "fit", SIM, "--save", model)
+    want = cli("compare", model, SIM, "--json")
+    assert pm.compare(model, SIM) == want                     # OLD a model file
+    assert pm.compare(pm.load_model(str(model)), SIM) == want  # OLD a Model
+    assert pm.compare(SIM, SIM, order=2)["n_terms"] == pm.fit_run(SIM, order=2).n_params
+    with pytest.raises(pm.Error, match="mount|equatorial|alt"):
+        pm.compare(real_run("mmt/k_and_e.dat"), gem)
+    with pytest.raises(pm.FileError, match="nothing.dat"):
+        pm.compare(tmp_path / "nothing.dat", SIM)
+    with pytest.raises(pm.ArgumentError, match="--add"):
+        pm.compare(SIM, SIM, add="nonsense")
