@@ -15,7 +15,16 @@ as 'ha_periodic:2' before the generic reading).
 tests/data/indep_ho_gem.dat: German mount, 269 points, half the sky, 2.87"
 noise, 23.8" RMS (single_higher_order_gem_16; read as 'ha_periodic:4').
 
-Usage: /usr/bin/python3 tests/ref/generic_case.py   (writes both into tests/data)
+And the case the generic reading does not take, for the smooth alternative:
+tests/data/indep_ho_fork_dec.dat: fork mount, 159 points, one pier side,
+1.94" noise, 19.8" RMS (single_higher_order_fork_09).  Its declination
+residuals rise and fall like 4 cycles per revolution over the 133 deg of
+declination sampled (1.5 cycles): dec_periodic:4 passes at 10^-25.5, order 2
+given it does not pass, and it adds nothing given order 2.  explain keeps
+the two-term reading and must offer higher_order beside it as the smooth
+alternative (the run cannot show the shape repeats).
+
+Usage: /usr/bin/python3 tests/ref/generic_case.py   (writes all three into tests/data)
 """
 import os
 import sys
@@ -34,6 +43,11 @@ CASES = [
       "el_limit": 18.962834742723373, "noise": 2.872469262742089, "coverage": "half",
       "index_deg": 2.960893268692846, "geom": 78.89402608894969, "aniso": 3.0,
       "aniso_order": 1, "effects": [{"name": "higher_order", "size": 23.84407409037782}]}),
+    ("indep_ho_fork_dec.dat",
+     {"mount": "fork", "n": 159, "seed": 20947471, "lat": -23.07974608650787,
+      "el_limit": 17.427736790530368, "noise": 1.942084413611793, "coverage": "pier_east",
+      "index_deg": 1.1761715087936342, "geom": 198.47588213298764, "aniso": 30.0,
+      "aniso_order": 1, "effects": [{"name": "higher_order", "size": 19.776128383348553}]}),
 ]
 
 

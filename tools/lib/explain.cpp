@@ -759,9 +759,38 @@ std::string separate_by(const Run &run, const State &st, const Candidate &a, con
     return s;
 }
 
+// A periodic reading of fewer than this many cycles over the range of the
+// axis the run samples is a shape the run does not see repeat.
+const double FEW_CYCLES = 3;
+
+// The smooth reading beside a periodic one the run cannot show to repeat:
+// c a periodic reading of fewer than FEW_CYCLES cycles over the sampled
+// range, h the next order (significant on its own), and c's terms add
+// nothing significant to h (c's partial F-test given h, times c's trials,
+// not below alpha).  Then h holds everything c explains, the run gives no
+// evidence that the shape is periodic, and h is offered as c's alternative
+// whatever its Delta BIC (which charges its many terms).  Sets *cycles.
+bool smooth_alternative(const Run &run, const State &st, const Candidate &c, const Candidate &h,
+                        const ExplainOptions &opt, double *cycles)
+{
+    if (!(c.peak_g > 0) || h.effect != "higher_order" || c.members.size() != 1)
+        return false;
+    int comp = c.effect == "dec_periodic" ? 1 : 0;
+    *cycles = c.peak_g * sampled_extent(run, st.use, comp) / (2 * PI);
+    if (!(*cycles < FEW_CYCLES))
+        return false;
+    Fit both = fit_spec(run, st.use, h.order, c.adds);
+    if (!both.ok || both.P <= h.fit.P)
+        return false;
+    double d2 = (double)(2 * both.N - both.P), dc = both.P - h.fit.P;
+    double fc = ((h.fit.chi2 - both.chi2) / dc) / (both.chi2 / d2);
+    return !(log_f_tail(fc, dc, d2) + std::log(c.trials) < std::log(opt.alpha));
+}
+
 // Readings whose evidence is close to the chosen one's: Delta BIC below
 // opt.close_delta_bic, with the noise fixed at the chosen fit's sigma,
-// each significant on its own.
+// each significant on its own; and the smooth reading of a periodic one
+// the run cannot show to repeat (smooth_alternative).
 std::vector<Alternative> alternatives(const Run &run, const State &st, const Candidate &c,
                                       const std::vector<Candidate> &cands, const ExplainOptions &opt)
 {
@@ -779,7 +808,9 @@ std::vector<Alternative> alternatives(const Run &run, const State &st, const Can
         double log10_lr = dchi / 2 / LN10;
         // Delta BIC charges the extra parameters; for two readings of as
         // many parameters it is 2 ln(likelihood ratio): below 6 = LR below 20
-        if (!(dbic < opt.close_delta_bic))
+        double cycles = 0;
+        bool smooth = !(dbic < opt.close_delta_bic) && smooth_alternative(run, st, c, a, opt, &cycles);
+        if (!(dbic < opt.close_delta_bic) && !smooth)
             continue;
         Alternative al;
         al.effect = a.effect;
@@ -787,6 +818,15 @@ std::vector<Alternative> alternatives(const Run &run, const State &st, const Can
         al.delta_bic = dbic;
         al.log10_lr = log10_lr;
         al.separate_by = separate_by(run, st, c, a);
+        if (smooth) {
+            al.smooth = true;
+            std::vector<double> d = model_difference(run, st.use, c.fit.f.model, a.fit.f.model);
+            std::string bin = largest_bin(run, st.use, d);
+            al.separate_by = fmt("the %s axis over more of its range: this run samples %.1f cycles "
+                                 "of the period (a gear error repeats, a smooth distortion does "
+                                 "not)", c.effect == "dec_periodic" ? "second" : "first", cycles) +
+                             (bin.empty() ? "" : "; on this run they differ most at " + bin);
+        }
         out.push_back(al);
     }
     return out;
@@ -1144,6 +1184,7 @@ void finding_to_c(const pmhost::Finding &f, pmx_finding &g)
         pmx_alternative &b = g.alternatives[g.n_alternatives++];
         std::snprintf(b.effect, sizeof b.effect, "%s", a.effect.c_str());
         std::snprintf(b.separate_by, sizeof b.separate_by, "%s", a.separate_by.c_str());
+        b.smooth = a.smooth ? 1 : 0;
         b.delta_bic = a.delta_bic;
         b.log10_lr = a.log10_lr;
         b.log10_fap = a.log10_fap;

@@ -22,6 +22,9 @@ typedef struct pmx_alternative {
     double log10_lr;                 /* log10 likelihood ratio chosen : alternative */
     double log10_fap;                /* its own false-alarm probability, log10 */
     char separate_by[160];           /* the observation that would tell them apart */
+    int smooth;                      /* 1: offered because the run cannot show the chosen
+                                        periodic shape repeats (any Delta BIC); 0: Delta BIC
+                                        below 6 (docs/explain.md, "Confusable effects") */
 } pmx_alternative;
 
 /* One item of the physical reading of the baseline. */

@@ -57,6 +57,9 @@ struct Alternative {
     double delta_bic = 0;      // BIC(alternative) - BIC(chosen), >= 0
     double log10_lr = 0;       // log10 of the likelihood ratio chosen : alternative
     std::string separate_by;   // the observation that would tell them apart
+    bool smooth = false;       // kind "smooth": offered because the run cannot show the
+                               // chosen periodic shape repeats (explain.cpp, smooth_alternative),
+                               // not for a Delta BIC below close_delta_bic (kind "close")
 };
 
 // One physical reading of the fitted baseline (docs/explain.md,

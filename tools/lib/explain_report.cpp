@@ -28,7 +28,8 @@ std::string alternatives_json(const std::vector<Alternative> &alts)
         j += std::string(k ? ", " : "") + "{\"effect\": " + str(a.effect) +
              ", \"log10_false_alarm_probability\": " + num(a.log10_fap) +
              ", \"delta_bic\": " + num(a.delta_bic) + ", \"log10_likelihood_ratio\": " +
-             num(a.log10_lr) + ", \"separate_by\": " + str(a.separate_by) + "}";
+             num(a.log10_lr) + ", \"kind\": " + str(a.smooth ? "smooth" : "close") +
+             ", \"separate_by\": " + str(a.separate_by) + "}";
     }
     return j + "]";
 }
@@ -153,14 +154,24 @@ void print_findings(const Explanation &ex, double alpha)
                     "%.3f\", CV RMS %.3f\", P = %d\n",
                     f.where.c_str(), f.false_alarm_probability, f.log10_p, f.sigma_after_arcsec,
                     f.cv_rms_after_arcsec, f.n_params_after);
-        for (const Alternative &a : f.alternatives)
-            std::printf("     as good a reading: %s (false-alarm 10^%.1f, Delta BIC %+.1f%s, "
-                        "likelihood ratio 10^%.2f in favour of %s); to separate them: %s\n",
-                        a.effect.c_str(), a.log10_fap, a.delta_bic,
-                        a.delta_bic < 0 ? ": BIC, which does not count the periods or candidates "
-                                          "tried, prefers it" : "",
-                        std::fabs(a.log10_lr), a.log10_lr >= 0 ? f.effect.c_str() : a.effect.c_str(),
-                        a.separate_by.c_str());
+        for (const Alternative &a : f.alternatives) {
+            if (a.smooth)
+                std::printf("     or a smooth shape: %s (false-alarm 10^%.1f) holds all that the "
+                            "periodic term explains, and the run samples too few cycles to show "
+                            "that the shape repeats (Delta BIC %+.1f prefers %s for its fewer "
+                            "terms); to separate them: %s\n",
+                            a.effect.c_str(), a.log10_fap, a.delta_bic, f.effect.c_str(),
+                            a.separate_by.c_str());
+            else
+                std::printf("     as good a reading: %s (false-alarm 10^%.1f, Delta BIC %+.1f%s, "
+                            "likelihood ratio 10^%.2f in favour of %s); to separate them: %s\n",
+                            a.effect.c_str(), a.log10_fap, a.delta_bic,
+                            a.delta_bic < 0 ? ": BIC, which does not count the periods or "
+                                              "candidates tried, prefers it" : "",
+                            std::fabs(a.log10_lr),
+                            a.log10_lr >= 0 ? f.effect.c_str() : a.effect.c_str(),
+                            a.separate_by.c_str());
+        }
     }
     for (size_t i = 0; i < ex.withdrawn.size(); i++)
         std::printf("  withdrawn: %s; the findings above are those of the search without it\n",

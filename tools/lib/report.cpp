@@ -653,9 +653,13 @@ void explain_findings(Page &p, const Data &d)
         if (!f.with.empty())
             extra += "<li>Found together with " + h(f.with) + ": neither alone passed, the pair does.</li>";
         for (const Alternative &a : f.alternatives)
-            extra += "<li>As good a reading: <b>" + h(a.effect) +
-                     fmt("</b> (false-alarm 10<sup>%.1f</sup>, &Delta;BIC %+.1f); to separate them: ", a.log10_fap,
-                         a.delta_bic) + h(a.separate_by) + "</li>";
+            extra += std::string(a.smooth ? "<li>Or a smooth shape: <b>" : "<li>As good a reading: <b>") +
+                     h(a.effect) +
+                     fmt("</b> (false-alarm 10<sup>%.1f</sup>, &Delta;BIC %+.1f%s); to separate them: ",
+                         a.log10_fap, a.delta_bic,
+                         a.smooth ? ": it holds all that the periodic term explains, and the run samples "
+                                    "too few cycles to show that the shape repeats" : "") +
+                     h(a.separate_by) + "</li>";
         p.body += fmt("<h3 id=\"finding%zu\">Finding %zu: ", k + 1, k + 1) + h(f.effect) + "</h3>\n";
         para(p, h(f.text) + ". <i>Where:</i> " + h(f.where) + ".");
         if (!extra.empty())
