@@ -822,10 +822,17 @@ std::vector<Alternative> alternatives(const Run &run, const State &st, const Can
             al.smooth = true;
             std::vector<double> d = model_difference(run, st.use, c.fit.f.model, a.fit.f.model);
             std::string bin = largest_bin(run, st.use, d);
-            al.separate_by = fmt("the %s axis over more of its range: this run samples %.1f cycles "
-                                 "of the period (a gear error repeats, a smooth distortion does "
-                                 "not)", c.effect == "dec_periodic" ? "second" : "first", cycles) +
-                             (bin.empty() ? "" : "; on this run they differ most at " + bin);
+            bool dec = c.effect == "dec_periodic", full = cycles / c.peak_g > 0.8;
+            al.separate_by =
+                full ? fmt("points over more of the %s axis's range: this run samples %.1f cycles "
+                           "of the period, nearly all of the %s axis, and a term of the axis angle "
+                           "and a smooth distortion change differently along the other axis",
+                           dec ? "first" : "second", cycles, dec ? "second" : "first")
+                     : fmt("the %s axis over more of its range: this run samples %.1f cycles of "
+                           "the period (a gear error repeats, a smooth distortion does not)",
+                           dec ? "second" : "first", cycles);
+            if (!bin.empty())
+                al.separate_by += "; on this run they differ most at " + bin;
         }
         out.push_back(al);
     }

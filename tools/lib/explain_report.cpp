@@ -157,8 +157,8 @@ void print_findings(const Explanation &ex, double alpha)
         for (const Alternative &a : f.alternatives) {
             if (a.smooth)
                 std::printf("     or a smooth shape: %s (false-alarm 10^%.1f) holds all that the "
-                            "periodic term explains, and the run samples too few cycles to show "
-                            "that the shape repeats (Delta BIC %+.1f prefers %s for its fewer "
+                            "periodic term explains, so this run cannot tell a periodic error "
+                            "from a smooth distortion (Delta BIC %+.1f prefers %s for its fewer "
                             "terms); to separate them: %s\n",
                             a.effect.c_str(), a.log10_fap, a.delta_bic, f.effect.c_str(),
                             a.separate_by.c_str());

@@ -657,8 +657,8 @@ void explain_findings(Page &p, const Data &d)
                      h(a.effect) +
                      fmt("</b> (false-alarm 10<sup>%.1f</sup>, &Delta;BIC %+.1f%s); to separate them: ",
                          a.log10_fap, a.delta_bic,
-                         a.smooth ? ": it holds all that the periodic term explains, and the run samples "
-                                    "too few cycles to show that the shape repeats" : "") +
+                         a.smooth ? ": it holds all that the periodic term explains, so this run cannot "
+                                    "tell a periodic error from a smooth distortion" : "") +
                      h(a.separate_by) + "</li>";
         p.body += fmt("<h3 id=\"finding%zu\">Finding %zu: ", k + 1, k + 1) + h(f.effect) + "</h3>\n";
         para(p, h(f.text) + ". <i>Where:</i> " + h(f.where) + ".");
