@@ -741,7 +741,7 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
     Trig<double> slot[3];
     Trig<double> &g = slot[0];
     double dh_t = 0, dh_d = 0; /* D^ of g */
-    double J[4] = {0, 0, 0, 0}, Ni[4] = {1, 0, 0, 1}, dist_j = 0;
+    double J[4], Ni[4], dist_j = 0;
     bool have_j = false, have_n = false, tried_n = false, reachable;
     double d0t = 0, d0d = 0;
     bool have_d = false; /* (d0t, d0d): D at g, evaluated */
@@ -786,98 +786,220 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
     if (raw)
         on_turn(m, k, a, &g, ref_t, ref_d);
 
-    double change = 0, last_change = 1e300, best_change = 1e300;
-    bool converged = false, best_reachable = reachable;
+    double change = 0, last_change, best_change;
+    bool converged = false, best_reachable;
     Trig<double> *gp = &slot[0], *bp = &slot[0];
     /* the best point's displacement, its D^ and distance from J's point */
-    double b_dt = 0, b_dd = 0, b_ht = 0, b_hd = 0, b_dist = 0;
+    double b_dt, b_dd, b_ht, b_hd, b_dist;
     bool chord = true; /* Newton steps on D (else plain fixed-point steps) */
-    for (int it = 0; !converged; it++) {
-        double dt, dd;
-        if (have_d) {
-            dt = d0t;
-            dd = d0d;
-            have_d = false;
-        } else {
-            if (used >= PM_INVERT_MAX_FIXED)
-                break;
-            used++;
-            if (have_j) {
-                aniso<double>(m, k, *gp, ctx, &dt, &dd);
-            } else {
-                aniso_jac(m, k, *gp, ctx, &dt, &dd, J);
-                have_j = true;
-                dist_j = 0;
+    int it0 = 0;       /* the iteration the loop below starts at */
+    bool lean_done = false;
+    if (reachable && lip2 >= 0 && !(m->order == 0 && m->n_terms == m->n_base)) {
+        /* The typical call (far from the mount's pole, a small anisotropic
+        ** displacement): every Newton step on D contracts, and the
+        ** predicted stop certifies a point within PM_INVERT_MAX_FIXED
+        ** evaluations.  The same operations and decisions as the loop
+        ** below, without its bookkeeping for the other cases: while the
+        ** steps contract the best point is the current one.  At the first
+        ** event of another kind (no contraction, no Newton step, a step
+        ** beyond the closed form's reach or beyond 0.01 rad, an overflow)
+        ** the loop below takes over at the start of that iteration, with
+        ** the evaluation made (have_d) and the state it would have had. */
+        /* the current point, the previous one (the best so far), the next */
+        Trig<double> *cur = &slot[0], *prv = &slot[1], *nxt = &slot[2];
+        double dt = d0t, dd = d0d, last = 1e300;
+        /* the previous point's (the best so far) displacement, D^, distance */
+        double p_dt = 0, p_dd = 0, p_ht = 0, p_hd = 0, p_dist = 0;
+        int it = 0;
+        bool bail = false;
+        for (;; it++) {
+            if (!have_d) {
+                if (used >= PM_INVERT_MAX_FIXED) {
+                    /* (the loop below would stop here, with the best point) */
+                    bp = prv;
+                    best_reachable = true;
+                    lean_done = true;
+                    break;
+                }
+                used++;
+                if (have_j) {
+                    aniso<double>(m, k, *cur, ctx, &dt, &dd);
+                } else {
+                    aniso_jac(m, k, *cur, ctx, &dt, &dd, J);
+                    have_j = true;
+                    dist_j = 0;
+                }
             }
-        }
-        if (!finite(dt * dt + dd * dd))
-            break; /* the forward model overflows here: not converged */
-        change = m_sqrt((dt - dh_t) * (dt - dh_t) + (dd - dh_d) * (dd - dh_d));
-        if (change < best_change) {
-            best_change = change;
-            bp = gp;
-            best_reachable = reachable;
-            b_dt = dt;
-            b_dd = dd;
-            b_ht = dh_t;
-            b_hd = dh_d;
-            b_dist = dist_j;
-        }
-        if (change <= PM_INVERT_TOL * 0.5) {
-            converged = true;
-            break;
-        }
-        if (it > 0 && change > 0.5 * last_change) {
-            /* not contracting: where the steps were Newton's on D (with
-            ** J from the first evaluation: a term that varies fast makes J
-            ** a poor guide), plain fixed-point steps from the best point;
-            ** else Newton on the forward model takes over */
-            if (!(chord && have_n))
+            have_d = false;
+            if (!finite(dt * dt + dd * dd)) {
+                bail = true;
                 break;
-            chord = false;
-            gp = bp;
-            reachable = best_reachable;
-            dt = b_dt;
-            dd = b_dd;
-            dh_t = b_ht;
-            dh_d = b_hd;
-            dist_j = b_dist;
-            change = best_change;
-        }
-        last_change = change;
-        double nt = dt, nd = dd, ht, hd;
-        if (!tried_n) { /* (F_D once, where the first step needs it) */
-            tried_n = true;
-            have_n = newton_prep(k, *gp, dh_t, dh_d, J, Ni);
-        }
-        if (chord && have_n && change <= 0.01) {
-            nt = dh_t + (Ni[0] * (dt - dh_t) + Ni[1] * (dd - dh_d));
-            nd = dh_d + (Ni[2] * (dt - dh_t) + Ni[3] * (dd - dh_d));
-        }
-        Trig<double> *g2p = &slot[0];
-        while (g2p == gp || g2p == bp)
-            g2p++;
-        reachable = iso_inverse<double>(k, tg, nt, nd, side, g2p);
-        if (raw)
-            on_turn(m, k, a, g2p, ref_t, ref_d);
-        if (lip2 >= 0 && small_step(*g2p, *gp, &ht, &hd)) {
-            double h2 = ht * ht + hd * hd, hn = m_sqrt(h2) * (1 + h2 * 0.2);
-            /* (the second-order part alone first: it fails most steps) */
+            }
+            change = m_sqrt((dt - dh_t) * (dt - dh_t) + (dd - dh_d) * (dd - dh_d));
+            if (change <= PM_INVERT_TOL * 0.5) {
+                bp = cur;
+                best_reachable = true;
+                converged = lean_done = true;
+                break;
+            }
+            if (it > 0 && change > 0.5 * last) {
+                bail = true;
+                break;
+            }
+            if (!tried_n) {
+                tried_n = true;
+                have_n = newton_prep(k, *cur, dh_t, dh_d, J, Ni);
+            }
+            if (!(have_n && change <= 0.01)) {
+                bail = true;
+                break;
+            }
+            const double nt = dh_t + (Ni[0] * (dt - dh_t) + Ni[1] * (dd - dh_d));
+            const double nd = dh_d + (Ni[2] * (dt - dh_t) + Ni[3] * (dd - dh_d));
+            double ht, hd;
+            if (!iso_inverse<double>(k, tg, nt, nd, side, nxt) ||
+                !small_step(*nxt, *cur, &ht, &hd)) {
+                bail = true;
+                break;
+            }
+            const double h2 = ht * ht + hd * hd, hn = m_sqrt(h2) * (1 + h2 * 0.2);
             if (!(lip2 * (dist_j + 0.5 * hn) * hn > PM_INVERT_TOL * 0.5) &&
-                step_bound(dt, dd, J, ht, hd, nt, nd, lip2, dist_j, hn) <=
-                    PM_INVERT_TOL * 0.5) {
-                bp = g2p;
+                step_bound(dt, dd, J, ht, hd, nt, nd, lip2, dist_j, hn) <= PM_INVERT_TOL * 0.5) {
+                bp = nxt;
+                best_reachable = true;
+                converged = lean_done = true;
+                break;
+            }
+            p_dt = dt;
+            p_dd = dd;
+            p_ht = dh_t;
+            p_hd = dh_d;
+            p_dist = dist_j;
+            last = change;
+            dist_j += hn;
+            dh_t = nt;
+            dh_d = nd;
+            Trig<double> *x = prv;
+            prv = cur;
+            cur = nxt;
+            nxt = x;
+        }
+        if (bail) {
+            /* the loop below, at the start of iteration it, the evaluation
+            ** at cur made */
+            it0 = it;
+            gp = cur;
+            d0t = dt;
+            d0d = dd;
+            have_d = true;
+            if (it == 0) {
+                bp = cur;
+                best_change = last_change = 1e300;
+                b_dt = b_dd = b_ht = b_hd = b_dist = 0;
+            } else {
+                bp = prv;
+                best_change = last_change = last;
+                b_dt = p_dt;
+                b_dd = p_dd;
+                b_ht = p_ht;
+                b_hd = p_hd;
+                b_dist = p_dist;
+            }
+            best_reachable = true;
+        }
+    } else {
+        last_change = best_change = 1e300;
+        best_reachable = reachable;
+        b_dt = b_dd = b_ht = b_hd = b_dist = 0;
+    }
+    if (!lean_done) {
+        for (int it = it0; !converged; it++) {
+            double dt, dd;
+            if (have_d) {
+                dt = d0t;
+                dd = d0d;
+                have_d = false;
+            } else {
+                if (used >= PM_INVERT_MAX_FIXED)
+                    break;
+                used++;
+                if (have_j) {
+                    aniso<double>(m, k, *gp, ctx, &dt, &dd);
+                } else {
+                    aniso_jac(m, k, *gp, ctx, &dt, &dd, J);
+                    have_j = true;
+                    dist_j = 0;
+                }
+            }
+            if (!finite(dt * dt + dd * dd))
+                break; /* the forward model overflows here: not converged */
+            change = m_sqrt((dt - dh_t) * (dt - dh_t) + (dd - dh_d) * (dd - dh_d));
+            if (change < best_change) {
+                best_change = change;
+                bp = gp;
                 best_reachable = reachable;
+                b_dt = dt;
+                b_dd = dd;
+                b_ht = dh_t;
+                b_hd = dh_d;
+                b_dist = dist_j;
+            }
+            if (change <= PM_INVERT_TOL * 0.5) {
                 converged = true;
                 break;
             }
-            dist_j += hn;
-        } else {
-            dist_j = 1e300; /* (a bound fails from here on: J is not evaluated again) */
+            if (it > 0 && change > 0.5 * last_change) {
+                /* not contracting: where the steps were Newton's on D (with
+                ** J from the first evaluation: a term that varies fast makes J
+                ** a poor guide), plain fixed-point steps from the best point;
+                ** else Newton on the forward model takes over */
+                if (!(chord && have_n))
+                    break;
+                chord = false;
+                gp = bp;
+                reachable = best_reachable;
+                dt = b_dt;
+                dd = b_dd;
+                dh_t = b_ht;
+                dh_d = b_hd;
+                dist_j = b_dist;
+                change = best_change;
+            }
+            last_change = change;
+            double nt = dt, nd = dd, ht, hd;
+            if (!tried_n) { /* (F_D once, where the first step needs it) */
+                tried_n = true;
+                have_n = newton_prep(k, *gp, dh_t, dh_d, J, Ni);
+            }
+            if (chord && have_n && change <= 0.01) {
+                nt = dh_t + (Ni[0] * (dt - dh_t) + Ni[1] * (dd - dh_d));
+                nd = dh_d + (Ni[2] * (dt - dh_t) + Ni[3] * (dd - dh_d));
+            }
+            Trig<double> *g2p = &slot[0];
+            while (g2p == gp || g2p == bp)
+                g2p++;
+            reachable = iso_inverse<double>(k, tg, nt, nd, side, g2p);
+            if (raw)
+                on_turn(m, k, a, g2p, ref_t, ref_d);
+            if (lip2 >= 0 && small_step(*g2p, *gp, &ht, &hd)) {
+                double h2 = ht * ht + hd * hd, hn = m_sqrt(h2) * (1 + h2 * 0.2);
+                /* (the second-order part alone first: it fails most steps) */
+                if (!(lip2 * (dist_j + 0.5 * hn) * hn > PM_INVERT_TOL * 0.5) &&
+                    step_bound(dt, dd, J, ht, hd, nt, nd, lip2, dist_j, hn) <=
+                        PM_INVERT_TOL * 0.5) {
+                    bp = g2p;
+                    best_reachable = reachable;
+                    converged = true;
+                    break;
+                }
+                dist_j += hn;
+            } else {
+                dist_j = 1e300; /* (a bound fails from here on: J is not evaluated again) */
+            }
+            gp = g2p;
+            dh_t = nt;
+            dh_d = nd;
         }
-        gp = g2p;
-        dh_t = nt;
-        dh_d = nd;
     }
     Trig<double> &gb = *bp;
     reachable = best_reachable;
