@@ -663,6 +663,22 @@ inline double step_bound(double dt, double dd, const double J[4], double ht, dou
 ** the iteration converges, never when it stops (the stop is measured, or
 ** bounded with J itself).  False where the step is ill-conditioned (the
 ** mount's pole). */
+/* Ni = (I - K)^-1, K = J F_D; false where I - K is ill-conditioned. */
+inline bool chord_matrix(double K00, double K01, double K10, double K11, double Ni[4])
+{
+    double A = 1 - K00, B = -K01, C = -K10, D = 1 - K11;
+    double det = A * D - B * C;
+    if (!(m_fabs(det) >= 0.05))
+        return false;
+    double id = 1 / det;
+    /* (I - K)^-1 */
+    Ni[0] = D * id;
+    Ni[1] = -B * id;
+    Ni[2] = -C * id;
+    Ni[3] = A * id;
+    return true;
+}
+
 inline bool newton_prep(const Iso<double> &k, const Trig<double> &g, double a, double b,
                         const double J[4], double Ni[4])
 {
@@ -685,19 +701,25 @@ inline bool newton_prep(const Iso<double> &k, const Trig<double> &g, double a, d
     double i00 = m11 * idm, i01 = -m01 * idm, i10 = -m10 * idm, i11 = m00 * idm;
     double f00 = -(i00 * w00 + i01 * w01), f01 = -(i00 * w01 + i01 * w11);
     double f10 = -(i10 * w00 + i11 * w01), f11 = -(i10 * w01 + i11 * w11);
-    double K00 = J[0] * f00 + J[1] * f10, K01 = J[0] * f01 + J[1] * f11;
-    double K10 = J[2] * f00 + J[3] * f10, K11 = J[2] * f01 + J[3] * f11;
-    double A = 1 - K00, B = -K01, C = -K10, D = 1 - K11;
-    double det = A * D - B * C;
-    if (!(m_fabs(det) >= 0.05))
+    return chord_matrix(J[0] * f00 + J[1] * f10, J[0] * f01 + J[1] * f11,
+                        J[2] * f00 + J[3] * f10, J[2] * f01 + J[3] * f11, Ni);
+}
+
+/* newton_prep at D^ = 0 (a cold call's first point): w = (1, 0, 0) and w_D
+** = I, the same values without the products by zero. */
+inline bool newton_prep0(const Iso<double> &k, const Trig<double> &g, const double J[4],
+                         double Ni[4])
+{
+    double sdp = g.sd * k.ce - g.cd * k.se, cdp = g.cd * k.ce + g.sd * k.se;
+    double ax = sdp * k.cd, ay = k.sd, az = cdp * k.cd;
+    double by = k.ci * ay - k.si * ax;
+    double dm = az * k.ci;
+    if (!(m_fabs(dm) >= 1e-3 * k.ci))
         return false;
-    double id = 1 / det;
-    /* (I - K)^-1 */
-    Ni[0] = D * id;
-    Ni[1] = -B * id;
-    Ni[2] = -C * id;
-    Ni[3] = A * id;
-    return true;
+    double idm = 1 / dm;
+    double f00 = -(k.ci * idm), f10 = -(by * idm), f11 = -(az * idm);
+    return chord_matrix(J[0] * f00 + J[1] * f10, J[1] * f11, J[2] * f00 + J[3] * f10,
+                        J[3] * f11, Ni);
 }
 
 /* Solve on one branch of the closed form (side = +1/-1), or from the start
@@ -754,7 +776,7 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
             double cdp = gs.cd * k.ce + gs.sd * k.se;
             side = cdp * k.ci >= 0 ? 1 : -1;
         }
-        reachable = iso_inverse<double>(k, tg, 0.0, 0.0, side, &g);
+        reachable = iso_inverse0<double>(k, tg, side, &g);
         if (raw)
             on_turn(m, k, a, &g, ref_t, ref_d);
         have_d = true; /* (the iteration below stops at once: D = D^ = 0) */
@@ -781,7 +803,7 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
         logmap<double>(w, &dh_t, &dh_d);
         reachable = true;
     } else {
-        reachable = iso_inverse<double>(k, tg, 0.0, 0.0, side, &g);
+        reachable = iso_inverse0<double>(k, tg, side, &g);
     }
     if (raw)
         on_turn(m, k, a, &g, ref_t, ref_d);
@@ -848,7 +870,8 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
             }
             if (!tried_n) {
                 tried_n = true;
-                have_n = newton_prep(k, *cur, dh_t, dh_d, J, Ni);
+                have_n = start ? newton_prep(k, *cur, dh_t, dh_d, J, Ni)
+                               : newton_prep0(k, *cur, J, Ni); /* (D^ = 0) */
             }
             if (!(have_n && change <= 0.01)) {
                 bail = true;
