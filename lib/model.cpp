@@ -824,16 +824,18 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
         ** below, without its bookkeeping for the other cases: while the
         ** steps contract the best point is the current one.  At the first
         ** event of another kind (no contraction, no Newton step, a step
-        ** beyond the closed form's reach or beyond 0.01 rad, an overflow)
-        ** the loop below takes over at the start of that iteration, with
-        ** the evaluation made (have_d) and the state it would have had. */
+        ** beyond the closed form's reach, an overflow) the loop below takes
+        ** over at the start of that iteration, with the evaluation made
+        ** (have_d) and the state it would have had; after a step beyond
+        ** 0.01 rad (small_step), at the start of the next one. */
         /* the current point, the previous one (the best so far), the next */
         Trig<double> *cur = &slot[0], *prv = &slot[1], *nxt = &slot[2];
         double dt = d0t, dd = d0d, last = 1e300;
         /* the previous point's (the best so far) displacement, D^, distance */
         double p_dt = 0, p_dd = 0, p_ht = 0, p_hd = 0, p_dist = 0;
         int it = 0;
-        bool bail = false;
+        bool bail = false, bail_next = false;
+        double s_nt = 0, s_nd = 0; /* (bail_next: the step's D^) */
         for (;; it++) {
             if (!have_d) {
                 if (used >= PM_INVERT_MAX_FIXED) {
@@ -880,9 +882,16 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
             const double nt = dh_t + (Ni[0] * (dt - dh_t) + Ni[1] * (dd - dh_d));
             const double nd = dh_d + (Ni[2] * (dt - dh_t) + Ni[3] * (dd - dh_d));
             double ht, hd;
-            if (!iso_inverse<double>(k, tg, nt, nd, side, nxt) ||
-                !small_step(*nxt, *cur, &ht, &hd)) {
+            if (!iso_inverse<double>(k, tg, nt, nd, side, nxt)) {
                 bail = true;
+                break;
+            }
+            if (!small_step(*nxt, *cur, &ht, &hd)) {
+                /* a step beyond 0.01 rad: no bound from here on, the loop
+                ** below takes over after it */
+                bail_next = true;
+                s_nt = nt;
+                s_nd = nd;
                 break;
             }
             const double h2 = ht * ht + hd * hd, hn = m_sqrt(h2) * (1 + h2 * 0.2);
@@ -929,6 +938,23 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
                 b_dist = p_dist;
             }
             best_reachable = true;
+        } else if (bail_next) {
+            /* the loop below, at the start of iteration it + 1, as it
+            ** leaves a step the bound cannot follow (dist_j = 1e300): the
+            ** point at cur the best, the next point at nxt */
+            it0 = it + 1;
+            bp = cur;
+            best_change = last_change = change;
+            b_dt = dt;
+            b_dd = dd;
+            b_ht = dh_t;
+            b_hd = dh_d;
+            b_dist = dist_j;
+            best_reachable = true;
+            dist_j = 1e300;
+            gp = nxt;
+            dh_t = s_nt;
+            dh_d = s_nd;
         }
     } else {
         last_change = best_change = 1e300;
