@@ -663,6 +663,22 @@ inline double step_bound(double dt, double dd, const double J[4], double ht, dou
 ** the iteration converges, never when it stops (the stop is measured, or
 ** bounded with J itself).  False where the step is ill-conditioned (the
 ** mount's pole). */
+/* Ni = (I - K)^-1, K = J F_D; false where I - K is ill-conditioned. */
+inline bool chord_matrix(double K00, double K01, double K10, double K11, double Ni[4])
+{
+    double A = 1 - K00, B = -K01, C = -K10, D = 1 - K11;
+    double det = A * D - B * C;
+    if (!(m_fabs(det) >= 0.05))
+        return false;
+    double id = 1 / det;
+    /* (I - K)^-1 */
+    Ni[0] = D * id;
+    Ni[1] = -B * id;
+    Ni[2] = -C * id;
+    Ni[3] = A * id;
+    return true;
+}
+
 inline bool newton_prep(const Iso<double> &k, const Trig<double> &g, double a, double b,
                         const double J[4], double Ni[4])
 {
@@ -685,19 +701,25 @@ inline bool newton_prep(const Iso<double> &k, const Trig<double> &g, double a, d
     double i00 = m11 * idm, i01 = -m01 * idm, i10 = -m10 * idm, i11 = m00 * idm;
     double f00 = -(i00 * w00 + i01 * w01), f01 = -(i00 * w01 + i01 * w11);
     double f10 = -(i10 * w00 + i11 * w01), f11 = -(i10 * w01 + i11 * w11);
-    double K00 = J[0] * f00 + J[1] * f10, K01 = J[0] * f01 + J[1] * f11;
-    double K10 = J[2] * f00 + J[3] * f10, K11 = J[2] * f01 + J[3] * f11;
-    double A = 1 - K00, B = -K01, C = -K10, D = 1 - K11;
-    double det = A * D - B * C;
-    if (!(m_fabs(det) >= 0.05))
+    return chord_matrix(J[0] * f00 + J[1] * f10, J[0] * f01 + J[1] * f11,
+                        J[2] * f00 + J[3] * f10, J[2] * f01 + J[3] * f11, Ni);
+}
+
+/* newton_prep at D^ = 0 (a cold call's first point): w = (1, 0, 0) and w_D
+** = I, the same values without the products by zero. */
+inline bool newton_prep0(const Iso<double> &k, const Trig<double> &g, const double J[4],
+                         double Ni[4])
+{
+    double sdp = g.sd * k.ce - g.cd * k.se, cdp = g.cd * k.ce + g.sd * k.se;
+    double ax = sdp * k.cd, ay = k.sd, az = cdp * k.cd;
+    double by = k.ci * ay - k.si * ax;
+    double dm = az * k.ci;
+    if (!(m_fabs(dm) >= 1e-3 * k.ci))
         return false;
-    double id = 1 / det;
-    /* (I - K)^-1 */
-    Ni[0] = D * id;
-    Ni[1] = -B * id;
-    Ni[2] = -C * id;
-    Ni[3] = A * id;
-    return true;
+    double idm = 1 / dm;
+    double f00 = -(k.ci * idm), f10 = -(by * idm), f11 = -(az * idm);
+    return chord_matrix(J[0] * f00 + J[1] * f10, J[1] * f11, J[2] * f00 + J[3] * f10,
+                        J[3] * f11, Ni);
 }
 
 /* Solve on one branch of the closed form (side = +1/-1), or from the start
@@ -741,7 +763,7 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
     Trig<double> slot[3];
     Trig<double> &g = slot[0];
     double dh_t = 0, dh_d = 0; /* D^ of g */
-    double J[4] = {0, 0, 0, 0}, Ni[4] = {1, 0, 0, 1}, dist_j = 0;
+    double J[4], Ni[4], dist_j = 0;
     bool have_j = false, have_n = false, tried_n = false, reachable;
     double d0t = 0, d0d = 0;
     bool have_d = false; /* (d0t, d0d): D at g, evaluated */
@@ -754,7 +776,7 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
             double cdp = gs.cd * k.ce + gs.sd * k.se;
             side = cdp * k.ci >= 0 ? 1 : -1;
         }
-        reachable = iso_inverse<double>(k, tg, 0.0, 0.0, side, &g);
+        reachable = iso_inverse0<double>(k, tg, side, &g);
         if (raw)
             on_turn(m, k, a, &g, ref_t, ref_d);
         have_d = true; /* (the iteration below stops at once: D = D^ = 0) */
@@ -781,103 +803,252 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
         logmap<double>(w, &dh_t, &dh_d);
         reachable = true;
     } else {
-        reachable = iso_inverse<double>(k, tg, 0.0, 0.0, side, &g);
+        reachable = iso_inverse0<double>(k, tg, side, &g);
     }
     if (raw)
         on_turn(m, k, a, &g, ref_t, ref_d);
 
-    double change = 0, last_change = 1e300, best_change = 1e300;
-    bool converged = false, best_reachable = reachable;
+    double change = 0, last_change, best_change;
+    bool converged = false, best_reachable;
     Trig<double> *gp = &slot[0], *bp = &slot[0];
     /* the best point's displacement, its D^ and distance from J's point */
-    double b_dt = 0, b_dd = 0, b_ht = 0, b_hd = 0, b_dist = 0;
+    double b_dt, b_dd, b_ht, b_hd, b_dist;
     bool chord = true; /* Newton steps on D (else plain fixed-point steps) */
-    for (int it = 0; !converged; it++) {
-        double dt, dd;
-        if (have_d) {
-            dt = d0t;
-            dd = d0d;
-            have_d = false;
-        } else {
-            if (used >= PM_INVERT_MAX_FIXED)
-                break;
-            used++;
-            if (have_j) {
-                aniso<double>(m, k, *gp, ctx, &dt, &dd);
-            } else {
-                aniso_jac(m, k, *gp, ctx, &dt, &dd, J);
-                have_j = true;
-                dist_j = 0;
+    int it0 = 0;       /* the iteration the loop below starts at */
+    bool lean_done = false;
+    if (reachable && lip2 >= 0 && !(m->order == 0 && m->n_terms == m->n_base)) {
+        /* The typical call (far from the mount's pole, a small anisotropic
+        ** displacement): every Newton step on D contracts, and the
+        ** predicted stop certifies a point within PM_INVERT_MAX_FIXED
+        ** evaluations.  The same operations and decisions as the loop
+        ** below, without its bookkeeping for the other cases: while the
+        ** steps contract the best point is the current one.  At the first
+        ** event of another kind (no contraction, no Newton step, a step
+        ** beyond the closed form's reach, an overflow) the loop below takes
+        ** over at the start of that iteration, with the evaluation made
+        ** (have_d) and the state it would have had; after a step beyond
+        ** 0.01 rad (small_step), at the start of the next one. */
+        /* the current point, the previous one (the best so far), the next */
+        Trig<double> *cur = &slot[0], *prv = &slot[1], *nxt = &slot[2];
+        double dt = d0t, dd = d0d, last = 1e300;
+        /* the previous point's (the best so far) displacement, D^, distance */
+        double p_dt = 0, p_dd = 0, p_ht = 0, p_hd = 0, p_dist = 0;
+        int it = 0;
+        bool bail = false, bail_next = false;
+        double s_nt = 0, s_nd = 0; /* (bail_next: the step's D^) */
+        for (;; it++) {
+            if (!have_d) {
+                if (used >= PM_INVERT_MAX_FIXED) {
+                    /* (the loop below would stop here, with the best point) */
+                    bp = prv;
+                    best_reachable = true;
+                    lean_done = true;
+                    break;
+                }
+                used++;
+                if (have_j) {
+                    aniso<double>(m, k, *cur, ctx, &dt, &dd);
+                } else {
+                    aniso_jac(m, k, *cur, ctx, &dt, &dd, J);
+                    have_j = true;
+                    dist_j = 0;
+                }
             }
+            have_d = false;
+            if (!finite(dt * dt + dd * dd)) {
+                bail = true;
+                break;
+            }
+            change = m_sqrt((dt - dh_t) * (dt - dh_t) + (dd - dh_d) * (dd - dh_d));
+            if (change <= PM_INVERT_TOL * 0.5) {
+                bp = cur;
+                best_reachable = true;
+                converged = lean_done = true;
+                break;
+            }
+            if (it > 0 && change > 0.5 * last) {
+                bail = true;
+                break;
+            }
+            if (!tried_n) {
+                tried_n = true;
+                have_n = start ? newton_prep(k, *cur, dh_t, dh_d, J, Ni)
+                               : newton_prep0(k, *cur, J, Ni); /* (D^ = 0) */
+            }
+            if (!(have_n && change <= 0.01)) {
+                bail = true;
+                break;
+            }
+            const double nt = dh_t + (Ni[0] * (dt - dh_t) + Ni[1] * (dd - dh_d));
+            const double nd = dh_d + (Ni[2] * (dt - dh_t) + Ni[3] * (dd - dh_d));
+            double ht, hd;
+            if (!iso_inverse<double>(k, tg, nt, nd, side, nxt)) {
+                bail = true;
+                break;
+            }
+            if (!small_step(*nxt, *cur, &ht, &hd)) {
+                /* a step beyond 0.01 rad: no bound from here on, the loop
+                ** below takes over after it */
+                bail_next = true;
+                s_nt = nt;
+                s_nd = nd;
+                break;
+            }
+            const double h2 = ht * ht + hd * hd, hn = m_sqrt(h2) * (1 + h2 * 0.2);
+            if (!(lip2 * (dist_j + 0.5 * hn) * hn > PM_INVERT_TOL * 0.5) &&
+                step_bound(dt, dd, J, ht, hd, nt, nd, lip2, dist_j, hn) <= PM_INVERT_TOL * 0.5) {
+                bp = nxt;
+                best_reachable = true;
+                converged = lean_done = true;
+                break;
+            }
+            p_dt = dt;
+            p_dd = dd;
+            p_ht = dh_t;
+            p_hd = dh_d;
+            p_dist = dist_j;
+            last = change;
+            dist_j += hn;
+            dh_t = nt;
+            dh_d = nd;
+            Trig<double> *x = prv;
+            prv = cur;
+            cur = nxt;
+            nxt = x;
         }
-        if (!finite(dt * dt + dd * dd))
-            break; /* the forward model overflows here: not converged */
-        change = m_sqrt((dt - dh_t) * (dt - dh_t) + (dd - dh_d) * (dd - dh_d));
-        if (change < best_change) {
-            best_change = change;
-            bp = gp;
-            best_reachable = reachable;
+        if (bail) {
+            /* the loop below, at the start of iteration it, the evaluation
+            ** at cur made */
+            it0 = it;
+            gp = cur;
+            d0t = dt;
+            d0d = dd;
+            have_d = true;
+            if (it == 0) {
+                bp = cur;
+                best_change = last_change = 1e300;
+                b_dt = b_dd = b_ht = b_hd = b_dist = 0;
+            } else {
+                bp = prv;
+                best_change = last_change = last;
+                b_dt = p_dt;
+                b_dd = p_dd;
+                b_ht = p_ht;
+                b_hd = p_hd;
+                b_dist = p_dist;
+            }
+            best_reachable = true;
+        } else if (bail_next) {
+            /* the loop below, at the start of iteration it + 1, as it
+            ** leaves a step the bound cannot follow (dist_j = 1e300): the
+            ** point at cur the best, the next point at nxt */
+            it0 = it + 1;
+            bp = cur;
+            best_change = last_change = change;
             b_dt = dt;
             b_dd = dd;
             b_ht = dh_t;
             b_hd = dh_d;
             b_dist = dist_j;
+            best_reachable = true;
+            dist_j = 1e300;
+            gp = nxt;
+            dh_t = s_nt;
+            dh_d = s_nd;
         }
-        if (change <= PM_INVERT_TOL * 0.5) {
-            converged = true;
-            break;
-        }
-        if (it > 0 && change > 0.5 * last_change) {
-            /* not contracting: where the steps were Newton's on D (with
-            ** J from the first evaluation: a term that varies fast makes J
-            ** a poor guide), plain fixed-point steps from the best point;
-            ** else Newton on the forward model takes over */
-            if (!(chord && have_n))
-                break;
-            chord = false;
-            gp = bp;
-            reachable = best_reachable;
-            dt = b_dt;
-            dd = b_dd;
-            dh_t = b_ht;
-            dh_d = b_hd;
-            dist_j = b_dist;
-            change = best_change;
-        }
-        last_change = change;
-        double nt = dt, nd = dd, ht, hd;
-        if (!tried_n) { /* (F_D once, where the first step needs it) */
-            tried_n = true;
-            have_n = newton_prep(k, *gp, dh_t, dh_d, J, Ni);
-        }
-        if (chord && have_n && change <= 0.01) {
-            nt = dh_t + (Ni[0] * (dt - dh_t) + Ni[1] * (dd - dh_d));
-            nd = dh_d + (Ni[2] * (dt - dh_t) + Ni[3] * (dd - dh_d));
-        }
-        Trig<double> *g2p = &slot[0];
-        while (g2p == gp || g2p == bp)
-            g2p++;
-        reachable = iso_inverse<double>(k, tg, nt, nd, side, g2p);
-        if (raw)
-            on_turn(m, k, a, g2p, ref_t, ref_d);
-        if (lip2 >= 0 && small_step(*g2p, *gp, &ht, &hd)) {
-            double h2 = ht * ht + hd * hd, hn = m_sqrt(h2) * (1 + h2 * 0.2);
-            /* (the second-order part alone first: it fails most steps) */
-            if (!(lip2 * (dist_j + 0.5 * hn) * hn > PM_INVERT_TOL * 0.5) &&
-                step_bound(dt, dd, J, ht, hd, nt, nd, lip2, dist_j, hn) <=
-                    PM_INVERT_TOL * 0.5) {
-                bp = g2p;
+    } else {
+        last_change = best_change = 1e300;
+        best_reachable = reachable;
+        b_dt = b_dd = b_ht = b_hd = b_dist = 0;
+    }
+    if (!lean_done) {
+        for (int it = it0; !converged; it++) {
+            double dt, dd;
+            if (have_d) {
+                dt = d0t;
+                dd = d0d;
+                have_d = false;
+            } else {
+                if (used >= PM_INVERT_MAX_FIXED)
+                    break;
+                used++;
+                if (have_j) {
+                    aniso<double>(m, k, *gp, ctx, &dt, &dd);
+                } else {
+                    aniso_jac(m, k, *gp, ctx, &dt, &dd, J);
+                    have_j = true;
+                    dist_j = 0;
+                }
+            }
+            if (!finite(dt * dt + dd * dd))
+                break; /* the forward model overflows here: not converged */
+            change = m_sqrt((dt - dh_t) * (dt - dh_t) + (dd - dh_d) * (dd - dh_d));
+            if (change < best_change) {
+                best_change = change;
+                bp = gp;
                 best_reachable = reachable;
+                b_dt = dt;
+                b_dd = dd;
+                b_ht = dh_t;
+                b_hd = dh_d;
+                b_dist = dist_j;
+            }
+            if (change <= PM_INVERT_TOL * 0.5) {
                 converged = true;
                 break;
             }
-            dist_j += hn;
-        } else {
-            dist_j = 1e300; /* (a bound fails from here on: J is not evaluated again) */
+            if (it > 0 && change > 0.5 * last_change) {
+                /* not contracting: where the steps were Newton's on D (with
+                ** J from the first evaluation: a term that varies fast makes J
+                ** a poor guide), plain fixed-point steps from the best point;
+                ** else Newton on the forward model takes over */
+                if (!(chord && have_n))
+                    break;
+                chord = false;
+                gp = bp;
+                reachable = best_reachable;
+                dt = b_dt;
+                dd = b_dd;
+                dh_t = b_ht;
+                dh_d = b_hd;
+                dist_j = b_dist;
+                change = best_change;
+            }
+            last_change = change;
+            double nt = dt, nd = dd, ht, hd;
+            if (!tried_n) { /* (F_D once, where the first step needs it) */
+                tried_n = true;
+                have_n = newton_prep(k, *gp, dh_t, dh_d, J, Ni);
+            }
+            if (chord && have_n && change <= 0.01) {
+                nt = dh_t + (Ni[0] * (dt - dh_t) + Ni[1] * (dd - dh_d));
+                nd = dh_d + (Ni[2] * (dt - dh_t) + Ni[3] * (dd - dh_d));
+            }
+            Trig<double> *g2p = &slot[0];
+            while (g2p == gp || g2p == bp)
+                g2p++;
+            reachable = iso_inverse<double>(k, tg, nt, nd, side, g2p);
+            if (raw)
+                on_turn(m, k, a, g2p, ref_t, ref_d);
+            if (lip2 >= 0 && small_step(*g2p, *gp, &ht, &hd)) {
+                double h2 = ht * ht + hd * hd, hn = m_sqrt(h2) * (1 + h2 * 0.2);
+                /* (the second-order part alone first: it fails most steps) */
+                if (!(lip2 * (dist_j + 0.5 * hn) * hn > PM_INVERT_TOL * 0.5) &&
+                    step_bound(dt, dd, J, ht, hd, nt, nd, lip2, dist_j, hn) <=
+                        PM_INVERT_TOL * 0.5) {
+                    bp = g2p;
+                    best_reachable = reachable;
+                    converged = true;
+                    break;
+                }
+                dist_j += hn;
+            } else {
+                dist_j = 1e300; /* (a bound fails from here on: J is not evaluated again) */
+            }
+            gp = g2p;
+            dh_t = nt;
+            dh_d = nd;
         }
-        gp = g2p;
-        dh_t = nt;
-        dh_d = nd;
     }
     Trig<double> &gb = *bp;
     reachable = best_reachable;

@@ -1333,11 +1333,29 @@ template <typename T> inline Target<T> target_of(const Iso<T> &k, const V3<T> &q
 ** if not, the nearest reachable point (branch boundary) is returned.
 */
 template <typename T>
+inline bool iso_inverse_v(const Iso<T> &k, const Target<T> &tg, const V3<T> &v, int side,
+                          Trig<T> *g);
+template <typename T>
 inline bool iso_inverse(const Iso<T> &k, const Target<T> &tg, T dt, T dd, int side,
                         Trig<T> *g)
 {
+    return iso_inverse_v<T>(k, tg, expmap_z<T>(k.si, k.ci, dt, dd), side, g);
+}
+
+/* The same for no displacement: expmap_z(si, ci, 0, 0) is (ci, si, 0)
+** exactly (si + 0: the sign of its zero as there), without the series. */
+template <typename T>
+inline bool iso_inverse0(const Iso<T> &k, const Target<T> &tg, int side, Trig<T> *g)
+{
+    return iso_inverse_v<T>(k, tg, v3<T>(k.ci, k.si + (T)0, (T)0), side, g);
+}
+
+/* iso_inverse for the pointing v = T(i) expmap(dt, dd) (expmap_z). */
+template <typename T>
+inline bool iso_inverse_v(const Iso<T> &k, const Target<T> &tg, const V3<T> &v, int side,
+                          Trig<T> *g)
+{
     const V3<T> &q0 = tg.q0;
-    V3<T> v = expmap_z<T>(k.si, k.ci, dt, dd);
     /* With g = Pd(d') v and u = X(d) g: u_z = q0_z fixes g3, then u_y,
     ** and |u_xy| = |q0_xy| fixes g1 up to the side. */
     T g3 = (q0.z - k.sd * v.y) * tg.icd;
