@@ -5,7 +5,11 @@ Run by `make bench-python` (PYTHONPATH=build/python).  For 10^6 encoder
 positions and a fitted model (examples/sim_gem.dat at orders 1 and 2):
 
   vectorised   Model.apply(ha, dec, threads=1): one call, the loop in C++
-               without the GIL, on one core
+               without the GIL, on one core, 4 points at a time with AVX2
+               (2 with SSE2; python/apply_simd.hpp)
+  C loop       Model._apply_lanes(ha, dec, 1): the same loop calling
+               pm_model_apply per point (the vectorised apply before the
+               lanes; what a C program's loop over the call costs)
   all cores    Model.apply(ha, dec): the same loop split over the cores
                (os.cpu_count())
   loop, C call [m.apply_point(h, d) for h, d in zip(...)]: a Python loop over
@@ -50,6 +54,7 @@ def main():
     for order in (1, 2):
         m = pm.fit_run(os.path.join(TOP, "examples", "sim_gem.dat"), order=order).model
         t_vec, (a, b) = best(lambda: m.apply(ha, dec, threads=1), REPS)
+        t_one, (oa, ob) = best(lambda: m._apply_lanes(ha, dec, 1), REPS)
         t_par, (pa, pb) = best(lambda: m.apply(ha, dec), REPS)
         ap = m.apply_point
         t_loop, lp = best(lambda: [ap(h, d) for h, d in zip(hl, dl)], max(1, REPS // 2))
@@ -57,34 +62,40 @@ def main():
         t_slow, sl = best(lambda: [m.apply(ha[i], dec[i]) for i in range(n_slow)], 1)
         t_slow *= N / n_slow
         lp = np.array(lp)
-        same = (np.array_equal(a, lp[:, 0]) and np.array_equal(pa, a) and np.array_equal(pb, b) and np.array_equal(b, lp[:, 1]) and
+        same = (np.array_equal(a, lp[:, 0]) and np.array_equal(oa, a) and np.array_equal(ob, b) and np.array_equal(pa, a) and np.array_equal(pb, b) and np.array_equal(b, lp[:, 1]) and
                 np.array_equal(np.array(sl), lp[:n_slow]))
         rows.append({"order": order, "n_terms": m.n_terms, "n": N,
                      "vectorised_s": t_vec, "all_cores_s": t_par, "cores": os.cpu_count(),
+                     "lanes": pm._pm._lanes_max, "c_loop_s": t_one,
+                     "ns_per_point_c_loop": t_one / N * 1e9,
                      "loop_c_call_s": t_loop, "loop_apply_s": t_slow,
                      "ns_per_point_vectorised": t_vec / N * 1e9,
                      "ns_per_point_loop_c_call": t_loop / N * 1e9,
                      "ratio_loop_c_call": t_loop / t_vec, "ratio_loop_apply": t_slow / t_vec,
                      "ratio_loop_c_call_all_cores": t_loop / t_par,
                      "identical": bool(same)})
-    print("pm Python package: %d-point apply, best of %d (python %s, numpy %s, %s)" % (
-        N, REPS, platform.python_version(), np.__version__, platform.machine()))
-    print("%-6s %-6s %12s %12s %13s %14s %10s %10s %10s %s" % (
-        "order", "terms", "vectorised", "all cores", "loop C call", "loop apply()", "x C call",
-        "x (cores)", "x apply()", "same doubles"))
+    print("pm Python package: %d-point apply, best of %d (python %s, numpy %s, %s, %d lanes, "
+          "load average %.2f)" % (N, REPS, platform.python_version(), np.__version__,
+                                  platform.machine(), pm._pm._lanes_max, os.getloadavg()[0]))
+    print("%-6s %-6s %12s %12s %10s %13s %14s %10s %10s %10s %s" % (
+        "order", "terms", "vectorised", "all cores", "C loop", "loop C call", "loop apply()",
+        "x C call", "x (cores)", "x apply()", "same doubles"))
     for r in rows:
-        print("%-6d %-6d %10.3f s %10.3f s %11.3f s %12.3f s %9.1fx %9.1fx %9.1fx %s" % (
-            r["order"], r["n_terms"], r["vectorised_s"], r["all_cores_s"], r["loop_c_call_s"],
-            r["loop_apply_s"], r["ratio_loop_c_call"], r["ratio_loop_c_call_all_cores"],
-            r["ratio_loop_apply"], "yes" if r["identical"] else "NO"))
-    print("(%d cores; per point, one core: %.0f ns at order 1, %.0f ns at order 2; the loop over "
-          "the C call %.0f ns, %.0f ns)" % (
+        print("%-6d %-6d %10.3f s %10.3f s %8.3f s %11.3f s %12.3f s %9.1fx %9.1fx %9.1fx %s" % (
+            r["order"], r["n_terms"], r["vectorised_s"], r["all_cores_s"], r["c_loop_s"],
+            r["loop_c_call_s"], r["loop_apply_s"], r["ratio_loop_c_call"],
+            r["ratio_loop_c_call_all_cores"], r["ratio_loop_apply"],
+            "yes" if r["identical"] else "NO"))
+    print("(%d cores; per point, one core: %.1f ns at order 1, %.1f ns at order 2; the C loop "
+          "%.1f ns, %.1f ns; the Python loop over the C call %.0f ns, %.0f ns)" % (
               os.cpu_count(), rows[0]["ns_per_point_vectorised"], rows[1]["ns_per_point_vectorised"],
+              rows[0]["ns_per_point_c_loop"], rows[1]["ns_per_point_c_loop"],
               rows[0]["ns_per_point_loop_c_call"], rows[1]["ns_per_point_loop_c_call"]))
     out = os.path.join(TOP, "build", "bench")
     os.makedirs(out, exist_ok=True)
     with open(os.path.join(out, "python.json"), "w") as f:
-        json.dump({"python": platform.python_version(), "numpy": np.__version__, "rows": rows}, f,
+        json.dump({"python": platform.python_version(), "numpy": np.__version__,
+               "loadavg": os.getloadavg(), "rows": rows}, f,
                   indent=1)
     print("wrote build/bench/python.json")
     return 0 if all(r["identical"] for r in rows) else 1

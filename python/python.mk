@@ -34,10 +34,32 @@ $(PY_DIR)/libpmhost_pic.a: $(PY_HOST_OBJ)
 	@rm -f $@
 	$(AR) rcs $@ $^
 
-$(PY_EXT): python/_pm.cpp $(PY_DIR)/libpmhost_pic.a $(B)/libpm.a $(wildcard include/*.h tools/lib/*.hpp tools/lib/*.h) | python-check-tools
+# The vectorised apply (python/apply_simd.hpp, bit for bit pm_model_apply):
+# 2 lanes for any x86-64, 4 lanes built with AVX2 and run only where the CPU
+# has it (apply_lanes.h).  No FMA and no contraction: the scalar core has
+# neither on x86-64, and the lanes must round as it does.
+PY_X86_64      := $(filter x86_64,$(shell $(CXX) -dumpmachine | cut -d- -f1))
+PY_LANES_FLAGS := $(if $(PY_X86_64),-mavx2 -mno-fma)
+PY_LANES8_FLAGS := $(if $(PY_X86_64),-mavx512f)
+PY_LANES_OBJ   := $(PY_DIR)/apply_w2.o $(PY_DIR)/apply_w4.o $(PY_DIR)/apply_w8.o
+PY_LANES_DEPS  := python/apply_simd.hpp python/apply_lanes.h lib/pm_detail.hpp include/pm.h
+
+$(PY_DIR)/apply_w2.o: python/apply_w2.cpp $(PY_LANES_DEPS)
 	@mkdir -p $(@D)
-	$(CXX) $(HOST_CXXFLAGS) -fPIC -pthread -fvisibility=hidden -shared $(PY_INCLUDES) $< -o $@ \
-	  $(PY_DIR)/libpmhost_pic.a $(B)/libpm.a -lerfa -lm
+	$(CXX) $(HOST_CXXFLAGS) -fPIC -ffp-contract=off -c $< -o $@
+
+$(PY_DIR)/apply_w4.o: python/apply_w4.cpp $(PY_LANES_DEPS)
+	@mkdir -p $(@D)
+	$(CXX) $(HOST_CXXFLAGS) -fPIC -ffp-contract=off $(PY_LANES_FLAGS) -c $< -o $@
+
+$(PY_DIR)/apply_w8.o: python/apply_w8.cpp $(PY_LANES_DEPS)
+	@mkdir -p $(@D)
+	$(CXX) $(HOST_CXXFLAGS) -fPIC -ffp-contract=off $(PY_LANES8_FLAGS) -c $< -o $@
+
+$(PY_EXT): python/_pm.cpp $(PY_LANES_OBJ) $(PY_DIR)/libpmhost_pic.a $(B)/libpm.a $(wildcard include/*.h tools/lib/*.hpp tools/lib/*.h python/*.h) | python-check-tools
+	@mkdir -p $(@D)
+	$(CXX) $(HOST_CXXFLAGS) -Ipython -fPIC -pthread -fvisibility=hidden -shared $(PY_INCLUDES) $< -o $@ \
+	  $(PY_LANES_OBJ) $(PY_DIR)/libpmhost_pic.a $(B)/libpm.a -lerfa -lm
 
 $(PY_DIR)/pm/%.py: python/pm/%.py
 	@mkdir -p $(@D)
