@@ -260,28 +260,18 @@ template <class F> std::pair<long, pm_status> for_points(long n, int threads, co
     });
 }
 
-// pm_model_apply without context on [lo, hi) in `lanes` points at a time
-// (apply_lanes.h: 4 AVX2, 2 SSE2, 1 the scalar call per point; the same
-// doubles), stopping at the first failing point: (its index, its status) or
-// (-1, PM_OK).
-std::pair<long, pm_status> apply_range(const pm_model &m, int lanes, long lo, long hi,
-                                       const double *h, const double *d, double *a, double *b)
+// pm_model_apply without context on the points, several at a time on the
+// given path (apply_lanes.h; the same doubles as the scalar call), on up to
+// `threads` threads: as for_ranges.
+std::pair<long, pm_status> apply_lanes_on(const pm_model &m, int path, long n, int threads,
+                                          const double *h, const double *d, double *a,
+                                          double *b)
 {
-    pm_status s = PM_OK;
-    long i = -1;
-    if (lanes == 8)
-        i = pm_apply_lanes8(&m, hi - lo, h + lo, d + lo, a + lo, b + lo, &s);
-    else if (lanes == 4)
-        i = pm_apply_lanes4(&m, hi - lo, h + lo, d + lo, a + lo, b + lo, &s);
-    else if (lanes == 2)
-        i = pm_apply_lanes2(&m, hi - lo, h + lo, d + lo, a + lo, b + lo, &s);
-    else
-        for (long k = lo; k < hi && i < 0; k++) {
-            s = pm_model_apply(&m, nullptr, h[k], d[k], &a[k], &b[k]);
-            if (s < 0)
-                i = k - lo;
-        }
-    return {i < 0 ? -1 : lo + i, s};
+    return for_ranges(n, threads, [&](long lo, long hi) -> std::pair<long, pm_status> {
+        pm_status s = PM_OK;
+        long i = pm_apply_lanes(path, &m, hi - lo, h + lo, d + lo, a + lo, b + lo, &s);
+        return {i < 0 ? -1 : lo + i, s};
+    });
 }
 
 // ---------------------------------------------------------------------------
@@ -427,12 +417,9 @@ struct Model {
         double *a = oa.mutable_data(), *b = od.mutable_data();
         const bool use_ctx = in.any();
         std::pair<long, pm_status> bad;
-        if (!use_ctx && pm_apply_lanes_ok(&m)) {
-            const int lanes = pm_apply_lanes_max();
-            bad = for_ranges(n, threads, [&](long lo, long hi) {
-                return apply_range(m, lanes, lo, hi, h, d, a, b);
-            });
-        } else
+        if (!use_ctx && pm_apply_lanes_ok(&m)) // several points at a time
+            bad = apply_lanes_on(m, pm_lanes_best(), n, threads, h, d, a, b);
+        else
             bad = for_points(n, threads, [&](long i) {
                 pm_context c;
                 if (use_ctx)
@@ -444,26 +431,26 @@ struct Model {
         return py::make_tuple(oa, od);
     }
 
-    // apply without context in `lanes` points at a time (1, 2, 4; for the
-    // tests of the lanes: each must give the scalar call's doubles), one
-    // thread; raises as apply, or ArgumentError if the lanes cannot take the
-    // model or the machine has not got them.
-    py::tuple apply_lanes(darr ha, darr dec, int lanes) const
+    // apply without context on one path of apply_lanes.h by name ("scalar",
+    // "sse2", "avx2x2", ...: _pm._lanes_paths), one thread, for the tests
+    // (each path must give the scalar call's doubles) and the bench; raises
+    // as apply, or ArgumentError if the path is not this machine's or the
+    // model not the lanes'.
+    py::tuple apply_lanes(darr ha, darr dec, const std::string &name) const
     {
         long n = length_of(ha, "enc_ha");
         length_of(dec, "enc_dec", n);
-        if (lanes != 1 && lanes != 2 && lanes != 4 && lanes != 8)
-            fail(K_ARGUMENT, "lanes: 1, 2 or 4");
-        if (lanes > pm_apply_lanes_max())
-            fail(K_ARGUMENT, "lanes: this machine runs " + std::to_string(pm_apply_lanes_max()));
-        if (lanes > 1 && !pm_apply_lanes_ok(&m))
+        int path = 0;
+        while (path < PM_LANES_N_PATHS && name != pm_lanes_name(path))
+            path++;
+        if (path == PM_LANES_N_PATHS || !pm_lanes_runs(path))
+            fail(K_ARGUMENT, "lanes: no path '" + name + "' on this machine");
+        if (path != PM_LANES_SCALAR && !pm_apply_lanes_ok(&m))
             fail(K_ARGUMENT, "lanes: the model has terms the lanes do not take");
         py::array_t<double> oa(n), od(n);
         const double *h = ha.data(), *d = dec.data();
         double *a = oa.mutable_data(), *b = od.mutable_data();
-        auto bad = for_ranges(n, 1, [&](long lo, long hi) {
-            return apply_range(m, lanes, lo, hi, h, d, a, b);
-        });
+        auto bad = apply_lanes_on(m, path, n, 1, h, d, a, b);
         if (bad.first >= 0)
             fail_status(bad.second, "apply, point " + std::to_string(bad.first));
         return py::make_tuple(oa, od);
@@ -1018,7 +1005,13 @@ PYBIND11_MODULE(_pm, mod)
     if (PM_CHECK_CONFIG() != PM_OK)
         throw std::runtime_error("pm: library and extension built with different PM_MAX_L/PM_MAX_EXTRA");
     py::register_exception_translator(translate);
-    mod.attr("_lanes_max") = pm_apply_lanes_max(); // apply's points per step (apply_lanes.h)
+    // apply's paths on this machine (apply_lanes.h), and the one apply takes
+    py::list paths;
+    for (int p = 0; p < PM_LANES_N_PATHS; p++)
+        if (pm_lanes_runs(p))
+            paths.append(pm_lanes_name(p));
+    mod.attr("_lanes_paths") = paths;
+    mod.attr("_lanes_best") = pm_lanes_name(pm_lanes_best());
 
     mod.def("_set_errors", [](py::dict d) {
         for (int k = 0; k < 6; k++) {

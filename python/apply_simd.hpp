@@ -42,6 +42,20 @@ template <> struct RawOf<8> {
     typedef long long mask __attribute__((vector_size(64)));
     typedef unsigned long long bits __attribute__((vector_size(64)));
 };
+template <> struct RawOf<16> {
+    typedef double raw __attribute__((vector_size(128)));
+    typedef long long mask __attribute__((vector_size(128)));
+    typedef unsigned long long bits __attribute__((vector_size(128)));
+};
+
+/* The widest vector of the machine the file is built for. */
+#if defined(__AVX512F__)
+const int NATIVE_W = 8;
+#elif defined(__AVX__)
+const int NATIVE_W = 4;
+#else
+const int NATIVE_W = 2;
+#endif
 
 /* W doubles in one vector, with the operators the core's templates use
 ** (a double converts to a vector of W copies of it). */
@@ -81,22 +95,46 @@ template <int W> struct Lanes {
     static void store(double *p, raw r) { __builtin_memcpy(p, &r, sizeof r); }
     static raw sel(mask m, raw a, raw b) { return (raw)(((bits)a & (bits)m) | ((bits)b & ~(bits)m)); }
     static raw fabs(raw x) { return (raw)((bits)x & 0x7fffffffffffffffULL); }
+    /* Comparisons (all ones where true).  Twice the machine's width is two
+    ** of its vectors (two chains side by side): compared half by half (gcc
+    ** would compare them lane by lane in scalar code). */
+    static constexpr bool halves = W > NATIVE_W;
+    template <class F> static mask cmp(raw a, raw b, F f)
+    {
+        if constexpr (halves) {
+            typedef RawOf<W / 2> H;
+            typename H::raw x[2], y[2];
+            typename H::mask z[2];
+            __builtin_memcpy(x, &a, sizeof a);
+            __builtin_memcpy(y, &b, sizeof b);
+            z[0] = Lanes<W / 2>::cmp(x[0], y[0], f);
+            z[1] = Lanes<W / 2>::cmp(x[1], y[1], f);
+            mask r;
+            __builtin_memcpy(&r, z, sizeof r);
+            return r;
+        } else
+            return (mask)f(a, b);
+    }
+    static mask le(raw a, raw b) { return cmp(a, b, [](auto x, auto y) { return x <= y; }); }
+    static mask lt(raw a, raw b) { return cmp(a, b, [](auto x, auto y) { return x < y; }); }
+    static mask eq(raw a, raw b) { return cmp(a, b, [](auto x, auto y) { return x == y; }); }
+    static raw all(double x) { return VD<W>(x).v; }
     static raw sqrt(raw x)
     {
-        if constexpr (W == 2)
+        if constexpr (halves) {
+            typename RawOf<W / 2>::raw h[2];
+            __builtin_memcpy(h, &x, sizeof x);
+            h[0] = Lanes<W / 2>::sqrt(h[0]);
+            h[1] = Lanes<W / 2>::sqrt(h[1]);
+            __builtin_memcpy(&x, h, sizeof x);
+            return x;
+        } else if constexpr (W == 2)
             return _mm_sqrt_pd(x);
         else if constexpr (W == 4)
             return _mm256_sqrt_pd(x);
         else {
 #if defined(__AVX512F__)
             return _mm512_mask_sqrt_pd(x, 0xff, x); /* (_mm512_sqrt_pd: a warning in gcc 12) */
-#else
-            typename RawOf<4>::raw h[2];
-            __builtin_memcpy(h, &x, sizeof x);
-            h[0] = _mm256_sqrt_pd(h[0]);
-            h[1] = _mm256_sqrt_pd(h[1]);
-            __builtin_memcpy(&x, h, sizeof x);
-            return x;
 #endif
         }
     }
@@ -204,7 +242,7 @@ inline unsigned apply_block(const Consts<W, LC> &K, const double *ha, const doub
     const Iso<V> &k = K.k;
     const raw t = Ln::load(ha), d = Ln::load(dec);
     /* sincos_d2's and frame_angles' ranges (false for NaN) */
-    mask ok = (Ln::fabs(t) <= 64.0) & (Ln::fabs(d) <= 4.0);
+    mask ok = Ln::le(Ln::fabs(t), Ln::all(64.0)) & Ln::le(Ln::fabs(d), Ln::all(4.0));
     /* trig_of */
     Trig<V> g;
     Ln::sincos(t, &g.st.v, &g.ct.v);
@@ -227,7 +265,7 @@ inline unsigned apply_block(const Consts<W, LC> &K, const double *ha, const doub
     const V dt = ((g.cd * S[2] + S[5]) - sc * S[0]) - (ss * S[1] + g.sd * S[3]);
     const V dd = (S[0] * stp - S[4]) - S[1] * ctp;
     const V r2 = dt * dt + dd * dd;
-    ok &= r2.v < 1e-4; /* expmap's series */
+    ok &= Ln::lt(r2.v, Ln::all(1e-4)); /* expmap's series */
     const V r4 = r2 * r2;
     const V c = (1 - 0.5 * r2) + r4 * ((1.0 / 24) - r2 * (1.0 / 720));
     const V s = (1 - (1.0 / 6) * r2) + r4 * ((1.0 / 120) - r2 * (1.0 / 5040));
@@ -238,36 +276,37 @@ inline unsigned apply_block(const Consts<W, LC> &K, const double *ha, const doub
     w = rot_z<V>(stp, ctp, w);
     const V3<V> p = mat_mul<V>(k.h, w);
     /* frame_angles (the model's |c'|, |e'| <= 0.5: apply_simd_ok) */
-    const mask flip = cdp.v < 0.0;
+    const mask flip = Ln::lt(cdp.v, Ln::all(0.0));
     const V sT(Ln::sel(flip, -stp.v, stp.v)), cT(Ln::sel(flip, -ctp.v, ctp.v));
     const V sD = sdp, cD(Ln::sel(flip, -cdp.v, cdp.v));
     const V x1 = cT * p.x + sT * p.y, y1 = cT * p.y - sT * p.x;
     const V rho(Ln::sqrt((x1 * x1 + y1 * y1).v));
     const V zn = p.z * cD - rho * sD, zd = rho * cD + p.z * sD;
-    ok &= (Ln::fabs(y1.v) <= (0.01 * x1).v) & (Ln::fabs(zn.v) <= 0.01) & (zd.v > 0.0);
+    ok &= Ln::le(Ln::fabs(y1.v), (0.01 * x1).v) & Ln::le(Ln::fabs(zn.v), Ln::all(0.01)) &
+          Ln::lt(Ln::all(0.0), zd.v);
     const V dT = atan_small_v<W>(y1 / x1), dD = asin_small_v<W>(zn);
     /* turn_sum(t, c' + dT, flip), its first try (the second: the scalar
     ** call) */
-    const V half(Ln::sel(flip, V(0.5).v, V(0.0).v));
-    const V two(Ln::sel(flip, V(2.0).v, V(0.0).v));
+    const V half(Ln::sel(flip, Ln::all(0.5), Ln::all(0.0)));
+    const V two(Ln::sel(flip, Ln::all(2.0), Ln::all(0.0)));
     const V tv(t), sv = K.c + dT;
     const V n = ((tv * 0.15915494309189535 + half) + RND_INT) - RND_INT;
     const V q = 4 * n - two;
     const V a = (tv - q * PIO2_1) + ((sv - q * PIO2_2) - q * PIO2_3);
-    ok &= Ln::fabs(a.v) <= PI;
-    raw T = Ln::sel(a.v == -PI, V(PI).v, a.v);
+    ok &= Ln::le(Ln::fabs(a.v), Ln::all(PI));
+    raw T = Ln::sel(Ln::eq(a.v, Ln::all(-PI)), Ln::all(PI), a.v);
     /* the declination: d + (dD - e'), or beyond the pole pi_minus */
     const V dv(d), ev(K.e);
     const V d0 = dv + (dD - ev);
     const V ed = ev + dD;
     const V dp = (2 * PIO2_1 - dv) + ((ed + 2 * PIO2_2) + 2 * PIO2_3);
     const V dm = -((2 * PIO2_1 - (-dv)) + (((-ed) + 2 * PIO2_2) + 2 * PIO2_3));
-    const raw da = Ln::sel(flip, Ln::sel((dv - ev).v > 0.0, dp.v, dm.v), d0.v);
-    const mask out = ~(Ln::fabs(da) <= PI / 2);
-    const raw D = Ln::sel(out, Ln::sel(da < 0.0, V(-PI / 2).v, V(PI / 2).v), da);
+    const raw da = Ln::sel(flip, Ln::sel(Ln::lt(Ln::all(0.0), (dv - ev).v), dp.v, dm.v), d0.v);
+    const mask out = ~Ln::le(Ln::fabs(da), Ln::all(PI / 2));
+    const raw D = Ln::sel(out, Ln::sel(Ln::lt(da, Ln::all(0.0)), Ln::all(-PI / 2), Ln::all(PI / 2)), da);
     /* pm_model_apply's ending: finite, -pi as pi */
-    ok &= ((T - T) == 0.0) & ((D - D) == 0.0);
-    T = Ln::sel(T <= -PI, V(PI).v, T);
+    ok &= Ln::eq(T - T, Ln::all(0.0)) & Ln::eq(D - D, Ln::all(0.0));
+    T = Ln::sel(Ln::le(T, Ln::all(-PI)), Ln::all(PI), T);
     Ln::store(oa, T);
     Ln::store(ob, D);
     unsigned redo = 0;

@@ -1,14 +1,15 @@
-"""The vectorised apply's lanes (python/apply_simd.hpp: 2 points at a time
-with SSE2, 4 with AVX2, 8 with AVX-512) give pm_model_apply's doubles bit for bit, and its
-errors at the same point: in every lane, in the tail (n not a multiple of the
-lanes), near and beyond the pole, at hour angles to +-64 rad and past them,
-for NaN and infinities, for orders 0..4, and for the points and models the
-lanes hand back to the scalar call (displacements past expmap's series, the
-pole's neighbourhood, added terms, |c'| > 0.5).
+"""The vectorised apply's lanes (python/apply_simd.hpp, apply_lanes.h: 2
+points at a time with SSE2, 4 with AVX2, 8 with AVX-512, and twice that with
+two vectors side by side) give pm_model_apply's doubles bit for bit, and its
+errors at the same point: in every lane, in the tail (n not a multiple of
+the lanes), near and beyond the pole, at hour angles to +-64 rad and past
+them, for NaN and infinities, for orders 0..4, and for the points and models
+the lanes hand back to the scalar call (displacements past expmap's series,
+the pole's neighbourhood, added terms, |c'| > 0.5).
 
-Model._apply_lanes(ha, dec, lanes) runs one path on one thread: lanes=1 is
-the scalar call per point (the reference), 2, 4 and 8 the vector code (as
-far as this machine has them: 2 on any x86-64).  (Speed:
+Model._apply_lanes(ha, dec, path) runs one path on one thread: "scalar" is
+the C call per point (the reference), the others the vector code, each
+path this machine runs (_pm._lanes_paths: SSE2 on any x86-64).  (Speed:
 bench/bench_python.py, not here.)"""
 import numpy as np
 import pytest
@@ -17,7 +18,8 @@ import pm
 from pm import _pm
 from conftest import TOP, sky_points
 
-LANES = [w for w in (2, 4, 8) if w <= _pm._lanes_max]
+LANES = [p for p in _pm._lanes_paths if p != "scalar"]
+WIDEST = 16  # points per step of the widest path (avx512x2)
 if not LANES:
     pytestmark = pytest.mark.skip(reason="no vector lanes on this machine (not x86-64): "
                                          "apply runs the scalar call per point")
@@ -36,7 +38,7 @@ def outcome(model, ha, dec, lanes):
 def assert_same(model, ha, dec):
     """Every lane width against the scalar call: the same doubles (bits), or
     the same error at the same point."""
-    want = outcome(model, ha, dec, 1)
+    want = outcome(model, ha, dec, "scalar")
     for w in LANES:
         got = outcome(model, ha, dec, w)
         assert got[0] == want[0], (w, got[:2], want[:2])
@@ -65,7 +67,7 @@ def fitted():
 def test_reference_is_the_c_call(fitted):
     """lanes=1 is pm_model_apply itself (apply_point: the bare binding)."""
     ha, dec = sky_points(997, seed=21, flipped=True)
-    a, b = fitted[2]._apply_lanes(ha, dec, 1)
+    a, b = fitted[2]._apply_lanes(ha, dec, "scalar")
     loop = np.array([fitted[2].apply_point(h, d) for h, d in zip(ha.tolist(), dec.tolist())])
     assert np.array_equal(a, loop[:, 0]) and np.array_equal(b, loop[:, 1])
 
@@ -73,7 +75,7 @@ def test_reference_is_the_c_call(fitted):
 @pytest.mark.parametrize("order", range(5))
 def test_lanes_equal_c_call_fitted_orders(fitted, order):
     """Fitted models of order 0..4 over the sky, both sides of the pole; n
-    = 8k + 3 (a tail in every width).  At order 4 the fit's displacement
+    = 16k + 3 (a tail in every width).  At order 4 the fit's displacement
     passes 0.01 rad over much of this sky: the lanes hand those points back."""
     m = fitted[order]
     assert m._lanes_ok
@@ -108,24 +110,24 @@ def special_values():
 
 
 def test_lanes_special_points_in_every_lane(fitted):
-    """Each special (ha, dec) pair at every position of a block of 8 (so of 4
-    and 2) and in the tail, between ordinary points (so one lane leaves the branch while
-    its neighbours stay)."""
+    """Each special (ha, dec) pair at every position of a block of 16 (so of
+    8, 4 and 2) and in the tail, between ordinary points (so one lane leaves
+    the branch while its neighbours stay)."""
     sha, sdec = special_values()
     pairs = [(h, d) for h in sha for d in sdec]
-    base_h, base_d = sky_points(8 * len(pairs) + 3, seed=41)
+    base_h, base_d = sky_points(WIDEST * len(pairs) + 3, seed=41)
     for m in (fitted[1], fitted[2], random_model(3, 3e-3, seed=42)):
-        for pos in range(8):
+        for pos in range(WIDEST):
             ha, dec = base_h.copy(), base_d.copy()
-            idx = 8 * np.arange(len(pairs)) + pos
+            idx = WIDEST * np.arange(len(pairs)) + pos
             ha[idx] = [p[0] for p in pairs]
             dec[idx] = [p[1] for p in pairs]
             assert_same(m, ha, dec)
-        # the tail: n = 8k + r, the special pair last
-        for r in range(1, 8):
+        # the tail: n = 16k + r, the special pair last
+        for r in range(1, WIDEST):
             for h, d in pairs[::7]:
-                ha = np.append(base_h[:16 + r - 1], h)
-                dec = np.append(base_d[:16 + r - 1], d)
+                ha = np.append(base_h[:2 * WIDEST + r - 1], h)
+                dec = np.append(base_d[:2 * WIDEST + r - 1], d)
                 assert_same(m, ha, dec)
 
 
@@ -163,9 +165,9 @@ def test_lanes_nonfinite_same_error_same_point(fitted, bad):
     """A NaN or infinity in either input, at each lane and in the tail:
     NonFiniteError naming the same point as the scalar call's loop."""
     m = fitted[2]
-    n = 8 * 25 + 7
+    n = WIDEST * 13 + 15
     for which in (0, 1):
-        for i in list(range(16)) + list(range(n - 7, n)):
+        for i in list(range(2 * WIDEST)) + list(range(n - 15, n)):
             ha, dec = sky_points(n, seed=61)
             (ha if which == 0 else dec)[i] = bad
             want = assert_same(m, ha, dec)
@@ -214,21 +216,23 @@ def test_lanes_decline_other_models(fitted):
                 assert_same(m, ha, dec)
             else:
                 a, b = m.apply(ha, dec, threads=1)
-                w = m._apply_lanes(ha, dec, 1)
+                w = m._apply_lanes(ha, dec, "scalar")
                 assert np.array_equal(a, w[0]) and np.array_equal(b, w[1])
 
 
 def test_apply_uses_the_widest_lanes(fitted):
-    """Model.apply (threads 1, 2, None) gives the lanes' results, which are
-    the scalar call's."""
+    """Model.apply (threads 1, 2, None) takes the fastest path, and gives
+    the scalar call's doubles."""
+    assert _pm._lanes_best in LANES
     ha, dec = sky_points(100001, seed=91, flipped=True)
     m = fitted[2]
-    want = m._apply_lanes(ha, dec, 1)
+    want = m._apply_lanes(ha, dec, "scalar")
     for t in (1, 2, None):
         a, b = m.apply(ha, dec, threads=t)
         assert np.array_equal(a, want[0]) and np.array_equal(b, want[1])
-    with pytest.raises(pm.ArgumentError, match="lanes"):
-        m._apply_lanes(ha, dec, 3)
-    if _pm._lanes_max < 8:
-        with pytest.raises(pm.ArgumentError, match="this machine runs"):
-            m._apply_lanes(ha, dec, 8)
+    with pytest.raises(pm.ArgumentError, match="no path 'avx3'"):
+        m._apply_lanes(ha, dec, "avx3")
+    for p in ("sse2", "sse2x2", "avx2", "avx2x2", "avx512", "avx512x2"):
+        if p not in _pm._lanes_paths:  # a machine without it
+            with pytest.raises(pm.ArgumentError, match="no path"):
+                m._apply_lanes(ha, dec, p)
