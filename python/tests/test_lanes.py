@@ -188,7 +188,26 @@ def test_lanes_overflow_in_the_terms():
     c[10] = 1e300
     m.coefficients = c
     ha, dec = sky_points(1003, seed=72, flipped=True)
-    assert_same(m, ha, dec)
+    want = assert_same(m, ha, dec)
+    assert want[0] == "NonFiniteError", want
+    # Model.apply (its way straight to the loop, then the checked way):
+    # the loop's error, the inputs being finite
+    with pytest.raises(pm.NonFiniteError, match=r"apply, point \d+"):
+        m.apply(ha, dec)
+
+
+def test_apply_nonfinite_input_named_on_the_fast_way(fitted):
+    """Float arrays of one shape go to the loop unchecked; a NaN there is
+    still reported by name and element (the checked way's message)."""
+    ha, dec = sky_points(4000, seed=73)
+    ha, dec = ha.reshape(40, 100), dec.reshape(40, 100)
+    dec[7, 3] = np.nan
+    ha[30, 1] = np.inf
+    with pytest.raises(pm.NonFiniteError, match=r"enc_ha\[30, 1\] is inf"):
+        fitted[2].apply(ha, dec)
+    ha[30, 1] = 0.5
+    with pytest.raises(pm.NonFiniteError, match=r"enc_dec\[7, 3\] is nan"):
+        fitted[2].apply(ha, dec, threads=2)
 
 
 def test_lanes_decline_other_models(fitted):
