@@ -1,6 +1,7 @@
 /*
 **  apply_simd.hpp - the forward model (pm_model_apply) on W points at once,
-**  one point per lane of a vector of W doubles (W = 2: SSE2, W = 4: AVX2),
+**  one point per lane of a vector of W doubles (W = 2: SSE2, 4: AVX2, 8:
+**  AVX-512F; twice the machine's width: two of its vectors side by side),
 **  for the Python package's vectorised apply (docs/python.md, "Speed").
 **
 **  Not a second model: the same IEEE operations in the same order as the
@@ -19,10 +20,14 @@
 **  beyond 4, an unprepared or stale model) go to pm_model_apply point by
 **  point (apply_batch's caller decides: apply_simd_ok).
 **
-**  Included inside a namespace of its own by apply_w2.cpp and apply_w4.cpp
-**  (after lib/pm_detail.hpp, in the same namespace), so that the copy built
-**  with -mavx2 shares no symbol with the core's (which runs on any x86-64).
-**  Host code: C++17, no heap.
+**  A change to the core's forward model must be made here too:
+**  python/tests/test_lanes.py compares every path with the scalar call bit
+**  for bit and fails otherwise.
+**
+**  Included inside a namespace of its own by apply_w2.cpp, apply_w4.cpp and
+**  apply_w8.cpp (after lib/pm_detail.hpp, in the same namespace), so that
+**  the copies built with -mavx2 or -mavx512f share no symbol with the
+**  core's (which runs on any x86-64).  Host code: C++17, no heap.
 */
 
 /* The vector types of W lanes: doubles, their comparisons' masks, bits. */

@@ -28,7 +28,11 @@ namespace detail {
 } // namespace pm
 } // namespace pm_lanes2
 
+#if defined(PM_LANES_OFF) /* the core rounds with FMA (python/python.mk) */
+bool pm_apply_lanes_ok(const pm_model *) { return false; }
+#else
 bool pm_apply_lanes_ok(const pm_model *m) { return pm_lanes2::pm::detail::apply_simd_ok(m); }
+#endif
 
 // (__builtin_cpu_supports checks that the OS saves the registers, too)
 bool pm_lanes_runs(int path)

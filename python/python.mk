@@ -47,9 +47,12 @@ PY_LANES_DEPS  := python/apply_simd.hpp python/apply_lanes.h lib/pm_detail.hpp i
 $(PY_DIR)/apply_w4.o: PY_ISA := $(if $(PY_X86_64),-mavx2 -mno-fma)
 $(PY_DIR)/apply_w8.o: PY_ISA := $(if $(PY_X86_64),-mavx512f -mno-fma)
 
-$(PY_DIR)/apply_w%.o: python/apply_w%.cpp $(PY_LANES_DEPS)
+# A core built with FMA (OPT=-march=native, say) rounds otherwise: then the
+# lanes are left out (-DPM_LANES_OFF: apply calls pm_model_apply per point).
+$(PY_DIR)/apply_w%.o: python/apply_w%.cpp $(PY_LANES_DEPS) $(B)/libpm.a
 	@mkdir -p $(@D)
-	$(CXX) $(HOST_CXXFLAGS) -fPIC -ffp-contract=off -Wno-psabi $(PY_ISA) -c $< -o $@
+	$(CXX) $(HOST_CXXFLAGS) -fPIC -ffp-contract=off -Wno-psabi $(PY_ISA) \
+	  $$(objdump -d $(B)/libpm.a | grep -qE '\svfn?m(add|sub)' && echo -DPM_LANES_OFF) -c $< -o $@
 	@if objdump -d $@ | grep -qE '\svfn?m(add|sub)'; then \
 	  echo "$@: FMA instructions in the lanes (they must round as the scalar core)"; rm -f $@; exit 1; fi
 

@@ -23,6 +23,9 @@ WIDEST = 16  # points per step of the widest path (avx512x2)
 if not LANES:
     pytestmark = pytest.mark.skip(reason="no vector lanes on this machine (not x86-64): "
                                          "apply runs the scalar call per point")
+elif not pm.Model(order=1)._lanes_ok:
+    pytestmark = pytest.mark.skip(reason="the lanes are off: the core was built with FMA "
+                                         "(python/python.mk), apply runs the scalar call")
 
 
 def outcome(model, ha, dec, lanes):
