@@ -16,7 +16,7 @@ import pytest
 
 import pm
 from pm import _pm
-from conftest import TOP, sky_points
+from conftest import REAL_RUNS, TOP, real_run, sky_points
 
 LANES = [p for p in _pm._lanes_paths if p != "scalar"]
 WIDEST = 16  # points per step of the widest path (avx512x2)
@@ -96,6 +96,55 @@ def test_lanes_equal_c_call_random_models(order, mount):
         m = random_model(order, scale, seed=100 + 10 * order + k, mount=mount)
         assert m._lanes_ok
         ha, dec = sky_points(20001, seed=31 + k, flipped=True)
+        assert_same(m, ha, dec)
+
+
+@pytest.mark.parametrize("name", REAL_RUNS)
+def test_lanes_equal_c_call_real_runs(name):
+    """Models fitted to the real runs of $PM_DATA_DIR (orders 0..2), over
+    the sky and the run's own positions (skipped when the data is absent)."""
+    path = real_run(name)
+    run = pm.read_run(path)
+    fitted = 0
+    for order in (0, 1, 2):
+        try:
+            m = pm.fit_run(run, order=order).model
+        except pm.FitError:
+            continue  # too few points for the order: nothing to apply
+        fitted += 1
+        assert m._lanes_ok
+        ha, dec = sky_points(30001, seed=order, flipped=True)
+        assert_same(m, ha, dec)
+        assert_same(m, np.asarray(run.enc_ha, dtype=float), np.asarray(run.enc_dec, dtype=float))
+    assert fitted >= 2, name
+
+
+def test_lanes_random_models_and_points():
+    """300 random models (orders 0..4, both mounts, coefficients of random
+    scales 1e-7..3e-2 rad, c' and e' to +-0.5) on random point sets of
+    random length: the sky, hour angles to +-70 and declinations to +-4.5,
+    and points piled up near +-pi, +-64, the pole and their edges."""
+    rng = np.random.default_rng(2024)
+    for _ in range(300):
+        m = pm.Model(order=int(rng.integers(0, 5)), mount=["equatorial", "altaz"][int(rng.integers(0, 2))],
+                     latitude=float(rng.uniform(-1.5, 1.5)))
+        c = rng.normal(size=m.n_terms) * 10 ** rng.uniform(-7, -1.5, size=m.n_terms)
+        if rng.uniform() < 0.3:
+            c[2] = rng.uniform(-0.5, 0.5)
+        if rng.uniform() < 0.3:
+            c[4] = rng.uniform(-0.5, 0.5)
+        m.coefficients = c
+        n = int(rng.integers(1, 3000))
+        kind = int(rng.integers(0, 3))
+        if kind == 0:
+            ha, dec = rng.uniform(-np.pi, np.pi, n), rng.uniform(-np.pi / 2, np.pi / 2, n)
+        elif kind == 1:
+            ha, dec = rng.uniform(-70, 70, n), rng.uniform(-4.5, 4.5, n)
+        else:
+            ha = (rng.choice([-np.pi, np.pi, 0.0, -0.0, 64.0, -64.0, np.pi - c[2], -np.pi - c[2]], n) +
+                  rng.normal(size=n) * 10 ** rng.uniform(-17, -2, n))
+            dec = (rng.choice([np.pi / 2, -np.pi / 2, c[4] + np.pi / 2, c[4] - np.pi / 2, 0.0, 4.0],
+                              n) + rng.normal(size=n) * 10 ** rng.uniform(-17, -2, n))
         assert_same(m, ha, dec)
 
 
