@@ -12,6 +12,7 @@
 #include <pybind11/stl.h>
 
 #include "pm.h"
+#include "apply_lanes.h"
 #include "compare.hpp"
 #include "explain.hpp"
 #include "fitrun.hpp"
@@ -212,12 +213,13 @@ template <class T> py::array_t<T> copy_out(const std::vector<T> &v)
 // Points per thread below which more threads do not pay for their start.
 const long MIN_POINTS_PER_THREAD = 1L << 15;
 
-// body(i) for every point i in [0, n), without the GIL, on up to `threads`
-// threads (0: as many as the machine has) in contiguous chunks; each chunk
-// stops at its first error (a negative status).  Returns the first failing
-// index of all (the lowest) and its status, or (-1, PM_OK).  The points are
-// independent, so the results do not depend on the number of threads.
-template <class F> std::pair<long, pm_status> for_points(long n, int threads, const F &body)
+// range(lo, hi) for contiguous chunks covering [0, n), without the GIL, on
+// up to `threads` threads (0: as many as the machine has); range returns
+// the first failing index of its chunk and its status, or (-1, PM_OK), and
+// stops there.  Returns the first failing index of all (the lowest) and its
+// status, or (-1, PM_OK).  The points are independent, so the results do not
+// depend on the number of threads.
+template <class F> std::pair<long, pm_status> for_ranges(long n, int threads, const F &range)
 {
     py::gil_scoped_release nogil;
     long t = threads > 0 ? threads : (long)std::thread::hardware_concurrency();
@@ -225,14 +227,8 @@ template <class F> std::pair<long, pm_status> for_points(long n, int threads, co
     std::vector<long> bad((size_t)t, -1);
     std::vector<pm_status> st((size_t)t, PM_OK);
     auto chunk = [&](long k) {
-        long lo = n * k / t, hi = n * (k + 1) / t;
-        for (long i = lo; i < hi; i++) {
-            pm_status s = body(i);
-            if (s < 0) {
-                bad[(size_t)k] = i, st[(size_t)k] = s;
-                return;
-            }
-        }
+        std::pair<long, pm_status> r = range(n * k / t, n * (k + 1) / t);
+        bad[(size_t)k] = r.first, st[(size_t)k] = r.second;
     };
     std::vector<std::thread> pool;
     std::vector<long> here; // chunks no thread could be started for
@@ -252,6 +248,34 @@ template <class F> std::pair<long, pm_status> for_points(long n, int threads, co
         if (bad[(size_t)k] >= 0)
             return {bad[(size_t)k], st[(size_t)k]};
     return {-1, PM_OK};
+}
+
+// body(i) for every point i in [0, n), as for_ranges; each chunk stops at
+// its first error (a negative status).
+template <class F> std::pair<long, pm_status> for_points(long n, int threads, const F &body)
+{
+    return for_ranges(n, threads, [&](long lo, long hi) -> std::pair<long, pm_status> {
+        for (long i = lo; i < hi; i++) {
+            pm_status s = body(i);
+            if (s < 0)
+                return {i, s};
+        }
+        return {-1, PM_OK};
+    });
+}
+
+// pm_model_apply without context on the points, several at a time on the
+// given path (apply_lanes.h; the same doubles as the scalar call), on up to
+// `threads` threads: as for_ranges.
+std::pair<long, pm_status> apply_lanes_on(const pm_model &m, int path, long n, int threads,
+                                          const double *h, const double *d, double *a,
+                                          double *b)
+{
+    return for_ranges(n, threads, [&](long lo, long hi) -> std::pair<long, pm_status> {
+        pm_status s = PM_OK;
+        long i = pm_apply_lanes(path, &m, hi - lo, h + lo, d + lo, a + lo, b + lo, &s);
+        return {i < 0 ? -1 : lo + i, s};
+    });
 }
 
 // ---------------------------------------------------------------------------
@@ -396,12 +420,41 @@ struct Model {
         const double *h = ha.data(), *d = dec.data();
         double *a = oa.mutable_data(), *b = od.mutable_data();
         const bool use_ctx = in.any();
-        auto bad = for_points(n, threads, [&](long i) {
-            pm_context c;
-            if (use_ctx)
-                in.fill(i, c);
-            return pm_model_apply(&m, use_ctx ? &c : nullptr, h[i], d[i], &a[i], &b[i]);
-        });
+        std::pair<long, pm_status> bad;
+        if (!use_ctx && pm_apply_lanes_ok(&m)) // several points at a time
+            bad = apply_lanes_on(m, pm_lanes_best(), n, threads, h, d, a, b);
+        else
+            bad = for_points(n, threads, [&](long i) {
+                pm_context c;
+                if (use_ctx)
+                    in.fill(i, c);
+                return pm_model_apply(&m, use_ctx ? &c : nullptr, h[i], d[i], &a[i], &b[i]);
+            });
+        if (bad.first >= 0)
+            fail_status(bad.second, "apply, point " + std::to_string(bad.first));
+        return py::make_tuple(oa, od);
+    }
+
+    // apply without context on one path of apply_lanes.h by name ("scalar",
+    // "sse2", "avx2x2", ...: _pm._lanes_paths), one thread, for the tests
+    // (each path must give the scalar call's doubles) and the bench; raises
+    // as apply, or ArgumentError if the path is not this machine's or the
+    // model not the lanes'.
+    py::tuple apply_lanes(darr ha, darr dec, const std::string &name) const
+    {
+        long n = length_of(ha, "enc_ha");
+        length_of(dec, "enc_dec", n);
+        int path = 0;
+        while (path < PM_LANES_N_PATHS && name != pm_lanes_name(path))
+            path++;
+        if (path == PM_LANES_N_PATHS || !pm_lanes_runs(path))
+            fail(K_ARGUMENT, "lanes: no path '" + name + "' on this machine");
+        if (path != PM_LANES_SCALAR && !pm_apply_lanes_ok(&m))
+            fail(K_ARGUMENT, "lanes: the model has terms the lanes do not take");
+        py::array_t<double> oa(n), od(n);
+        const double *h = ha.data(), *d = dec.data();
+        double *a = oa.mutable_data(), *b = od.mutable_data();
+        auto bad = apply_lanes_on(m, path, n, 1, h, d, a, b);
         if (bad.first >= 0)
             fail_status(bad.second, "apply, point " + std::to_string(bad.first));
         return py::make_tuple(oa, od);
@@ -1099,6 +1152,13 @@ PYBIND11_MODULE(_pm, mod)
     if (PM_CHECK_CONFIG() != PM_OK)
         throw std::runtime_error("pm: library and extension built with different PM_MAX_L/PM_MAX_EXTRA");
     py::register_exception_translator(translate);
+    // apply's paths on this machine (apply_lanes.h), and the one apply takes
+    py::list paths;
+    for (int p = 0; p < PM_LANES_N_PATHS; p++)
+        if (pm_lanes_runs(p))
+            paths.append(pm_lanes_name(p));
+    mod.attr("_lanes_paths") = paths;
+    mod.attr("_lanes_best") = pm_lanes_name(pm_lanes_best());
 
     mod.def("_set_errors", [](py::dict d) {
         for (int k = 0; k < 6; k++) {
@@ -1133,6 +1193,8 @@ PYBIND11_MODULE(_pm, mod)
         .def_property_readonly("_inputs_needed", &Model::inputs_needed)
         .def("_add_term", &Model::add_term)
         .def("_apply", &Model::apply)
+        .def("_apply_lanes", &Model::apply_lanes)
+        .def_property_readonly("_lanes_ok", [](const Model &m) { return pm_apply_lanes_ok(&m.m); })
         .def("_invert", &Model::invert)
         .def("_residual", &Model::residual)
         .def("apply_point", &Model::apply_point, py::arg("enc_ha"), py::arg("enc_dec"),

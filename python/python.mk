@@ -4,6 +4,7 @@
 #                      reference driver the tests compare with (build/python/pm_ref)
 #   make bench-python  the vectorised apply against a Python loop over the C call
 #                      (bench/bench_python.py; timings, never a test)
+#   make bench-python-insns  its instructions per point by width (callgrind)
 # make test runs the pytest suite (python/tests) through tests/check_python.c.
 #
 # The extension is a shared object, so it needs position-independent code:
@@ -34,10 +35,31 @@ $(PY_DIR)/libpmhost_pic.a: $(PY_HOST_OBJ)
 	@rm -f $@
 	$(AR) rcs $@ $^
 
-$(PY_EXT): python/_pm.cpp $(PY_DIR)/libpmhost_pic.a $(B)/libpm.a $(wildcard include/*.h tools/lib/*.hpp tools/lib/*.h) | python-check-tools
+# The vectorised apply (python/apply_simd.hpp, bit for bit pm_model_apply):
+# SSE2 for any x86-64, AVX2 and AVX-512F built with their instructions and
+# run only where the CPU has them (apply_lanes.h).  No FMA and no
+# contraction: the scalar core has neither on x86-64, and the lanes must
+# round as it does (each object is checked for FMA instructions).  (-Wno-psabi:
+# the wider vectors are passed only between the inline functions of one file.)
+PY_X86_64      := $(filter x86_64,$(shell $(CXX) -dumpmachine | cut -d- -f1))
+PY_LANES_OBJ   := $(PY_DIR)/apply_w2.o $(PY_DIR)/apply_w4.o $(PY_DIR)/apply_w8.o
+PY_LANES_DEPS  := python/apply_simd.hpp python/apply_lanes.h lib/pm_detail.hpp include/pm.h
+$(PY_DIR)/apply_w4.o: PY_ISA := $(if $(PY_X86_64),-mavx2 -mno-fma)
+$(PY_DIR)/apply_w8.o: PY_ISA := $(if $(PY_X86_64),-mavx512f -mno-fma)
+
+# A core built with FMA (OPT=-march=native, say) rounds otherwise: then the
+# lanes are left out (-DPM_LANES_OFF: apply calls pm_model_apply per point).
+$(PY_DIR)/apply_w%.o: python/apply_w%.cpp $(PY_LANES_DEPS) $(B)/libpm.a
 	@mkdir -p $(@D)
-	$(CXX) $(HOST_CXXFLAGS) -fPIC -pthread -fvisibility=hidden -shared $(PY_INCLUDES) $< -o $@ \
-	  $(PY_DIR)/libpmhost_pic.a $(B)/libpm.a -lerfa -lm
+	$(CXX) $(HOST_CXXFLAGS) -fPIC -ffp-contract=off -Wno-psabi $(PY_ISA) \
+	  $$(objdump -d $(B)/libpm.a | grep -qE '\svfn?m(add|sub)' && echo -DPM_LANES_OFF) -c $< -o $@
+	@if objdump -d $@ | grep -qE '\svfn?m(add|sub)'; then \
+	  echo "$@: FMA instructions in the lanes (they must round as the scalar core)"; rm -f $@; exit 1; fi
+
+$(PY_EXT): python/_pm.cpp $(PY_LANES_OBJ) $(PY_DIR)/libpmhost_pic.a $(B)/libpm.a $(wildcard include/*.h tools/lib/*.hpp tools/lib/*.h python/*.h) | python-check-tools
+	@mkdir -p $(@D)
+	$(CXX) $(HOST_CXXFLAGS) -Ipython -fPIC -pthread -fvisibility=hidden -shared $(PY_INCLUDES) $< -o $@ \
+	  $(PY_LANES_OBJ) $(PY_DIR)/libpmhost_pic.a $(B)/libpm.a -lerfa -lm
 
 $(PY_DIR)/pm/%.py: python/pm/%.py
 	@mkdir -p $(@D)
@@ -53,6 +75,11 @@ $(B)/tests/check_python: $(PY_EXT) $(PY_COPY) $(PY_DIR)/pm_ref $(B)/pmfit
 
 bench-python: python $(B)/pmfit
 	PYTHONPATH=$(CURDIR)/$(PY_DIR) $(PYTHON) bench/bench_python.py
+
+# Instructions per point of the vectorised apply by width (callgrind).
+.PHONY: bench-python-insns
+bench-python-insns: python
+	PYTHONPATH=$(CURDIR)/$(PY_DIR) $(PYTHON) bench/bench_lanes_insns.py
 
 # make demo ends with the package's example (examples/python_demo.py).
 .PHONY: python-demo
