@@ -17,6 +17,7 @@
 #include "explain.hpp"
 #include "fitrun.hpp"
 #include "hostutil.hpp"
+#include "inject.hpp"
 #include "modelfile.h"
 #include "plan.hpp"
 #include "runfile.h"
@@ -1144,6 +1145,55 @@ std::string compare_run(const Model *old_model, const std::shared_ptr<RunData> &
     return comparison_json(c);
 }
 
+// pmfit simulate --inject SPEC ... --into RUN, without the file: a copy of
+// the run with the effects added to its observed positions, and what was
+// injected (sizes, RMS displacements, the lines of moved points).
+py::tuple inject_run(const RunData &d, const std::vector<std::string> &specs, double phase_deg,
+                     unsigned long long seed)
+{
+    if (specs.empty())
+        fail(K_ARGUMENT, "effects: expected at least one EFFECT[=SIZE] (pmfit --inject syntax)");
+    if (!std::isfinite(phase_deg))
+        fail(K_ARGUMENT, "phase: expected a finite angle in degrees");
+    std::vector<Injection> list;
+    for (const std::string &spec : specs) {
+        Injection in;
+        try {
+            in = parse_injection(spec);
+        } catch (const std::runtime_error &e) {
+            fail(K_ARGUMENT, e.what());
+        }
+        in.phase_deg = phase_deg;
+        in.seed = seed;
+        list.push_back(in);
+    }
+    auto out = std::make_shared<RunData>(d);
+    InjectReport rep;
+    try {
+        rep = inject(out->run, list);
+    } catch (const std::runtime_error &e) {
+        std::string w = e.what(); // an effect it cannot make, or the baseline fit failing
+        fail(w.find("--add") != std::string::npos || w.rfind("--inject", 0) == 0 ? K_ARGUMENT : K_ERROR, w);
+    }
+    py::list items;
+    for (size_t k = 0; k < list.size(); k++) {
+        py::dict it;
+        it["effect"] = list[k].effect;
+        it["size_arcsec"] = rep.size_arcsec[k];
+        it["rms_arcsec"] = rep.rms_arcsec[k];
+        py::list lines;
+        for (int j : rep.moved[k])
+            lines.append(out->run.obs[(size_t)j].line);
+        it["moved_lines"] = lines;
+        items.append(it);
+    }
+    py::dict info;
+    info["order"] = rep.order;
+    info["sigma_arcsec"] = rep.sigma_arcsec;
+    info["injected"] = items;
+    return py::make_tuple(out, info);
+}
+
 } // namespace
 
 PYBIND11_MODULE(_pm, mod)
@@ -1236,4 +1286,5 @@ PYBIND11_MODULE(_pm, mod)
     mod.def("explain_run", &explain_run);
     mod.def("plan_run", &plan_run);
     mod.def("compare_run", &compare_run);
+    mod.def("inject_run", &inject_run);
 }

@@ -34,7 +34,7 @@ except ImportError as _e:  # the source tree (python/pm) has no extension
 __all__ = [
     "Error", "FileError", "FormatError", "ArgumentError", "NonFiniteError", "FitError",
     "PointingWarning", "Model", "Run", "FitResult", "SplitFit", "read_run", "load_model",
-    "fit", "fit_run", "explain", "plan", "compare", "RAD2ARCSEC", "MAX_L", "MAX_TERMS", "MAX_AUX",
+    "fit", "fit_run", "explain", "plan", "compare", "inject", "RAD2ARCSEC", "MAX_L", "MAX_TERMS", "MAX_AUX",
 ]
 
 # ---------------------------------------------------------------------------
@@ -748,3 +748,29 @@ def compare(old, run, *, order=1, add=()):
     else:
         text = _pm.compare_run(None, None, _path(old, "old"), r._data, _order(order), _adds(add))
     return _json.loads(text)
+
+
+def inject(run, effects, *, phase=0.0, seed=1):
+    """A known effect added to a real recording (``pmfit simulate --inject
+    EFFECT --into RUN``, docs/explain.md "Real recordings with injected
+    effects"): returns ``(new_run, info)``, the run (a Run or a path) with
+    the effects added to its observed positions in the frame of its own
+    baseline fit (noise and everything else unchanged), and a dict:
+    ``order`` and ``sigma_arcsec`` of that baseline, ``injected`` (per
+    effect: ``effect``, ``size_arcsec``, ``rms_arcsec`` per axis on the sky,
+    ``moved_lines`` for outliers).
+
+    ``effects``: one or a list of pmfit's --inject specs: ``"EFFECT"`` (one
+    sigma), ``"EFFECT=SIZE"`` (arcsec) or ``"EFFECT:SIZEsigma"`` /
+    ``"EFFECT:SIZEas"``; EFFECT is any --add effect, ``outlier[:N]`` or
+    ``higher_order``.  ``phase`` (degrees) for periodic effects, ``seed`` for
+    outliers and higher_order."""
+    r = _run(run)
+    specs = [effects] if isinstance(effects, str) else list(effects)
+    for e in specs:
+        if not isinstance(e, str):
+            raise ArgumentError("effects: expected --inject specs (strings), got %r" % (e,))
+    if isinstance(seed, bool) or not isinstance(seed, (int, _np.integer)) or seed < 0:
+        raise ArgumentError("seed: expected an integer >= 0, got %r" % (seed,))
+    data, info = _pm.inject_run(r._data, specs, _opt_float("phase", phase), int(seed))
+    return Run(data), info
