@@ -31,26 +31,10 @@
 */
 
 /* The vector types of W lanes: doubles, their comparisons' masks, bits. */
-template <int W> struct RawOf;
-template <> struct RawOf<2> {
-    typedef double raw __attribute__((vector_size(16)));
-    typedef long long mask __attribute__((vector_size(16)));
-    typedef unsigned long long bits __attribute__((vector_size(16)));
-};
-template <> struct RawOf<4> {
-    typedef double raw __attribute__((vector_size(32)));
-    typedef long long mask __attribute__((vector_size(32)));
-    typedef unsigned long long bits __attribute__((vector_size(32)));
-};
-template <> struct RawOf<8> {
-    typedef double raw __attribute__((vector_size(64)));
-    typedef long long mask __attribute__((vector_size(64)));
-    typedef unsigned long long bits __attribute__((vector_size(64)));
-};
-template <> struct RawOf<16> {
-    typedef double raw __attribute__((vector_size(128)));
-    typedef long long mask __attribute__((vector_size(128)));
-    typedef unsigned long long bits __attribute__((vector_size(128)));
+template <int W> struct RawOf {
+    typedef double raw __attribute__((vector_size(8 * W)));
+    typedef long long mask __attribute__((vector_size(8 * W)));
+    typedef unsigned long long bits __attribute__((vector_size(8 * W)));
 };
 
 /* The widest vector of the machine the file is built for. */
