@@ -21,8 +21,11 @@
 #include "modelfile.h"
 #include "plan.hpp"
 #include "runfile.h"
+#include "simulate.h"
 
 #include <algorithm>
+#include <cstdlib>
+#include <unistd.h>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -1194,6 +1197,58 @@ py::tuple inject_run(const RunData &d, const std::vector<std::string> &specs, do
     return py::make_tuple(out, info);
 }
 
+// pmfit simulate OUT (the true model given): the run pmsim_write writes,
+// read back as pmfit would read the file (through a temporary file, removed).
+std::shared_ptr<RunData> simulate_run(const Model &truth, long n, unsigned long long seed,
+                                      double lat_deg, double el_limit, double noise, bool fork,
+                                      const std::vector<std::pair<std::string, double>> &effects,
+                                      double phase_deg)
+{
+    if (n < 1 || n > 10000000)
+        fail(K_ARGUMENT, "n: expected 1..10000000 observations, got " + std::to_string(n));
+    pmsim_spec spec;
+    pmsim_default(&spec);
+    spec.n = n;
+    spec.seed = seed;
+    spec.latitude_deg = in_range("latitude", lat_deg, -90, 90, "degrees");
+    spec.el_limit_deg = in_range("el_limit", el_limit, -10, 80, "degrees");
+    spec.noise_arcsec = in_range("noise", noise, 0, 1e5, "arcseconds");
+    spec.gem = fork ? 0 : 1;
+    spec.truth = truth.m;
+    spec.truth.latitude = lat_deg * PI / 180;
+    if (pm_model_prepare(&spec.truth) != PM_OK)
+        fail(K_ARGUMENT, "truth: the model cannot be prepared (non-finite coefficients?)");
+    char err[1024];
+    for (const auto &e : effects)
+        if (pmsim_add_effect(&spec, e.first.c_str(), e.second, phase_deg, seed, err, sizeof err) != 0)
+            fail(K_ARGUMENT, std::string("effects: ") + err);
+    const char *dir = std::getenv("TMPDIR");
+    std::string path = std::string(dir && *dir ? dir : "/tmp") + "/pm-simulate-XXXXXX";
+    int fd = mkstemp(&path[0]);
+    if (fd < 0)
+        fail(K_FILE, path + ": cannot create a temporary file: " + std::strerror(errno));
+    close(fd);
+    int st;
+    {
+        py::gil_scoped_release nogil;
+        st = pmsim_write(&spec, path.c_str(), "made by: pm.simulate", err, sizeof err);
+    }
+    if (st != 0) {
+        std::remove(path.c_str());
+        fail(K_ERROR, err);
+    }
+    std::shared_ptr<RunData> r;
+    try {
+        r = read_run(path, true, false, "named", "");
+    } catch (...) {
+        std::remove(path.c_str());
+        throw;
+    }
+    std::remove(path.c_str());
+    r->run.path = "<pm.simulate>"; // (the temporary file is gone)
+    return r;
+}
+
 } // namespace
 
 PYBIND11_MODULE(_pm, mod)
@@ -1287,4 +1342,5 @@ PYBIND11_MODULE(_pm, mod)
     mod.def("plan_run", &plan_run);
     mod.def("compare_run", &compare_run);
     mod.def("inject_run", &inject_run);
+    mod.def("simulate_run", &simulate_run);
 }

@@ -34,7 +34,7 @@ except ImportError as _e:  # the source tree (python/pm) has no extension
 __all__ = [
     "Error", "FileError", "FormatError", "ArgumentError", "NonFiniteError", "FitError",
     "PointingWarning", "Model", "Run", "FitResult", "SplitFit", "read_run", "load_model",
-    "fit", "fit_run", "explain", "plan", "compare", "inject", "RAD2ARCSEC", "MAX_L", "MAX_TERMS", "MAX_AUX",
+    "fit", "fit_run", "explain", "plan", "compare", "inject", "simulate", "RAD2ARCSEC", "MAX_L", "MAX_TERMS", "MAX_AUX",
 ]
 
 # ---------------------------------------------------------------------------
@@ -774,3 +774,43 @@ def inject(run, effects, *, phase=0.0, seed=1):
         raise ArgumentError("seed: expected an integer >= 0, got %r" % (seed,))
     data, info = _pm.inject_run(r._data, specs, _opt_float("phase", phase), int(seed))
     return Run(data), info
+
+
+def simulate(truth, *, n=200, seed=1, latitude=47.0, el_limit=15.0, noise=1.0, fork=False,
+             effects=(), phase=0.0):
+    """A simulated pointing run (``pmfit simulate OUT``): ``truth`` (a Model:
+    its mount, order and coefficients; its latitude is set to ``latitude``)
+    observed at ``n`` targets above ``el_limit`` degrees in a nearest-
+    neighbour sequence, a German mount flipping west of the meridian (or a
+    fork, ``fork=True``), Gaussian ``noise`` (arcsec per axis).  ``effects``:
+    physical effects added to the truth, each ``"EFFECT=SIZE"`` or
+    ``(EFFECT, SIZE)`` with EFFECT any --add effect, ``outlier[:N]`` or
+    ``higher_order`` and SIZE in arcsec (pmfit simulate --effect); ``phase``
+    (degrees) for periodic ones.  Returns a Run, as read from the file pmfit
+    would write."""
+    if not isinstance(truth, Model):
+        raise ArgumentError("truth: expected a pm.Model, got %r" % (truth,))
+    for name, v in (("n", n), ("seed", seed)):
+        if isinstance(v, bool) or not isinstance(v, (int, _np.integer)) or v < 0:
+            raise ArgumentError("%s: expected an integer >= 0, got %r" % (name, v))
+    effs = []
+    for e in ([effects] if isinstance(effects, str) else effects):
+        if isinstance(e, str):
+            name, sep, size = e.rpartition("=")
+            try:
+                effs.append((name, float(size)) if sep else None)
+            except ValueError:
+                effs.append(None)
+            if effs[-1] is None:
+                raise ArgumentError("effects: expected EFFECT=SIZE (arcsec), got %r" % (e,))
+        else:
+            try:
+                name, size = e
+                effs.append((str(name), _opt_float("effects", size)))
+            except (TypeError, ValueError):
+                raise ArgumentError("effects: expected EFFECT=SIZE or (EFFECT, SIZE), got %r"
+                                    % (e,)) from None
+    data = _pm.simulate_run(truth, int(n), int(seed), _opt_float("latitude", latitude),
+                            _opt_float("el_limit", el_limit), _opt_float("noise", noise),
+                            bool(fork), effs, _opt_float("phase", phase))
+    return Run(data)
