@@ -434,6 +434,84 @@ inline bool better(const pm_model *m, const NPoint &x, const NPoint &c, int want
 #ifndef NEWTON_MAX_STEP
 #define NEWTON_MAX_STEP 1.0
 #endif
+/* A trust region for the fold step (ht, hd): the quadratic model holds
+** over a fraction of a radian at most (near the mount's pole, where the
+** hour angle is ill-determined, over much less). */
+inline void trust_region(double *ht, double *hd)
+{
+    const double big = m_fabs(*ht) > 4 * m_fabs(*hd) ? m_fabs(*ht) : 4 * m_fabs(*hd);
+    if (big > NEWTON_MAX_STEP) {
+        *ht *= NEWTON_MAX_STEP / big;
+        *hd *= NEWTON_MAX_STEP / big;
+    }
+}
+
+/* The last point of the pole's edge the iteration stood on (along_edge). */
+struct EdgeMemo {
+    double t, g; /* its hour angle and p_t . q there */
+    bool have;
+};
+
+/* The trial point (nt, nd) of newton beyond the pole from side `want`,
+** moved back onto the edge: dec - e' = +-90 deg on the side wanted, and
+** along the edge the hour angle's Newton step on p . q (its maximum: the
+** nearest point of the edge where the target is out of reach), the plain
+** step where p . q is not concave.  ht is the step's hour angle from cur, lam
+** its damping. */
+inline void onto_edge(const pm_model *m, const NPoint &cur, const double *turn, int want,
+                      double lam, double ht, EdgeMemo *e, double *nt, double *nd)
+{
+    const double pole = m_sin(*nd - m->coef[4]) >= 0 ? PI / 2 : -PI / 2;
+    const double step_d = *nd - cur.d;
+    *nd = edge_of(m, turn, pole, want);
+    if (!(m_fabs(*nd - cur.d) <= 1e-15 * m_fabs(*nd))) {
+        /* the step as far as the edge */
+        double frac = (*nd - cur.d) / step_d;
+        frac = frac > 0 ? (frac < 1 ? frac : 1) : 0;
+        *nt = cur.t + lam * ht * frac;
+        return;
+    }
+    /* from the edge along it: where the target is out of reach, the
+    ** nearest point is where p . q peaks; the secant step on its
+    ** derivative p_t . q once two points of the edge are known, the
+    ** Gauss-Newton step before */
+    double he = -(cur.M[0] * cur.F[0] + cur.M[2] * cur.F[1]) /
+                (cur.M[0] * cur.M[0] + cur.M[2] * cur.M[2]);
+    if (e->have && cur.t != e->t && cur.gt != e->g)
+        he = -cur.gt * (cur.t - e->t) / (cur.gt - e->g);
+    e->t = cur.t;
+    e->g = cur.gt;
+    e->have = true;
+    if (!finite(he))
+        he = 0;
+    if (m_fabs(he) > NEWTON_MAX_STEP)
+        he = he > 0 ? NEWTON_MAX_STEP : -NEWTON_MAX_STEP;
+    *nt = cur.t + lam * he;
+}
+
+/* The secant of the curvature along the step from cur to trial at (nt,
+** nd), into cv (fold_step's second-order part), where the step is long
+** enough for F's change to show it above rounding. */
+inline void secant_curvature(const NPoint &cur, const NPoint &trial, double nt, double nd,
+                             Curv *cv)
+{
+    const double h[2] = {wrap_pi(nt - cur.t), nd - cur.d};
+    const double hn2 = h[0] * h[0] + h[1] * h[1];
+    if (!(hn2 > 1e-12 && hn2 < 1))
+        return;
+    const double hn = m_sqrt(hn2);
+    const Curv zero = {{0, 0}, {0, 0}};
+    cv->dir[0] = h[0] / hn;
+    cv->dir[1] = h[1] / hn;
+    for (int i = 0; i < 2; i++) {
+        const double u[2] = {i == 0 ? 1.0 : 0.0, i == 1 ? 1.0 : 0.0};
+        const double s = trial.F[i] - cur.F[i] - (cur.M[2 * i] * h[0] + cur.M[2 * i + 1] * h[1]);
+        cv->C[i] = 2 * s / hn2 - hess(cur, zero, u, cv->dir, cv->dir);
+    }
+    if (!finite(cv->C[0]) || !finite(cv->C[1]))
+        *cv = zero;
+}
+
 /* Damped Newton iteration on the forward model, in a frame fixed at the
 ** target, with the analytic Jacobian and the fold step (newton_point,
 ** fold_step: one evaluation per trial point).  Used where the closed
@@ -443,11 +521,10 @@ inline bool better(const pm_model *m, const NPoint &x, const NPoint &c, int want
 ** already evaluated); a trial point that is not better shortens the step
 ** to a quarter.  want = +1/-1: the side of the pole wanted (a trial
 ** point beyond the pole from that side is moved back onto the pole's
-** edge, where the step is the hour angle's Newton step on p . q: the
-** nearest point of the edge); 0: any side, the nearer solution.  Trial
-** points are kept on the turn the result is returned on (turn, from
-** turn_of), since periodic terms of non-integer G read the raw angles and
-** jump between turns. */
+** edge: onto_edge); 0: any side, the nearer solution.  Trial points are
+** kept on the turn the result is returned on (turn, from turn_of), since
+** periodic terms of non-integer G read the raw angles and jump between
+** turns. */
 __attribute__((noinline)) pm_status newton(const pm_model *m, const Iso<double> &k,
                                            const pm_context *ctx, const Aim &a,
                                            const double *turn, double *t, double *d,
@@ -463,81 +540,25 @@ __attribute__((noinline)) pm_status newton(const pm_model *m, const Iso<double> 
         newton_point(m, k, ctx, f, *t, *d, &cur);
         evals = 1;
     }
-    double lam = 1, edge_t = 0, edge_g = 0;
-    bool have_edge = false;
+    double lam = 1;
+    EdgeMemo edge = {0, 0, false};
     Curv cv = {{0, 0}, {0, 0}};
     while (!(cur.err <= PM_INVERT_TOL && (!want || side_of(m, cur.d) == want)) &&
            evals < budget) {
         double ht, hd;
         if (!fold_step(m, cur, cv, want, &ht, &hd))
             break;
-        /* a trust region: the quadratic model holds over a fraction of a
-        ** radian at most (near the mount's pole, where the hour angle is
-        ** ill-determined, over much less) */
-        const double big = m_fabs(ht) > 4 * m_fabs(hd) ? m_fabs(ht) : 4 * m_fabs(hd);
-        if (big > NEWTON_MAX_STEP) {
-            ht *= NEWTON_MAX_STEP / big;
-            hd *= NEWTON_MAX_STEP / big;
-        }
+        trust_region(&ht, &hd);
         double nt = cur.t + lam * ht, nd = cur.d + lam * hd;
-        if (want && side_of(m, nd) != want) {
-            /* back onto the edge: dec - e' = +-90 deg on the side wanted,
-            ** and along the edge the hour angle's Newton step on p . q
-            ** (its maximum: the nearest point of the edge where the target
-            ** is out of reach), the plain step where p . q is not concave */
-            const double pole = m_sin(nd - m->coef[4]) >= 0 ? PI / 2 : -PI / 2;
-            const double step_d = nd - cur.d;
-            nd = edge_of(m, turn, pole, want);
-            if (!(m_fabs(nd - cur.d) <= 1e-15 * m_fabs(nd))) {
-                /* the step as far as the edge */
-                double frac = (nd - cur.d) / step_d;
-                frac = frac > 0 ? (frac < 1 ? frac : 1) : 0;
-                nt = cur.t + lam * ht * frac;
-            } else {
-                /* from the edge along it: where the target is out of
-                ** reach, the nearest point is where p . q peaks; the
-                ** secant step on its derivative p_t . q once two points
-                ** of the edge are known, the Gauss-Newton step before */
-                double he = -(cur.M[0] * cur.F[0] + cur.M[2] * cur.F[1]) /
-                            (cur.M[0] * cur.M[0] + cur.M[2] * cur.M[2]);
-                if (have_edge && cur.t != edge_t && cur.gt != edge_g)
-                    he = -cur.gt * (cur.t - edge_t) / (cur.gt - edge_g);
-                edge_t = cur.t;
-                edge_g = cur.gt;
-                have_edge = true;
-                if (!finite(he))
-                    he = 0;
-                if (m_fabs(he) > NEWTON_MAX_STEP)
-                    he = he > 0 ? NEWTON_MAX_STEP : -NEWTON_MAX_STEP;
-                nt = cur.t + lam * he;
-            }
-        }
+        if (want && side_of(m, nd) != want)
+            onto_edge(m, cur, turn, want, lam, ht, &edge, &nt, &nd);
         finish_angles(turn, &nt, &nd);
         if (want && m_fabs(nt - cur.t) <= 1e-15 * m_fabs(cur.t) &&
             m_fabs(nd - cur.d) <= 1e-15 * m_fabs(cur.d))
             break; /* no step left (a few ulp): the nearest point */
         newton_point(m, k, ctx, f, nt, nd, &trial);
         evals++;
-        {
-            /* the secant of the curvature along this step (where it is
-            ** long enough for F's change to show it above rounding) */
-            const double h[2] = {wrap_pi(nt - cur.t), nd - cur.d};
-            const double hn2 = h[0] * h[0] + h[1] * h[1];
-            if (hn2 > 1e-12 && hn2 < 1) {
-                const double hn = m_sqrt(hn2);
-                const Curv zero = {{0, 0}, {0, 0}};
-                cv.dir[0] = h[0] / hn;
-                cv.dir[1] = h[1] / hn;
-                for (int i = 0; i < 2; i++) {
-                    const double u[2] = {i == 0 ? 1.0 : 0.0, i == 1 ? 1.0 : 0.0};
-                    const double s = trial.F[i] - cur.F[i] -
-                                     (cur.M[2 * i] * h[0] + cur.M[2 * i + 1] * h[1]);
-                    cv.C[i] = 2 * s / hn2 - hess(cur, zero, u, cv.dir, cv.dir);
-                }
-                if (!finite(cv.C[0]) || !finite(cv.C[1]))
-                    cv = zero;
-            }
-        }
+        secant_curvature(cur, trial, nt, nd, &cv);
         if (better(m, trial, cur, want)) {
             cur = trial;
             lam = 1;
