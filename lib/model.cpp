@@ -840,7 +840,10 @@ PM_HOT void first_point(Branch *s)
         ** Pd(d - e') T(i) w there, the quantity iso_inverse chooses by
         ** (near the mount's pole it differs from the sign of cos(dec)). */
         g = trig_of(s->start[0], s->start[1]);
-        aniso_jac(m, k, g, s->ctx, &s->d0t, &s->d0d, s->J);
+        double dt, dd; /* (locals: the Branch's address stays in here) */
+        aniso_jac(m, k, g, s->ctx, &dt, &dd, s->J);
+        s->d0t = dt;
+        s->d0d = dd;
         s->used = 1;
         s->have_j = s->have_d = true;
         double stp, ctp, sdp, cdp;
@@ -856,7 +859,10 @@ PM_HOT void first_point(Branch *s)
             k.si, k.ci,
             rot_dt<double>(sdp, cdp,
                            rot_xt<double>(k.sd, k.cd, rot_zt<double>(stp, ctp, s->tg->q0))));
-        logmap<double>(w, &s->dh_t, &s->dh_d);
+        double ht, hd;
+        logmap<double>(w, &ht, &hd);
+        s->dh_t = ht;
+        s->dh_d = hd;
         s->reachable = true;
     } else {
         s->reachable = iso_inverse0<double>(k, *s->tg, s->side, &g);
@@ -865,17 +871,22 @@ PM_HOT void first_point(Branch *s)
         on_turn(m, k, *s->a, &g, s->ref_t, s->ref_d);
 }
 
-/* One evaluation of D at g (counted in used); J with the first. */
-PM_HOT void evaluate(Branch *s, const Trig<double> &g, double *dt, double *dd)
+/* One evaluation of D at g (counted in used); J with the first.  (D
+** through locals: the evaluations are calls, and a Branch or Lean whose
+** address reached one would live in memory, not in registers.) */
+PM_HOT void evaluate(Branch *s, const Trig<double> &g, double *dt_out, double *dd_out)
 {
+    double dt, dd;
     s->used++;
     if (s->have_j) {
-        aniso<double>(s->m, *s->k, g, s->ctx, dt, dd);
+        aniso<double>(s->m, *s->k, g, s->ctx, &dt, &dd);
     } else {
-        aniso_jac(s->m, *s->k, g, s->ctx, dt, dd, s->J);
+        aniso_jac(s->m, *s->k, g, s->ctx, &dt, &dd, s->J);
         s->have_j = true;
         s->dist_j = 0;
     }
+    *dt_out = dt;
+    *dd_out = dd;
 }
 
 /* The Newton step on D from D = (dt, dd) at D^: the next D^ (chord). */
