@@ -745,13 +745,16 @@ inline bool newton_prep0(const Iso<double> &k, const Trig<double> &g, const doub
 
 /* solve_branch in parts, every one inlined into it (the hot path gains no
 ** calls): the first point (first_point), the lean loop of the typical
-** iteration (lean_loop, lean_step), the hand-over to the general loop
-** (hand_over), the general loop (general_loop, general_step, fall_back,
-** general_next) and the check of the returned angles (rounding_safe,
-** finish_branch).  Their state is a Branch, passed by pointer; the points
-** themselves live in three slots of solve_branch's frame, J and Ni beside
-** them (passed to the evaluations: kept out of the Branch, whose scalars
-** then stay in registers). */
+** iteration (lean_loop, lean_stop, lean_advance), the hand-over to the
+** general loop (hand_over), the general loop (general_loop, general_step,
+** fall_back, general_next) and the check of the returned angles
+** (rounding_safe, finish_branch).  Their state is a Branch, passed by
+** pointer; the points themselves live in three slots of solve_branch's
+** frame, J and Ni beside them, and D is evaluated into locals (addresses
+** that reach a call keep the Branch out of memory: its scalars stay in
+** registers).  The lean loop's iterations stay one loop: as a function per
+** iteration returning how it ended, gcc spilled more across the closed
+** form's call (+31 host instructions per cold call, bench/typical.sh). */
 #define PM_HOT __attribute__((always_inline)) inline
 
 /* The state of solve_branch's iteration.
@@ -915,10 +918,10 @@ PM_HOT bool predicted_stop(const Branch *s, double dt, double dd, double ht, dou
                PM_INVERT_TOL * 0.5;
 }
 
-/* How the lean loop ends: it goes on; it is done (converged, or the
-** evaluations spent); the general loop takes over at the start of this
-** iteration (bail) or of the next (bail_next). */
-enum LeanEnd { LEAN_ON, LEAN_DONE, LEAN_BAIL, LEAN_BAIL_NEXT };
+/* How the lean loop hands over where it is not done: the general loop
+** takes over at the start of this iteration (bail) or of the next
+** (bail_next). */
+enum LeanEnd { LEAN_BAIL, LEAN_BAIL_NEXT };
 
 /* The lean loop's own state: the current point, the previous one (the
 ** best so far: while the steps contract the best point is the current
@@ -931,74 +934,6 @@ struct Lean {
     double s_nt, s_nd;
     int it;
 };
-
-/* One iteration of the lean loop (lean_loop): evaluate, the measured stop,
-** the contraction, the chord step, the predicted stop; any other event
-** ends it (LeanEnd). */
-PM_HOT LeanEnd lean_step(Branch *s, Lean *L)
-{
-    if (!s->have_d) {
-        if (s->used >= PM_INVERT_MAX_FIXED) {
-            /* (the general loop would stop here, with the best point) */
-            s->bp = L->prv;
-            s->best_reachable = true;
-            return LEAN_DONE;
-        }
-        evaluate(s, *L->cur, &L->dt, &L->dd);
-    }
-    s->have_d = false;
-    const double dt = L->dt, dd = L->dd;
-    if (!finite(dt * dt + dd * dd))
-        return LEAN_BAIL;
-    s->change = m_sqrt((dt - s->dh_t) * (dt - s->dh_t) + (dd - s->dh_d) * (dd - s->dh_d));
-    if (s->change <= PM_INVERT_TOL * 0.5) {
-        s->bp = L->cur;
-        s->best_reachable = true;
-        s->converged = true;
-        return LEAN_DONE;
-    }
-    if (L->it > 0 && s->change > 0.5 * L->last)
-        return LEAN_BAIL;
-    if (!s->tried_n) {
-        s->tried_n = true;
-        s->have_n = s->start ? newton_prep(*s->k, *L->cur, s->dh_t, s->dh_d, s->J, s->Ni)
-                             : newton_prep0(*s->k, *L->cur, s->J, s->Ni); /* (D^ = 0) */
-    }
-    if (!(s->have_n && s->change <= 0.01))
-        return LEAN_BAIL;
-    double nt, nd, ht, hd;
-    chord_step(s, dt, dd, &nt, &nd);
-    if (!iso_inverse<double>(*s->k, *s->tg, nt, nd, s->side, L->nxt))
-        return LEAN_BAIL;
-    if (!small_step(*L->nxt, *L->cur, &ht, &hd)) {
-        /* a step beyond 0.01 rad: no bound from here on, the general loop
-        ** takes over after it */
-        L->s_nt = nt;
-        L->s_nd = nd;
-        return LEAN_BAIL_NEXT;
-    }
-    const double hn = step_len(ht, hd);
-    if (predicted_stop(s, dt, dd, ht, hd, nt, nd, hn)) {
-        s->bp = L->nxt;
-        s->best_reachable = true;
-        s->converged = true;
-        return LEAN_DONE;
-    }
-    L->p_dt = dt;
-    L->p_dd = dd;
-    L->p_ht = s->dh_t;
-    L->p_hd = s->dh_d;
-    L->p_dist = s->dist_j;
-    L->last = s->change;
-    s->dist_j += hn;
-    s->dh_t = nt;
-    s->dh_d = nd;
-    Trig<double> *x = L->prv;
-    L->prv = L->cur;
-    L->cur = L->nxt;
-    L->nxt = x;
-    return LEAN_ON;
-}
 
 /* The loop below (hand_over) in the state bail_next leaves: the general
 ** loop at the start of iteration it + 1, as it leaves a step the bound
@@ -1051,6 +986,35 @@ PM_HOT void hand_over(Branch *s, const Lean *L, LeanEnd end)
     s->best_reachable = true;
 }
 
+/* The lean loop certifies point p (converged, the best point). */
+PM_HOT void lean_stop(Branch *s, Trig<double> *p)
+{
+    s->bp = p;
+    s->best_reachable = true;
+    s->converged = true;
+}
+
+/* The lean loop's step taken: the current point (D = (dt, dd)) becomes
+** the previous one, the best so far; the next point, at D^ = (nt, nd) a
+** step hn from it, the current one. */
+PM_HOT void lean_advance(Branch *s, Lean *L, double dt, double dd, double nt, double nd,
+                         double hn)
+{
+    L->p_dt = dt;
+    L->p_dd = dd;
+    L->p_ht = s->dh_t;
+    L->p_hd = s->dh_d;
+    L->p_dist = s->dist_j;
+    L->last = s->change;
+    s->dist_j += hn;
+    s->dh_t = nt;
+    s->dh_d = nd;
+    Trig<double> *x = L->prv;
+    L->prv = L->cur;
+    L->cur = L->nxt;
+    L->nxt = x;
+}
+
 /* The typical call (far from the mount's pole, a small anisotropic
 ** displacement): every Newton step on D contracts, and the predicted stop
 ** certifies a point within PM_INVERT_MAX_FIXED evaluations.  The same
@@ -1073,11 +1037,62 @@ PM_HOT bool lean_loop(Branch *s)
     L.last = 1e300;
     L.p_dt = L.p_dd = L.p_ht = L.p_hd = L.p_dist = 0;
     L.s_nt = L.s_nd = 0;
-    LeanEnd end;
-    for (L.it = 0; (end = lean_step(s, &L)) == LEAN_ON; L.it++) {
+    LeanEnd end = LEAN_BAIL;
+    for (L.it = 0;; L.it++) {
+        if (!s->have_d) {
+            if (s->used >= PM_INVERT_MAX_FIXED) {
+                /* (the general loop would stop here, with the best point) */
+                s->bp = L.prv;
+                s->best_reachable = true;
+                return true;
+            }
+            evaluate(s, *L.cur, &L.dt, &L.dd);
+        }
+        s->have_d = false;
+        const double dt = L.dt, dd = L.dd;
+        if (!finite(dt * dt + dd * dd)) {
+            end = LEAN_BAIL;
+            break;
+        }
+        s->change = m_sqrt((dt - s->dh_t) * (dt - s->dh_t) + (dd - s->dh_d) * (dd - s->dh_d));
+        if (s->change <= PM_INVERT_TOL * 0.5) {
+            lean_stop(s, L.cur);
+            return true;
+        }
+        if (L.it > 0 && s->change > 0.5 * L.last) {
+            end = LEAN_BAIL;
+            break;
+        }
+        if (!s->tried_n) {
+            s->tried_n = true;
+            s->have_n = s->start ? newton_prep(*s->k, *L.cur, s->dh_t, s->dh_d, s->J, s->Ni)
+                                 : newton_prep0(*s->k, *L.cur, s->J, s->Ni); /* (D^ = 0) */
+        }
+        if (!(s->have_n && s->change <= 0.01)) {
+            end = LEAN_BAIL;
+            break;
+        }
+        double nt, nd, ht, hd;
+        chord_step(s, dt, dd, &nt, &nd);
+        if (!iso_inverse<double>(*s->k, *s->tg, nt, nd, s->side, L.nxt)) {
+            end = LEAN_BAIL;
+            break;
+        }
+        if (!small_step(*L.nxt, *L.cur, &ht, &hd)) {
+            /* a step beyond 0.01 rad: no bound from here on, the general
+            ** loop takes over after it */
+            L.s_nt = nt;
+            L.s_nd = nd;
+            end = LEAN_BAIL_NEXT;
+            break;
+        }
+        const double hn = step_len(ht, hd);
+        if (predicted_stop(s, dt, dd, ht, hd, nt, nd, hn)) {
+            lean_stop(s, L.nxt);
+            return true;
+        }
+        lean_advance(s, &L, dt, dd, nt, nd, hn);
     }
-    if (end == LEAN_DONE)
-        return true;
     hand_over(s, &L, end);
     return false;
 }
