@@ -746,15 +746,17 @@ inline bool newton_prep0(const Iso<double> &k, const Trig<double> &g, const doub
 /* solve_branch in parts, every one inlined into it (the hot path gains no
 ** calls): the first point (first_point), the lean loop of the typical
 ** iteration (lean_loop, lean_stop, lean_advance), the hand-over to the
-** general loop (hand_over), the general loop (general_loop, general_step,
+** general loop (hand_over), the general loop (general_loop, keep_best,
 ** fall_back, general_next) and the check of the returned angles
 ** (rounding_safe, finish_branch).  Their state is a Branch, passed by
 ** pointer; the points themselves live in three slots of solve_branch's
 ** frame, J and Ni beside them, and D is evaluated into locals (addresses
 ** that reach a call keep the Branch out of memory: its scalars stay in
-** registers).  The lean loop's iterations stay one loop: as a function per
+** registers).  Each loop's iterations stay one loop: as a function per
 ** iteration returning how it ended, gcc spilled more across the closed
-** form's call (+31 host instructions per cold call, bench/typical.sh). */
+** form's call (+31 host instructions per cold call, bench/typical.sh); the
+** general loop is marked unlikely, so that the typical path gets the
+** registers. */
 #define PM_HOT __attribute__((always_inline)) inline
 
 /* The state of solve_branch's iteration.
@@ -1097,7 +1099,7 @@ PM_HOT bool lean_loop(Branch *s)
     return false;
 }
 
-/* Not contracting (general_step): where the steps were Newton's on D
+/* Not contracting (general_loop): where the steps were Newton's on D
 ** (with J from the first evaluation: a term that varies fast makes J a
 ** poor guide), plain fixed-point steps from the best point, its D in
 ** (dt, dd); false where they were plain already or had no Newton step
@@ -1155,53 +1157,53 @@ PM_HOT bool general_next(Branch *s, double dt, double dd)
     return false;
 }
 
-/* One iteration `it` of the general loop: D at *gp (evaluated, or the
-** lean loop's), the best point so far, the measured stop, the
-** contraction (else fall_back), the step (general_next).  False where the
-** iteration stops (converged, out of evaluations, an overflow, no
-** contraction left). */
-PM_HOT bool general_step(Branch *s, int it)
+/* The point *gp, where D = (dt, dd), the best so far (general_loop). */
+PM_HOT void keep_best(Branch *s, double dt, double dd)
 {
-    double dt, dd;
-    if (s->have_d) {
-        dt = s->d0t;
-        dd = s->d0d;
-        s->have_d = false;
-    } else {
-        if (s->used >= PM_INVERT_MAX_FIXED)
-            return false;
-        evaluate(s, *s->gp, &dt, &dd);
-    }
-    if (!finite(dt * dt + dd * dd))
-        return false; /* the forward model overflows here: not converged */
-    s->change = m_sqrt((dt - s->dh_t) * (dt - s->dh_t) + (dd - s->dh_d) * (dd - s->dh_d));
-    if (s->change < s->best_change) {
-        s->best_change = s->change;
-        s->bp = s->gp;
-        s->best_reachable = s->reachable;
-        s->b_dt = dt;
-        s->b_dd = dd;
-        s->b_ht = s->dh_t;
-        s->b_hd = s->dh_d;
-        s->b_dist = s->dist_j;
-    }
-    if (s->change <= PM_INVERT_TOL * 0.5) {
-        s->converged = true;
-        return false;
-    }
-    if (it > 0 && s->change > 0.5 * s->last_change && !fall_back(s, &dt, &dd))
-        return false;
-    s->last_change = s->change;
-    return !general_next(s, dt, dd);
+    s->best_change = s->change;
+    s->bp = s->gp;
+    s->best_reachable = s->reachable;
+    s->b_dt = dt;
+    s->b_dd = dd;
+    s->b_ht = s->dh_t;
+    s->b_hd = s->dh_d;
+    s->b_dist = s->dist_j;
 }
 
-/* The general loop: the fixed point with its best point kept, plain steps
-** where the chord does not contract, from iteration it0. */
+/* The general loop, from iteration it0: the fixed point with its best
+** point kept, plain steps where the chord does not contract.  Each
+** iteration: D at *gp (evaluated, or the lean loop's), the best point so
+** far, the measured stop, the contraction (else fall_back), the step
+** (general_next).  It stops converged, out of evaluations, at an overflow
+** or with no contraction left.  (One loop, as the lean one: see above.) */
 PM_HOT void general_loop(Branch *s)
 {
-    for (int it = s->it0; !s->converged; it++)
-        if (!general_step(s, it))
+    for (int it = s->it0; !s->converged; it++) {
+        double dt, dd;
+        if (s->have_d) {
+            dt = s->d0t;
+            dd = s->d0d;
+            s->have_d = false;
+        } else {
+            if (s->used >= PM_INVERT_MAX_FIXED)
+                break;
+            evaluate(s, *s->gp, &dt, &dd);
+        }
+        if (!finite(dt * dt + dd * dd))
+            break; /* the forward model overflows here: not converged */
+        s->change = m_sqrt((dt - s->dh_t) * (dt - s->dh_t) + (dd - s->dh_d) * (dd - s->dh_d));
+        if (s->change < s->best_change)
+            keep_best(s, dt, dd);
+        if (s->change <= PM_INVERT_TOL * 0.5) {
+            s->converged = true;
             break;
+        }
+        if (it > 0 && s->change > 0.5 * s->last_change && !fall_back(s, &dt, &dd))
+            break;
+        s->last_change = s->change;
+        if (general_next(s, dt, dd))
+            break;
+    }
 }
 
 /* Are the angles (t, d), the best point's rounded to doubles, safe to
@@ -1313,7 +1315,7 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
         s.best_reachable = s.reachable;
         s.b_dt = s.b_dd = s.b_ht = s.b_hd = s.b_dist = 0;
     }
-    if (!lean_done)
+    if (__builtin_expect(!lean_done, 0)) /* (the typical call is done) */
         general_loop(&s);
     return finish_branch(&s, want, turn, t_out, d_out, err_out);
 }
