@@ -434,6 +434,84 @@ inline bool better(const pm_model *m, const NPoint &x, const NPoint &c, int want
 #ifndef NEWTON_MAX_STEP
 #define NEWTON_MAX_STEP 1.0
 #endif
+/* A trust region for the fold step (ht, hd): the quadratic model holds
+** over a fraction of a radian at most (near the mount's pole, where the
+** hour angle is ill-determined, over much less). */
+inline void trust_region(double *ht, double *hd)
+{
+    const double big = m_fabs(*ht) > 4 * m_fabs(*hd) ? m_fabs(*ht) : 4 * m_fabs(*hd);
+    if (big > NEWTON_MAX_STEP) {
+        *ht *= NEWTON_MAX_STEP / big;
+        *hd *= NEWTON_MAX_STEP / big;
+    }
+}
+
+/* The last point of the pole's edge the iteration stood on (along_edge). */
+struct EdgeMemo {
+    double t, g; /* its hour angle and p_t . q there */
+    bool have;
+};
+
+/* The trial point (nt, nd) of newton beyond the pole from side `want`,
+** moved back onto the edge: dec - e' = +-90 deg on the side wanted, and
+** along the edge the hour angle's Newton step on p . q (its maximum: the
+** nearest point of the edge where the target is out of reach), the plain
+** step where p . q is not concave.  ht is the step's hour angle from cur, lam
+** its damping. */
+inline void onto_edge(const pm_model *m, const NPoint &cur, const double *turn, int want,
+                      double lam, double ht, EdgeMemo *e, double *nt, double *nd)
+{
+    const double pole = m_sin(*nd - m->coef[4]) >= 0 ? PI / 2 : -PI / 2;
+    const double step_d = *nd - cur.d;
+    *nd = edge_of(m, turn, pole, want);
+    if (!(m_fabs(*nd - cur.d) <= 1e-15 * m_fabs(*nd))) {
+        /* the step as far as the edge */
+        double frac = (*nd - cur.d) / step_d;
+        frac = frac > 0 ? (frac < 1 ? frac : 1) : 0;
+        *nt = cur.t + lam * ht * frac;
+        return;
+    }
+    /* from the edge along it: where the target is out of reach, the
+    ** nearest point is where p . q peaks; the secant step on its
+    ** derivative p_t . q once two points of the edge are known, the
+    ** Gauss-Newton step before */
+    double he = -(cur.M[0] * cur.F[0] + cur.M[2] * cur.F[1]) /
+                (cur.M[0] * cur.M[0] + cur.M[2] * cur.M[2]);
+    if (e->have && cur.t != e->t && cur.gt != e->g)
+        he = -cur.gt * (cur.t - e->t) / (cur.gt - e->g);
+    e->t = cur.t;
+    e->g = cur.gt;
+    e->have = true;
+    if (!finite(he))
+        he = 0;
+    if (m_fabs(he) > NEWTON_MAX_STEP)
+        he = he > 0 ? NEWTON_MAX_STEP : -NEWTON_MAX_STEP;
+    *nt = cur.t + lam * he;
+}
+
+/* The secant of the curvature along the step from cur to trial at (nt,
+** nd), into cv (fold_step's second-order part), where the step is long
+** enough for F's change to show it above rounding. */
+inline void secant_curvature(const NPoint &cur, const NPoint &trial, double nt, double nd,
+                             Curv *cv)
+{
+    const double h[2] = {wrap_pi(nt - cur.t), nd - cur.d};
+    const double hn2 = h[0] * h[0] + h[1] * h[1];
+    if (!(hn2 > 1e-12 && hn2 < 1))
+        return;
+    const double hn = m_sqrt(hn2);
+    const Curv zero = {{0, 0}, {0, 0}};
+    cv->dir[0] = h[0] / hn;
+    cv->dir[1] = h[1] / hn;
+    for (int i = 0; i < 2; i++) {
+        const double u[2] = {i == 0 ? 1.0 : 0.0, i == 1 ? 1.0 : 0.0};
+        const double s = trial.F[i] - cur.F[i] - (cur.M[2 * i] * h[0] + cur.M[2 * i + 1] * h[1]);
+        cv->C[i] = 2 * s / hn2 - hess(cur, zero, u, cv->dir, cv->dir);
+    }
+    if (!finite(cv->C[0]) || !finite(cv->C[1]))
+        *cv = zero;
+}
+
 /* Damped Newton iteration on the forward model, in a frame fixed at the
 ** target, with the analytic Jacobian and the fold step (newton_point,
 ** fold_step: one evaluation per trial point).  Used where the closed
@@ -443,11 +521,10 @@ inline bool better(const pm_model *m, const NPoint &x, const NPoint &c, int want
 ** already evaluated); a trial point that is not better shortens the step
 ** to a quarter.  want = +1/-1: the side of the pole wanted (a trial
 ** point beyond the pole from that side is moved back onto the pole's
-** edge, where the step is the hour angle's Newton step on p . q: the
-** nearest point of the edge); 0: any side, the nearer solution.  Trial
-** points are kept on the turn the result is returned on (turn, from
-** turn_of), since periodic terms of non-integer G read the raw angles and
-** jump between turns. */
+** edge: onto_edge); 0: any side, the nearer solution.  Trial points are
+** kept on the turn the result is returned on (turn, from turn_of), since
+** periodic terms of non-integer G read the raw angles and jump between
+** turns. */
 __attribute__((noinline)) pm_status newton(const pm_model *m, const Iso<double> &k,
                                            const pm_context *ctx, const Aim &a,
                                            const double *turn, double *t, double *d,
@@ -463,81 +540,25 @@ __attribute__((noinline)) pm_status newton(const pm_model *m, const Iso<double> 
         newton_point(m, k, ctx, f, *t, *d, &cur);
         evals = 1;
     }
-    double lam = 1, edge_t = 0, edge_g = 0;
-    bool have_edge = false;
+    double lam = 1;
+    EdgeMemo edge = {0, 0, false};
     Curv cv = {{0, 0}, {0, 0}};
     while (!(cur.err <= PM_INVERT_TOL && (!want || side_of(m, cur.d) == want)) &&
            evals < budget) {
         double ht, hd;
         if (!fold_step(m, cur, cv, want, &ht, &hd))
             break;
-        /* a trust region: the quadratic model holds over a fraction of a
-        ** radian at most (near the mount's pole, where the hour angle is
-        ** ill-determined, over much less) */
-        const double big = m_fabs(ht) > 4 * m_fabs(hd) ? m_fabs(ht) : 4 * m_fabs(hd);
-        if (big > NEWTON_MAX_STEP) {
-            ht *= NEWTON_MAX_STEP / big;
-            hd *= NEWTON_MAX_STEP / big;
-        }
+        trust_region(&ht, &hd);
         double nt = cur.t + lam * ht, nd = cur.d + lam * hd;
-        if (want && side_of(m, nd) != want) {
-            /* back onto the edge: dec - e' = +-90 deg on the side wanted,
-            ** and along the edge the hour angle's Newton step on p . q
-            ** (its maximum: the nearest point of the edge where the target
-            ** is out of reach), the plain step where p . q is not concave */
-            const double pole = m_sin(nd - m->coef[4]) >= 0 ? PI / 2 : -PI / 2;
-            const double step_d = nd - cur.d;
-            nd = edge_of(m, turn, pole, want);
-            if (!(m_fabs(nd - cur.d) <= 1e-15 * m_fabs(nd))) {
-                /* the step as far as the edge */
-                double frac = (nd - cur.d) / step_d;
-                frac = frac > 0 ? (frac < 1 ? frac : 1) : 0;
-                nt = cur.t + lam * ht * frac;
-            } else {
-                /* from the edge along it: where the target is out of
-                ** reach, the nearest point is where p . q peaks; the
-                ** secant step on its derivative p_t . q once two points
-                ** of the edge are known, the Gauss-Newton step before */
-                double he = -(cur.M[0] * cur.F[0] + cur.M[2] * cur.F[1]) /
-                            (cur.M[0] * cur.M[0] + cur.M[2] * cur.M[2]);
-                if (have_edge && cur.t != edge_t && cur.gt != edge_g)
-                    he = -cur.gt * (cur.t - edge_t) / (cur.gt - edge_g);
-                edge_t = cur.t;
-                edge_g = cur.gt;
-                have_edge = true;
-                if (!finite(he))
-                    he = 0;
-                if (m_fabs(he) > NEWTON_MAX_STEP)
-                    he = he > 0 ? NEWTON_MAX_STEP : -NEWTON_MAX_STEP;
-                nt = cur.t + lam * he;
-            }
-        }
+        if (want && side_of(m, nd) != want)
+            onto_edge(m, cur, turn, want, lam, ht, &edge, &nt, &nd);
         finish_angles(turn, &nt, &nd);
         if (want && m_fabs(nt - cur.t) <= 1e-15 * m_fabs(cur.t) &&
             m_fabs(nd - cur.d) <= 1e-15 * m_fabs(cur.d))
             break; /* no step left (a few ulp): the nearest point */
         newton_point(m, k, ctx, f, nt, nd, &trial);
         evals++;
-        {
-            /* the secant of the curvature along this step (where it is
-            ** long enough for F's change to show it above rounding) */
-            const double h[2] = {wrap_pi(nt - cur.t), nd - cur.d};
-            const double hn2 = h[0] * h[0] + h[1] * h[1];
-            if (hn2 > 1e-12 && hn2 < 1) {
-                const double hn = m_sqrt(hn2);
-                const Curv zero = {{0, 0}, {0, 0}};
-                cv.dir[0] = h[0] / hn;
-                cv.dir[1] = h[1] / hn;
-                for (int i = 0; i < 2; i++) {
-                    const double u[2] = {i == 0 ? 1.0 : 0.0, i == 1 ? 1.0 : 0.0};
-                    const double s = trial.F[i] - cur.F[i] -
-                                     (cur.M[2 * i] * h[0] + cur.M[2 * i + 1] * h[1]);
-                    cv.C[i] = 2 * s / hn2 - hess(cur, zero, u, cv.dir, cv.dir);
-                }
-                if (!finite(cv.C[0]) || !finite(cv.C[1]))
-                    cv = zero;
-            }
-        }
+        secant_curvature(cur, trial, nt, nd, &cv);
         if (better(m, trial, cur, want)) {
             cur = trial;
             lam = 1;
@@ -722,26 +743,67 @@ inline bool newton_prep0(const Iso<double> &k, const Trig<double> &g, const doub
                         J[3] * f11, Ni);
 }
 
-/* Solve on one branch of the closed form (side = +1/-1), or from the start
-** position's branch, with the angles on the turn the result is returned
-** on (turn_of).  Returns the status, (t, d) and the miss at (t, d) (0 for
-** PM_OK: below PM_INVERT_TOL). */
-pm_status solve_branch(const pm_model *m, const Iso<double> &k,
-                       const pm_context *ctx, const Aim &a, int side, int want,
-                       const double *start,
-                       const double *turn, double *t_out, double *d_out, double *err_out)
+/* solve_branch in parts, every one inlined into it (the hot path gains no
+** calls): the first point (first_point), the lean loop of the typical
+** iteration (lean_loop, lean_stop, lean_advance), the hand-over to the
+** general loop (hand_over), the general loop (general_loop, keep_best,
+** fall_back, general_next) and the check of the returned angles
+** (rounding_safe, finish_branch).  Their state is a Branch, passed by
+** pointer; the points themselves live in three slots of solve_branch's
+** frame, J and Ni beside them, and D is evaluated into locals (addresses
+** that reach a call keep the Branch out of memory: its scalars stay in
+** registers).  Each loop's iterations stay one loop: as a function per
+** iteration returning how it ended, gcc spilled more across the closed
+** form's call (+31 host instructions per cold call, bench/typical.sh); the
+** general loop is marked unlikely, so that the typical path gets the
+** registers. */
+#define PM_HOT __attribute__((always_inline)) inline
+
+/* The state of solve_branch's iteration.
+**
+** Iteration: g = F(D^), the closed form for the displacement D^; the
+** model's displacement D at g misses D^ by |D - D^|, which is g's
+** round-trip error (to first order): the measured stop.  The next D^ is
+** the Newton step on D^ = D(F(D^)) with J = dD/dx from the first
+** evaluation (a chord: J is not evaluated again), and where lip2 is known
+** the next point's error is bounded before it is evaluated,
+**   |D(x') - D^'| <= |D + J h - D^'| + lip2 (|x - x_J| + |h| / 2) |h|,
+** h = x' - x: the predicted stop. */
+struct Branch {
+    /* the call */
+    const pm_model *m;
+    const Iso<double> *k;
+    const pm_context *ctx;
+    const Aim *a;
+    const Target<double> *tg;
+    const double *start;
+    double ref_t, ref_d; /* the turn the angles are kept on (turn_of) */
+    double lip2;         /* the second-derivative bound; -1: no predicted stop */
+    bool raw;            /* a term reads the raw angles (on_turn at every point) */
+    int side;            /* the closed form's branch */
+    /* the points (three slots, passed round by pointer: no copies), J, Ni */
+    Trig<double> *slot;
+    double *J, *Ni;
+    Trig<double> *gp, *bp; /* the current point, the best */
+    double dh_t, dh_d;     /* D^ of *gp */
+    double d0t, d0d;       /* D at *gp, where have_d */
+    double dist_j;         /* the distance from J's point (1e300: no bound) */
+    int used;              /* evaluations made */
+    bool have_j, have_n, tried_n, have_d, reachable;
+    /* the general loop: the misses, the best point's D, D^ and distance */
+    double change, last_change, best_change;
+    double b_dt, b_dd, b_ht, b_hd, b_dist;
+    bool converged, best_reachable;
+    bool chord; /* Newton steps on D (else plain fixed-point steps) */
+    int it0;    /* the iteration the general loop starts at */
+};
+
+/* The predicted stop (Note 1 of pm_model_invert in pm.h) needs the
+** second-derivative bound: finite only where J is complete (harmonic and
+** AUX terms) and no term reads the raw angles; the AUX terms' part at
+** this context.  -1: no prediction. */
+PM_HOT double lip2_at(const pm_model *m, const pm_context *ctx, bool raw)
 {
-    /* Periodic terms of non-integer G read the raw angle itself, not only
-    ** its sine and cosine: iterate with the angles on the returned turn. */
-    const double ref_t = turn[0], ref_d = turn[1];
-    const Target<double> tg = target_of(k, a.q);
-    /* the angles themselves (on_turn) only where a term reads them; else
-    ** once, at the end */
-    const bool raw = reads_raw_angles(m);
-    /* The predicted stop (Note 1 of pm_model_invert in pm.h) needs the
-    ** second-derivative bound: finite only where J is complete (harmonic
-    ** and AUX terms) and no term reads the raw angles; the AUX terms' part
-    ** at this context. */
     double lip2 = raw ? __builtin_inf() : m->lip2;
     if (lip2 < 1e300)
         for (int i = m->n_base; i < m->n_terms; i++)
@@ -749,346 +811,451 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
                                                 m->term[i].param));
     if (!(lip2 < 1e300))
         lip2 = -1; /* no prediction */
+    return lip2;
+}
 
-    /* Iteration: g = F(D^), the closed form for the displacement D^; the
-    ** model's displacement D at g misses D^ by |D - D^|, which is g's
-    ** round-trip error (to first order): the measured stop.  The next D^
-    ** is the Newton step on D^ = D(F(D^)) with J = dD/dx from the first
-    ** evaluation (a chord: J is not evaluated again), and where lip2 is
-    ** known the next point's error is bounded before it is evaluated,
-    **   |D(x') - D^'| <= |D + J h - D^'| + lip2 (|x - x_J| + |h| / 2) |h|,
-    ** h = x' - x: the predicted stop. */
-    /* three slots (the current point, the next, the best), passed round by
-    ** pointer: no copies */
-    Trig<double> slot[3];
-    Trig<double> &g = slot[0];
-    double dh_t = 0, dh_d = 0; /* D^ of g */
-    double J[4], Ni[4], dist_j = 0;
-    bool have_j = false, have_n = false, tried_n = false, reachable;
-    double d0t = 0, d0d = 0;
-    bool have_d = false; /* (d0t, d0d): D at g, evaluated */
-    int used = 0;        /* evaluations made */
-    if (m->order == 0 && m->n_terms == m->n_base) {
-        /* No anisotropic term: D = 0 everywhere, and the closed form is
-        ** the solution (no evaluation); from a start, on its branch. */
-        if (start) {
-            Trig<double> gs = trig_of(start[0], start[1]);
+/* No anisotropic term: D = 0 everywhere. */
+PM_HOT bool iso_only(const pm_model *m)
+{
+    return m->order == 0 && m->n_terms == m->n_base;
+}
+
+/* The first point, in slot 0: the closed form at D^ = 0 (a cold call), or
+** the start (one evaluation, with J); the branch (side) and whether the
+** closed form reaches the target. */
+PM_HOT void first_point(Branch *s)
+{
+    const pm_model *m = s->m;
+    const Iso<double> &k = *s->k;
+    Trig<double> &g = s->slot[0];
+    if (iso_only(m)) {
+        /* No anisotropic term: the closed form is the solution (no
+        ** evaluation); from a start, on its branch. */
+        if (s->start) {
+            Trig<double> gs = trig_of(s->start[0], s->start[1]);
             double cdp = gs.cd * k.ce + gs.sd * k.se;
-            side = cdp * k.ci >= 0 ? 1 : -1;
+            s->side = cdp * k.ci >= 0 ? 1 : -1;
         }
-        reachable = iso_inverse0<double>(k, tg, side, &g);
-        if (raw)
-            on_turn(m, k, a, &g, ref_t, ref_d);
-        have_d = true; /* (the iteration below stops at once: D = D^ = 0) */
-    } else if (start) {
+        s->reachable = iso_inverse0<double>(k, *s->tg, s->side, &g);
+        if (s->raw)
+            on_turn(m, k, *s->a, &g, s->ref_t, s->ref_d);
+        s->have_d = true; /* (the iteration stops at once: D = D^ = 0) */
+    } else if (s->start) {
         /* The branch of the start: the sign of the x-component of
         ** Pd(d - e') T(i) w there, the quantity iso_inverse chooses by
         ** (near the mount's pole it differs from the sign of cos(dec)). */
-        g = trig_of(start[0], start[1]);
-        aniso_jac(m, k, g, ctx, &d0t, &d0d, J);
-        used = 1;
-        have_j = have_d = true;
+        g = trig_of(s->start[0], s->start[1]);
+        double dt, dd; /* (locals: the Branch's address stays in here) */
+        aniso_jac(m, k, g, s->ctx, &dt, &dd, s->J);
+        s->d0t = dt;
+        s->d0d = dd;
+        s->used = 1;
+        s->have_j = s->have_d = true;
         double stp, ctp, sdp, cdp;
         shifted<double>(k, g, &stp, &ctp, &sdp, &cdp);
-        V3<double> v = rot_z<double>(k.si, k.ci, expmap<double>(d0t, d0d));
-        side = cdp * v.x - sdp * v.z >= 0 ? 1 : -1;
+        V3<double> v = rot_z<double>(k.si, k.ci, expmap<double>(s->d0t, s->d0d));
+        s->side = cdp * v.x - sdp * v.z >= 0 ? 1 : -1;
         /* The start is the closed form's exact point for the displacement
         ** at which the target is seen from it: D^ = log((H Pt X Pd T)^T q),
         ** so it is the first iterate (its miss |D - D^| is measured like
         ** the others', and a start that already points there is returned
         ** after one evaluation). */
         V3<double> w = rot_zt<double>(
-            k.si, k.ci, rot_dt<double>(sdp, cdp, rot_xt<double>(k.sd, k.cd,
-                                                                rot_zt<double>(stp, ctp, tg.q0))));
-        logmap<double>(w, &dh_t, &dh_d);
-        reachable = true;
+            k.si, k.ci,
+            rot_dt<double>(sdp, cdp,
+                           rot_xt<double>(k.sd, k.cd, rot_zt<double>(stp, ctp, s->tg->q0))));
+        double ht, hd;
+        logmap<double>(w, &ht, &hd);
+        s->dh_t = ht;
+        s->dh_d = hd;
+        s->reachable = true;
     } else {
-        reachable = iso_inverse0<double>(k, tg, side, &g);
+        s->reachable = iso_inverse0<double>(k, *s->tg, s->side, &g);
     }
-    if (raw)
-        on_turn(m, k, a, &g, ref_t, ref_d);
+    if (s->raw)
+        on_turn(m, k, *s->a, &g, s->ref_t, s->ref_d);
+}
 
-    double change = 0, last_change, best_change;
-    bool converged = false, best_reachable;
-    Trig<double> *gp = &slot[0], *bp = &slot[0];
-    /* the best point's displacement, its D^ and distance from J's point */
-    double b_dt, b_dd, b_ht, b_hd, b_dist;
-    bool chord = true; /* Newton steps on D (else plain fixed-point steps) */
-    int it0 = 0;       /* the iteration the loop below starts at */
-    bool lean_done = false;
-    if (reachable && lip2 >= 0 && !(m->order == 0 && m->n_terms == m->n_base)) {
-        /* The typical call (far from the mount's pole, a small anisotropic
-        ** displacement): every Newton step on D contracts, and the
-        ** predicted stop certifies a point within PM_INVERT_MAX_FIXED
-        ** evaluations.  The same operations and decisions as the loop
-        ** below, without its bookkeeping for the other cases: while the
-        ** steps contract the best point is the current one.  At the first
-        ** event of another kind (no contraction, no Newton step, a step
-        ** beyond the closed form's reach, an overflow) the loop below takes
-        ** over at the start of that iteration, with the evaluation made
-        ** (have_d) and the state it would have had; after a step beyond
-        ** 0.01 rad (small_step), at the start of the next one. */
-        /* the current point, the previous one (the best so far), the next */
-        Trig<double> *cur = &slot[0], *prv = &slot[1], *nxt = &slot[2];
-        double dt = d0t, dd = d0d, last = 1e300;
-        /* the previous point's (the best so far) displacement, D^, distance */
-        double p_dt = 0, p_dd = 0, p_ht = 0, p_hd = 0, p_dist = 0;
-        int it = 0;
-        bool bail = false, bail_next = false;
-        double s_nt = 0, s_nd = 0; /* (bail_next: the step's D^) */
-        for (;; it++) {
-            if (!have_d) {
-                if (used >= PM_INVERT_MAX_FIXED) {
-                    /* (the loop below would stop here, with the best point) */
-                    bp = prv;
-                    best_reachable = true;
-                    lean_done = true;
-                    break;
-                }
-                used++;
-                if (have_j) {
-                    aniso<double>(m, k, *cur, ctx, &dt, &dd);
-                } else {
-                    aniso_jac(m, k, *cur, ctx, &dt, &dd, J);
-                    have_j = true;
-                    dist_j = 0;
-                }
-            }
-            have_d = false;
-            if (!finite(dt * dt + dd * dd)) {
-                bail = true;
-                break;
-            }
-            change = m_sqrt((dt - dh_t) * (dt - dh_t) + (dd - dh_d) * (dd - dh_d));
-            if (change <= PM_INVERT_TOL * 0.5) {
-                bp = cur;
-                best_reachable = true;
-                converged = lean_done = true;
-                break;
-            }
-            if (it > 0 && change > 0.5 * last) {
-                bail = true;
-                break;
-            }
-            if (!tried_n) {
-                tried_n = true;
-                have_n = start ? newton_prep(k, *cur, dh_t, dh_d, J, Ni)
-                               : newton_prep0(k, *cur, J, Ni); /* (D^ = 0) */
-            }
-            if (!(have_n && change <= 0.01)) {
-                bail = true;
-                break;
-            }
-            const double nt = dh_t + (Ni[0] * (dt - dh_t) + Ni[1] * (dd - dh_d));
-            const double nd = dh_d + (Ni[2] * (dt - dh_t) + Ni[3] * (dd - dh_d));
-            double ht, hd;
-            if (!iso_inverse<double>(k, tg, nt, nd, side, nxt)) {
-                bail = true;
-                break;
-            }
-            if (!small_step(*nxt, *cur, &ht, &hd)) {
-                /* a step beyond 0.01 rad: no bound from here on, the loop
-                ** below takes over after it */
-                bail_next = true;
-                s_nt = nt;
-                s_nd = nd;
-                break;
-            }
-            const double h2 = ht * ht + hd * hd, hn = m_sqrt(h2) * (1 + h2 * 0.2);
-            if (!(lip2 * (dist_j + 0.5 * hn) * hn > PM_INVERT_TOL * 0.5) &&
-                step_bound(dt, dd, J, ht, hd, nt, nd, lip2, dist_j, hn) <= PM_INVERT_TOL * 0.5) {
-                bp = nxt;
-                best_reachable = true;
-                converged = lean_done = true;
-                break;
-            }
-            p_dt = dt;
-            p_dd = dd;
-            p_ht = dh_t;
-            p_hd = dh_d;
-            p_dist = dist_j;
-            last = change;
-            dist_j += hn;
-            dh_t = nt;
-            dh_d = nd;
-            Trig<double> *x = prv;
-            prv = cur;
-            cur = nxt;
-            nxt = x;
-        }
-        if (bail) {
-            /* the loop below, at the start of iteration it, the evaluation
-            ** at cur made */
-            it0 = it;
-            gp = cur;
-            d0t = dt;
-            d0d = dd;
-            have_d = true;
-            if (it == 0) {
-                bp = cur;
-                best_change = last_change = 1e300;
-                b_dt = b_dd = b_ht = b_hd = b_dist = 0;
-            } else {
-                bp = prv;
-                best_change = last_change = last;
-                b_dt = p_dt;
-                b_dd = p_dd;
-                b_ht = p_ht;
-                b_hd = p_hd;
-                b_dist = p_dist;
-            }
-            best_reachable = true;
-        } else if (bail_next) {
-            /* the loop below, at the start of iteration it + 1, as it
-            ** leaves a step the bound cannot follow (dist_j = 1e300): the
-            ** point at cur the best, the next point at nxt */
-            it0 = it + 1;
-            bp = cur;
-            best_change = last_change = change;
-            b_dt = dt;
-            b_dd = dd;
-            b_ht = dh_t;
-            b_hd = dh_d;
-            b_dist = dist_j;
-            best_reachable = true;
-            dist_j = 1e300;
-            gp = nxt;
-            dh_t = s_nt;
-            dh_d = s_nd;
-        }
+/* One evaluation of D at g (counted in used); J with the first.  (D
+** through locals: the evaluations are calls, and a Branch or Lean whose
+** address reached one would live in memory, not in registers.) */
+PM_HOT void evaluate(Branch *s, const Trig<double> &g, double *dt_out, double *dd_out)
+{
+    double dt, dd;
+    s->used++;
+    if (s->have_j) {
+        aniso<double>(s->m, *s->k, g, s->ctx, &dt, &dd);
     } else {
-        last_change = best_change = 1e300;
-        best_reachable = reachable;
-        b_dt = b_dd = b_ht = b_hd = b_dist = 0;
+        aniso_jac(s->m, *s->k, g, s->ctx, &dt, &dd, s->J);
+        s->have_j = true;
+        s->dist_j = 0;
     }
-    if (!lean_done) {
-        for (int it = it0; !converged; it++) {
-            double dt, dd;
-            if (have_d) {
-                dt = d0t;
-                dd = d0d;
-                have_d = false;
-            } else {
-                if (used >= PM_INVERT_MAX_FIXED)
-                    break;
-                used++;
-                if (have_j) {
-                    aniso<double>(m, k, *gp, ctx, &dt, &dd);
-                } else {
-                    aniso_jac(m, k, *gp, ctx, &dt, &dd, J);
-                    have_j = true;
-                    dist_j = 0;
-                }
-            }
-            if (!finite(dt * dt + dd * dd))
-                break; /* the forward model overflows here: not converged */
-            change = m_sqrt((dt - dh_t) * (dt - dh_t) + (dd - dh_d) * (dd - dh_d));
-            if (change < best_change) {
-                best_change = change;
-                bp = gp;
-                best_reachable = reachable;
-                b_dt = dt;
-                b_dd = dd;
-                b_ht = dh_t;
-                b_hd = dh_d;
-                b_dist = dist_j;
-            }
-            if (change <= PM_INVERT_TOL * 0.5) {
-                converged = true;
-                break;
-            }
-            if (it > 0 && change > 0.5 * last_change) {
-                /* not contracting: where the steps were Newton's on D (with
-                ** J from the first evaluation: a term that varies fast makes J
-                ** a poor guide), plain fixed-point steps from the best point;
-                ** else Newton on the forward model takes over */
-                if (!(chord && have_n))
-                    break;
-                chord = false;
-                gp = bp;
-                reachable = best_reachable;
-                dt = b_dt;
-                dd = b_dd;
-                dh_t = b_ht;
-                dh_d = b_hd;
-                dist_j = b_dist;
-                change = best_change;
-            }
-            last_change = change;
-            double nt = dt, nd = dd, ht, hd;
-            if (!tried_n) { /* (F_D once, where the first step needs it) */
-                tried_n = true;
-                have_n = newton_prep(k, *gp, dh_t, dh_d, J, Ni);
-            }
-            if (chord && have_n && change <= 0.01) {
-                nt = dh_t + (Ni[0] * (dt - dh_t) + Ni[1] * (dd - dh_d));
-                nd = dh_d + (Ni[2] * (dt - dh_t) + Ni[3] * (dd - dh_d));
-            }
-            Trig<double> *g2p = &slot[0];
-            while (g2p == gp || g2p == bp)
-                g2p++;
-            reachable = iso_inverse<double>(k, tg, nt, nd, side, g2p);
-            if (raw)
-                on_turn(m, k, a, g2p, ref_t, ref_d);
-            if (lip2 >= 0 && small_step(*g2p, *gp, &ht, &hd)) {
-                double h2 = ht * ht + hd * hd, hn = m_sqrt(h2) * (1 + h2 * 0.2);
-                /* (the second-order part alone first: it fails most steps) */
-                if (!(lip2 * (dist_j + 0.5 * hn) * hn > PM_INVERT_TOL * 0.5) &&
-                    step_bound(dt, dd, J, ht, hd, nt, nd, lip2, dist_j, hn) <=
-                        PM_INVERT_TOL * 0.5) {
-                    bp = g2p;
-                    best_reachable = reachable;
-                    converged = true;
-                    break;
-                }
-                dist_j += hn;
-            } else {
-                dist_j = 1e300; /* (a bound fails from here on: J is not evaluated again) */
-            }
-            gp = g2p;
-            dh_t = nt;
-            dh_d = nd;
-        }
-    }
-    Trig<double> &gb = *bp;
-    reachable = best_reachable;
-    if (!raw)
-        on_turn(m, k, a, &gb, ref_t, ref_d);
+    *dt_out = dt;
+    *dd_out = dd;
+}
 
+/* The Newton step on D from D = (dt, dd) at D^: the next D^ (chord). */
+PM_HOT void chord_step(const Branch *s, double dt, double dd, double *nt, double *nd)
+{
+    const double *Ni = s->Ni;
+    *nt = s->dh_t + (Ni[0] * (dt - s->dh_t) + Ni[1] * (dd - s->dh_d));
+    *nd = s->dh_d + (Ni[2] * (dt - s->dh_t) + Ni[3] * (dd - s->dh_d));
+}
+
+/* A bound on the length in angle of the step whose sines are (ht, hd). */
+PM_HOT double step_len(double ht, double hd)
+{
+    const double h2 = ht * ht + hd * hd;
+    return m_sqrt(h2) * (1 + h2 * 0.2);
+}
+
+/* The predicted stop for the step (ht, hd) of length hn to D^ = (nt, nd)
+** from D = (dt, dd): the second-order part alone first (it fails most
+** steps), then the whole bound (step_bound). */
+PM_HOT bool predicted_stop(const Branch *s, double dt, double dd, double ht, double hd,
+                           double nt, double nd, double hn)
+{
+    return !(s->lip2 * (s->dist_j + 0.5 * hn) * hn > PM_INVERT_TOL * 0.5) &&
+           step_bound(dt, dd, s->J, ht, hd, nt, nd, s->lip2, s->dist_j, hn) <=
+               PM_INVERT_TOL * 0.5;
+}
+
+/* How the lean loop hands over where it is not done: the general loop
+** takes over at the start of this iteration (bail) or of the next
+** (bail_next). */
+enum LeanEnd { LEAN_BAIL, LEAN_BAIL_NEXT };
+
+/* The lean loop's own state: the current point, the previous one (the
+** best so far: while the steps contract the best point is the current
+** one's predecessor or itself), the next; D at the current point; the
+** previous point's miss, D, D^ and distance; the step's D^ (bail_next). */
+struct Lean {
+    Trig<double> *cur, *prv, *nxt;
+    double dt, dd, last;
+    double p_dt, p_dd, p_ht, p_hd, p_dist;
+    double s_nt, s_nd;
+    int it;
+};
+
+/* The loop below (hand_over) in the state bail_next leaves: the general
+** loop at the start of iteration it + 1, as it leaves a step the bound
+** cannot follow (dist_j = 1e300): the point at cur the best, the next
+** point at nxt. */
+PM_HOT void hand_over_next(Branch *s, const Lean *L)
+{
+    s->it0 = L->it + 1;
+    s->bp = L->cur;
+    s->best_change = s->last_change = s->change;
+    s->b_dt = L->dt;
+    s->b_dd = L->dd;
+    s->b_ht = s->dh_t;
+    s->b_hd = s->dh_d;
+    s->b_dist = s->dist_j;
+    s->best_reachable = true;
+    s->dist_j = 1e300;
+    s->gp = L->nxt;
+    s->dh_t = L->s_nt;
+    s->dh_d = L->s_nd;
+}
+
+/* The general loop's state where the lean loop ends with `end` (bail or
+** bail_next).  Bail: the general loop at the start of iteration it, the
+** evaluation at cur made, the previous point the best (none at it = 0). */
+PM_HOT void hand_over(Branch *s, const Lean *L, LeanEnd end)
+{
+    if (end == LEAN_BAIL_NEXT) {
+        hand_over_next(s, L);
+        return;
+    }
+    s->it0 = L->it;
+    s->gp = L->cur;
+    s->d0t = L->dt;
+    s->d0d = L->dd;
+    s->have_d = true;
+    if (L->it == 0) {
+        s->bp = L->cur;
+        s->best_change = s->last_change = 1e300;
+        s->b_dt = s->b_dd = s->b_ht = s->b_hd = s->b_dist = 0;
+    } else {
+        s->bp = L->prv;
+        s->best_change = s->last_change = L->last;
+        s->b_dt = L->p_dt;
+        s->b_dd = L->p_dd;
+        s->b_ht = L->p_ht;
+        s->b_hd = L->p_hd;
+        s->b_dist = L->p_dist;
+    }
+    s->best_reachable = true;
+}
+
+/* The lean loop certifies point p (converged, the best point). */
+PM_HOT void lean_stop(Branch *s, Trig<double> *p)
+{
+    s->bp = p;
+    s->best_reachable = true;
+    s->converged = true;
+}
+
+/* The lean loop's step taken: the current point (D = (dt, dd)) becomes
+** the previous one, the best so far; the next point, at D^ = (nt, nd) a
+** step hn from it, the current one. */
+PM_HOT void lean_advance(Branch *s, Lean *L, double dt, double dd, double nt, double nd,
+                         double hn)
+{
+    L->p_dt = dt;
+    L->p_dd = dd;
+    L->p_ht = s->dh_t;
+    L->p_hd = s->dh_d;
+    L->p_dist = s->dist_j;
+    L->last = s->change;
+    s->dist_j += hn;
+    s->dh_t = nt;
+    s->dh_d = nd;
+    Trig<double> *x = L->prv;
+    L->prv = L->cur;
+    L->cur = L->nxt;
+    L->nxt = x;
+}
+
+/* The typical call (far from the mount's pole, a small anisotropic
+** displacement): every Newton step on D contracts, and the predicted stop
+** certifies a point within PM_INVERT_MAX_FIXED evaluations.  The same
+** operations and decisions as the general loop, without its bookkeeping
+** for the other cases: while the steps contract the best point is the
+** current one.  At the first event of another kind (no contraction, no
+** Newton step, a step beyond the closed form's reach, an overflow) the
+** general loop takes over at the start of that iteration, with the
+** evaluation made (have_d) and the state it would have had; after a step
+** beyond 0.01 rad (small_step), at the start of the next one.  True where
+** the lean loop is done (the general loop is not needed). */
+PM_HOT bool lean_loop(Branch *s)
+{
+    Lean L;
+    L.cur = &s->slot[0];
+    L.prv = &s->slot[1];
+    L.nxt = &s->slot[2];
+    L.dt = s->d0t;
+    L.dd = s->d0d;
+    L.last = 1e300;
+    L.p_dt = L.p_dd = L.p_ht = L.p_hd = L.p_dist = 0;
+    L.s_nt = L.s_nd = 0;
+    LeanEnd end = LEAN_BAIL;
+    for (L.it = 0;; L.it++) {
+        if (!s->have_d) {
+            if (s->used >= PM_INVERT_MAX_FIXED) {
+                /* (the general loop would stop here, with the best point) */
+                s->bp = L.prv;
+                s->best_reachable = true;
+                return true;
+            }
+            evaluate(s, *L.cur, &L.dt, &L.dd);
+        }
+        s->have_d = false;
+        const double dt = L.dt, dd = L.dd;
+        if (!finite(dt * dt + dd * dd)) {
+            end = LEAN_BAIL;
+            break;
+        }
+        s->change = m_sqrt((dt - s->dh_t) * (dt - s->dh_t) + (dd - s->dh_d) * (dd - s->dh_d));
+        if (s->change <= PM_INVERT_TOL * 0.5) {
+            lean_stop(s, L.cur);
+            return true;
+        }
+        if (L.it > 0 && s->change > 0.5 * L.last) {
+            end = LEAN_BAIL;
+            break;
+        }
+        if (!s->tried_n) {
+            s->tried_n = true;
+            s->have_n = s->start ? newton_prep(*s->k, *L.cur, s->dh_t, s->dh_d, s->J, s->Ni)
+                                 : newton_prep0(*s->k, *L.cur, s->J, s->Ni); /* (D^ = 0) */
+        }
+        if (!(s->have_n && s->change <= 0.01)) {
+            end = LEAN_BAIL;
+            break;
+        }
+        double nt, nd, ht, hd;
+        chord_step(s, dt, dd, &nt, &nd);
+        if (!iso_inverse<double>(*s->k, *s->tg, nt, nd, s->side, L.nxt)) {
+            end = LEAN_BAIL;
+            break;
+        }
+        if (!small_step(*L.nxt, *L.cur, &ht, &hd)) {
+            /* a step beyond 0.01 rad: no bound from here on, the general
+            ** loop takes over after it */
+            L.s_nt = nt;
+            L.s_nd = nd;
+            end = LEAN_BAIL_NEXT;
+            break;
+        }
+        const double hn = step_len(ht, hd);
+        if (predicted_stop(s, dt, dd, ht, hd, nt, nd, hn)) {
+            lean_stop(s, L.nxt);
+            return true;
+        }
+        lean_advance(s, &L, dt, dd, nt, nd, hn);
+    }
+    hand_over(s, &L, end);
+    return false;
+}
+
+/* Not contracting (general_loop): where the steps were Newton's on D
+** (with J from the first evaluation: a term that varies fast makes J a
+** poor guide), plain fixed-point steps from the best point, its D in
+** (dt, dd); false where they were plain already or had no Newton step
+** (Newton on the forward model takes over). */
+PM_HOT bool fall_back(Branch *s, double *dt, double *dd)
+{
+    if (!(s->chord && s->have_n))
+        return false;
+    s->chord = false;
+    s->gp = s->bp;
+    s->reachable = s->best_reachable;
+    *dt = s->b_dt;
+    *dd = s->b_dd;
+    s->dh_t = s->b_ht;
+    s->dh_d = s->b_hd;
+    s->dist_j = s->b_dist;
+    s->change = s->best_change;
+    return true;
+}
+
+/* The general loop's step from *gp, where D = (dt, dd): the next D^ (the
+** chord step, or the plain fixed-point step D^' = D), its point in a free
+** slot, the predicted stop.  True where that stops the iteration
+** (converged). */
+PM_HOT bool general_next(Branch *s, double dt, double dd)
+{
+    double nt = dt, nd = dd, ht, hd;
+    if (!s->tried_n) { /* (F_D once, where the first step needs it) */
+        s->tried_n = true;
+        s->have_n = newton_prep(*s->k, *s->gp, s->dh_t, s->dh_d, s->J, s->Ni);
+    }
+    if (s->chord && s->have_n && s->change <= 0.01)
+        chord_step(s, dt, dd, &nt, &nd);
+    Trig<double> *g2p = &s->slot[0];
+    while (g2p == s->gp || g2p == s->bp)
+        g2p++;
+    s->reachable = iso_inverse<double>(*s->k, *s->tg, nt, nd, s->side, g2p);
+    if (s->raw)
+        on_turn(s->m, *s->k, *s->a, g2p, s->ref_t, s->ref_d);
+    if (s->lip2 >= 0 && small_step(*g2p, *s->gp, &ht, &hd)) {
+        const double hn = step_len(ht, hd);
+        if (predicted_stop(s, dt, dd, ht, hd, nt, nd, hn)) {
+            s->bp = g2p;
+            s->best_reachable = s->reachable;
+            s->converged = true;
+            return true;
+        }
+        s->dist_j += hn;
+    } else {
+        s->dist_j = 1e300; /* (a bound fails from here on: J is not evaluated again) */
+    }
+    s->gp = g2p;
+    s->dh_t = nt;
+    s->dh_d = nd;
+    return false;
+}
+
+/* The point *gp, where D = (dt, dd), the best so far (general_loop). */
+PM_HOT void keep_best(Branch *s, double dt, double dd)
+{
+    s->best_change = s->change;
+    s->bp = s->gp;
+    s->best_reachable = s->reachable;
+    s->b_dt = dt;
+    s->b_dd = dd;
+    s->b_ht = s->dh_t;
+    s->b_hd = s->dh_d;
+    s->b_dist = s->dist_j;
+}
+
+/* The general loop, from iteration it0: the fixed point with its best
+** point kept, plain steps where the chord does not contract.  Each
+** iteration: D at *gp (evaluated, or the lean loop's), the best point so
+** far, the measured stop, the contraction (else fall_back), the step
+** (general_next).  It stops converged, out of evaluations, at an overflow
+** or with no contraction left.  (One loop, as the lean one: see above.) */
+PM_HOT void general_loop(Branch *s)
+{
+    for (int it = s->it0; !s->converged; it++) {
+        double dt, dd;
+        if (s->have_d) {
+            dt = s->d0t;
+            dd = s->d0d;
+            s->have_d = false;
+        } else {
+            if (s->used >= PM_INVERT_MAX_FIXED)
+                break;
+            evaluate(s, *s->gp, &dt, &dd);
+        }
+        if (!finite(dt * dt + dd * dd))
+            break; /* the forward model overflows here: not converged */
+        s->change = m_sqrt((dt - s->dh_t) * (dt - s->dh_t) + (dd - s->dh_d) * (dd - s->dh_d));
+        if (s->change < s->best_change)
+            keep_best(s, dt, dd);
+        if (s->change <= PM_INVERT_TOL * 0.5) {
+            s->converged = true;
+            break;
+        }
+        if (it > 0 && s->change > 0.5 * s->last_change && !fall_back(s, &dt, &dd))
+            break;
+        s->last_change = s->change;
+        if (general_next(s, dt, dd))
+            break;
+    }
+}
+
+/* Are the angles (t, d), the best point's rounded to doubles, safe to
+** return without a check?  The fixed point judged the position before
+** its angles were rounded (atan2, the turn), with PM_INVERT_TOL / 2 to
+** spare.  The rounding (a few ulp of the larger angle) moves the model's
+** position by up to 1 + lip times as much; where that could use the
+** margin, Newton checks the round trip at the returned angles themselves
+** (pm.h, pm_model_invert Note 4). */
+PM_HOT bool rounding_safe(const Branch *s, const Trig<double> &gb, double t, double d)
+{
+    const pm_model *m = s->m;
+    double big = m_fabs(t) > m_fabs(d) ? m_fabs(t) : m_fabs(d);
+    double lip = m->lip;
+    bool sided = false;
+    for (int i = m->n_base; i < m->n_terms; i++) {
+        if (m->term[i].kind == PM_TERM_AUX) /* (ctx checked by eval_ready) */
+            lip += m_fabs(m->coef[i] * (aux_input(s->ctx, m->term[i].aux) - m->term[i].param)) *
+                   2;
+        sided = sided || m->term[i].side != 0;
+    }
+    /* (the AUX terms' part of lip is twice their largest displacement:
+    ** beyond 0.5 rad, as for lipschitz(), every inverse is checked) */
+    if (!((1 + lip) * 8 * DBL_EPS * (big > 1 ? big : 1) <= 0.5 * PM_INVERT_TOL) ||
+        !(lip - m->lip <= 1))
+        return false;
+    /* A term restricted to one side of the pole jumps at the pole's edge;
+    ** where rounding the angles moved the point across it, the returned
+    ** angles evaluate a different model: Newton checks them. */
+    return !(sided && !(s->ctx && s->ctx->pier) &&
+             side_at(*s->k, gb) != side_at(*s->k, trig_of(t, d)));
+}
+
+/* The result from the best point: its angles, checked by Newton (newton)
+** where the iteration did not converge, the closed form did not reach
+** the target, the point is not on the side wanted or rounding could
+** matter (rounding_safe). */
+PM_HOT pm_status finish_branch(Branch *s, int want, const double *turn, double *t_out,
+                               double *d_out, double *err_out)
+{
+    Trig<double> &gb = *s->bp;
+    const bool reachable = s->best_reachable;
+    if (!s->raw)
+        on_turn(s->m, *s->k, *s->a, &gb, s->ref_t, s->ref_d);
     double t = gb.t; /* on the turn of ref_t, ref_d (on_turn) */
     double d = gb.d;
-    /* The fixed point judged the position before its angles were rounded
-    ** to doubles (atan2, the turn), with PM_INVERT_TOL / 2 to spare.  The
-    ** rounding (a few ulp of the larger angle) moves the model's position
-    ** by up to 1 + lip times as much; where that could use the margin,
-    ** Newton checks the round trip at the returned angles themselves
-    ** (pm.h, pm_model_invert Note 4). */
-    if (converged) {
-        double big = m_fabs(t) > m_fabs(d) ? m_fabs(t) : m_fabs(d);
-        double lip = m->lip;
-        bool sided = false;
-        for (int i = m->n_base; i < m->n_terms; i++) {
-            if (m->term[i].kind == PM_TERM_AUX) /* (ctx checked by eval_ready) */
-                lip += m_fabs(m->coef[i] * (aux_input(ctx, m->term[i].aux) -
-                                            m->term[i].param)) * 2;
-            sided = sided || m->term[i].side != 0;
-        }
-        /* (the AUX terms' part of lip is twice their largest displacement:
-        ** beyond 0.5 rad, as for lipschitz(), every inverse is checked) */
-        if (!((1 + lip) * 8 * DBL_EPS * (big > 1 ? big : 1) <= 0.5 * PM_INVERT_TOL) ||
-            !(lip - m->lip <= 1))
-            converged = false;
-        /* A term restricted to one side of the pole jumps at the pole's
-        ** edge; where rounding the angles moved the point across it, the
-        ** returned angles evaluate a different model: Newton checks them. */
-        else if (sided && !(ctx && ctx->pier) && side_at(k, gb) != side_at(k, trig_of(t, d)))
-            converged = false;
-    }
+    bool converged = s->converged && rounding_safe(s, gb, t, d);
     pm_status result = PM_OK;
     double err = 0;
-    if (!converged || !reachable || (want && side_of(m, d) != want)) {
-        result = newton(m, k, ctx, a, turn, &t, &d, &err, want,
-                        PM_INVERT_MAX_FIXED + PM_INVERT_MAX_NEWTON - used);
+    if (!converged || !reachable || (want && side_of(s->m, d) != want)) {
+        result = newton(s->m, *s->k, s->ctx, *s->a, turn, &t, &d, &err, want,
+                        PM_INVERT_MAX_FIXED + PM_INVERT_MAX_NEWTON - s->used);
         if (result != PM_OK && !reachable)
             result = PM_WARN_UNREACHABLE;
     }
@@ -1096,6 +1263,61 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
     *d_out = d;
     *err_out = err;
     return result;
+}
+
+/* Solve on one branch of the closed form (side = +1/-1), or from the start
+** position's branch, with the angles on the turn the result is returned
+** on (turn_of).  Returns the status, (t, d) and the miss at (t, d) (0 for
+** PM_OK: below PM_INVERT_TOL).  The fixed point (Branch) by the lean loop
+** where the typical iteration applies, the general loop where it does not
+** or from where it ends; Newton on the forward model where neither
+** certifies a point (finish_branch). */
+pm_status solve_branch(const pm_model *m, const Iso<double> &k,
+                       const pm_context *ctx, const Aim &a, int side, int want,
+                       const double *start,
+                       const double *turn, double *t_out, double *d_out, double *err_out)
+{
+    const Target<double> tg = target_of(k, a.q);
+    Trig<double> slot[3];
+    double J[4], Ni[4];
+    Branch s;
+    s.m = m;
+    s.k = &k;
+    s.ctx = ctx;
+    s.a = &a;
+    s.tg = &tg;
+    s.start = start;
+    /* Periodic terms of non-integer G read the raw angle itself, not only
+    ** its sine and cosine: iterate with the angles on the returned turn
+    ** (on_turn at every point), else once, at the end. */
+    s.ref_t = turn[0];
+    s.ref_d = turn[1];
+    s.raw = reads_raw_angles(m);
+    s.lip2 = lip2_at(m, ctx, s.raw);
+    s.side = side;
+    s.slot = slot;
+    s.J = J;
+    s.Ni = Ni;
+    s.dh_t = s.dh_d = s.d0t = s.d0d = s.dist_j = 0;
+    s.used = 0;
+    s.have_j = s.have_n = s.tried_n = s.have_d = false;
+    first_point(&s);
+    s.change = 0;
+    s.converged = false;
+    s.chord = true;
+    s.it0 = 0;
+    s.gp = s.bp = &slot[0];
+    bool lean_done = false;
+    if (s.reachable && s.lip2 >= 0 && !iso_only(m)) {
+        lean_done = lean_loop(&s);
+    } else {
+        s.last_change = s.best_change = 1e300;
+        s.best_reachable = s.reachable;
+        s.b_dt = s.b_dd = s.b_ht = s.b_hd = s.b_dist = 0;
+    }
+    if (__builtin_expect(!lean_done, 0)) /* (the typical call is done) */
+        general_loop(&s);
+    return finish_branch(&s, want, turn, t_out, d_out, err_out);
 }
 
 /* The pole rescue's parametrisation: at encoder hour angle t (st, ct its
