@@ -1359,6 +1359,95 @@ __attribute__((noinline)) double bracket_root(double y0, double y1, double y2, i
     return r;
 }
 
+/* What pole_rescue learns from the ring of hour angles round the mount's
+** pole: the edge points (Newton's starts, by miss), each ring point's
+** displacement and miss E, and the brackets of E's sign changes on the
+** requested side (their start, by the smaller |E| of their ends). */
+struct PoleScan {
+    NPoint edge[PM_INVERT_POLE_RUNS + 1];
+    int n_edge;
+    double sa[PM_INVERT_POLE_STARTS], sb[PM_INVERT_POLE_STARTS], se[PM_INVERT_POLE_STARTS];
+    double bt[PM_INVERT_POLE_RUNS], bd[PM_INVERT_POLE_RUNS], bs[PM_INVERT_POLE_RUNS];
+    int n_b;
+};
+
+/* The ring: PM_INVERT_POLE_STARTS hour angles, d(t_j) for no displacement
+** (ring_point), one evaluation there (the displacement D_j and the miss,
+** kept sorted by miss in ps->edge), E(t_j) again with D_j. */
+inline void pole_ring(const pm_model *m, const Iso<double> &k, const pm_context *ctx,
+                      const Frame &f, const V3<double> &q0, const double *turn, PoleScan *ps)
+{
+    const double step = 2 * PI / PM_INVERT_POLE_STARTS;
+    ps->n_edge = 0;
+    for (int j = 0; j < PM_INVERT_POLE_STARTS; j++) {
+        double tj = -PI + step * (j + 0.5), st, ct, sdp, cdp;
+        sincos_d(tj, &st, &ct);
+        ring_point(k, q0, st, ct, 0.0, 0.0, &sdp, &cdp);
+        double dj = m_atan2(sdp, cdp) + m->coef[4];
+        finish_angles(turn, &tj, &dj);
+        int i = ps->n_edge < PM_INVERT_POLE_RUNS ? ps->n_edge++ : PM_INVERT_POLE_RUNS;
+        NPoint *edge = ps->edge;
+        newton_point(m, k, ctx, f, tj, dj, &edge[i]);
+        ps->sa[j] = edge[i].da;
+        ps->sb[j] = edge[i].db;
+        ps->se[j] = ring_point(k, q0, st, ct, ps->sa[j], ps->sb[j], &sdp, &cdp);
+        if (!finite(ps->se[j]))
+            ps->se[j] = 0;
+        for (; i > 0 && (edge[i].err < edge[i - 1].err || !(edge[i - 1].err >= 0)); i--) {
+            NPoint x = edge[i];
+            edge[i] = edge[i - 1];
+            edge[i - 1] = x;
+        }
+    }
+}
+
+/* The brackets on the side requested, by the smaller |E| of their ends (a
+** solution near a point where the displacement was evaluated). */
+inline void pole_brackets(const pm_model *m, const Iso<double> &k, const V3<double> &q0,
+                          const double *turn, int side, PoleScan *ps)
+{
+    const double step = 2 * PI / PM_INVERT_POLE_STARTS;
+    const double *se = ps->se, *sa = ps->sa, *sb = ps->sb;
+    ps->n_b = 0;
+    for (int j = 0; j < PM_INVERT_POLE_STARTS; j++) {
+        const int jn = (j + 1) % PM_INVERT_POLE_STARTS;
+        const double e0 = se[j], e1 = se[jn];
+        if (e0 * e1 > 0)
+            continue;
+        /* the root in [0, 1] of the parabolas through the bracket and
+        ** either neighbour (E varies with the displacement, by the
+        ** harmonics of t: a straight line misses roots near a turning
+        ** point), averaged */
+        const double em = se[(j + PM_INVERT_POLE_STARTS - 1) % PM_INVERT_POLE_STARTS],
+                     ep = se[(jn + 1) % PM_INVERT_POLE_STARTS];
+        const double w = 0.5 * (bracket_root(em, e0, e1, 0) + bracket_root(e0, e1, ep, 1));
+        double tj = -PI + step * (j + 0.5 + w), st, ct, sdp, cdp;
+        sincos_d(tj, &st, &ct);
+        ring_point(k, q0, st, ct, sa[j] + w * (sa[jn] - sa[j]), sb[j] + w * (sb[jn] - sb[j]),
+                   &sdp, &cdp);
+        double dj = m_atan2(sdp, cdp) + m->coef[4];
+        finish_angles(turn, &tj, &dj);
+        if (side_of(m, dj) != side)
+            continue;
+        const double sc = m_fabs(e0) < m_fabs(e1) ? m_fabs(e0) : m_fabs(e1);
+        int i;
+        if (ps->n_b < PM_INVERT_POLE_RUNS)
+            i = ps->n_b++;
+        else if (sc < ps->bs[PM_INVERT_POLE_RUNS - 1])
+            i = PM_INVERT_POLE_RUNS - 1; /* (replaces the last) */
+        else
+            continue;
+        for (; i > 0 && sc < ps->bs[i - 1]; i--) {
+            ps->bt[i] = ps->bt[i - 1];
+            ps->bd[i] = ps->bd[i - 1];
+            ps->bs[i] = ps->bs[i - 1];
+        }
+        ps->bt[i] = tj;
+        ps->bd[i] = dj;
+        ps->bs[i] = sc;
+    }
+}
+
 /* The pole rescue of pm_model_invert (pm.h, Note 2), after both branches
 ** failed to give a PM_OK point on the requested side: (t, d, err) the
 ** first branch's point and status `result`, (t2, d2, err2) the second's
@@ -1398,93 +1487,30 @@ __attribute__((noinline)) pm_status pole_rescue(const pm_model *m, const Iso<dou
     ** d(t) that turns the pointing into the plane of the target and the
     ** polar axis (exact, ring_point) leaves one equation, E(t) = 0 (the
     ** pointing's miss along the declination axis), on the circle of hour
-    ** angles.  PM_INVERT_POLE_STARTS points round it: d(t_j) for no
-    ** displacement, one evaluation there (the displacement D_j, the
-    ** miss), d(t_j) and E(t_j) again with D_j.  A change of sign of E
-    ** between neighbours brackets a solution (the displacement changes
-    ** little between them): the interpolated hour angle and displacement
-    ** give a start close to it, on the side requested.  Newton runs from
-    ** the best bracket and then from the points with the smallest miss,
+    ** angles (pole_ring).  A change of sign of E between neighbours
+    ** brackets a solution (the displacement changes little between them):
+    ** the interpolated hour angle and displacement give a start close to
+    ** it, on the side requested (pole_brackets).  Newton runs from the best
+    ** bracket and then from the points with the smallest miss,
     ** PM_INVERT_POLE_RUNS runs in all. */
-    const double step = 2 * PI / PM_INVERT_POLE_STARTS;
-    NPoint edge[PM_INVERT_POLE_RUNS + 1];
-    double sa[PM_INVERT_POLE_STARTS], sb[PM_INVERT_POLE_STARTS], se[PM_INVERT_POLE_STARTS];
-    int n_edge = 0;
-    for (int j = 0; j < PM_INVERT_POLE_STARTS; j++) {
-        double tj = -PI + step * (j + 0.5), st, ct, sdp, cdp;
-        sincos_d(tj, &st, &ct);
-        ring_point(k, q0, st, ct, 0.0, 0.0, &sdp, &cdp);
-        double dj = m_atan2(sdp, cdp) + m->coef[4];
-        finish_angles(turn, &tj, &dj);
-        int i = n_edge < PM_INVERT_POLE_RUNS ? n_edge++ : PM_INVERT_POLE_RUNS;
-        newton_point(m, k, ctx, f, tj, dj, &edge[i]);
-        sa[j] = edge[i].da;
-        sb[j] = edge[i].db;
-        se[j] = ring_point(k, q0, st, ct, sa[j], sb[j], &sdp, &cdp);
-        if (!finite(se[j]))
-            se[j] = 0;
-        for (; i > 0 && (edge[i].err < edge[i - 1].err || !(edge[i - 1].err >= 0)); i--) {
-            NPoint x = edge[i];
-            edge[i] = edge[i - 1];
-            edge[i - 1] = x;
-        }
-    }
-    /* the brackets on the side requested, by the smaller |E| of their ends
-    ** (a solution near a point where the displacement was evaluated) */
-    double bt[PM_INVERT_POLE_RUNS], bd[PM_INVERT_POLE_RUNS], bs[PM_INVERT_POLE_RUNS];
-    int n_b = 0;
-    for (int j = 0; j < PM_INVERT_POLE_STARTS; j++) {
-        const int jn = (j + 1) % PM_INVERT_POLE_STARTS;
-        const double e0 = se[j], e1 = se[jn];
-        if (e0 * e1 > 0)
-            continue;
-        /* the root in [0, 1] of the parabolas through the bracket and
-        ** either neighbour (E varies with the displacement, by the
-        ** harmonics of t: a straight line misses roots near a turning
-        ** point), averaged */
-        const double em = se[(j + PM_INVERT_POLE_STARTS - 1) % PM_INVERT_POLE_STARTS],
-                     ep = se[(jn + 1) % PM_INVERT_POLE_STARTS];
-        const double w = 0.5 * (bracket_root(em, e0, e1, 0) + bracket_root(e0, e1, ep, 1));
-        double tj = -PI + step * (j + 0.5 + w), st, ct, sdp, cdp;
-        sincos_d(tj, &st, &ct);
-        ring_point(k, q0, st, ct, sa[j] + w * (sa[jn] - sa[j]), sb[j] + w * (sb[jn] - sb[j]),
-                   &sdp, &cdp);
-        double dj = m_atan2(sdp, cdp) + m->coef[4];
-        finish_angles(turn, &tj, &dj);
-        if (side_of(m, dj) != side)
-            continue;
-        const double sc = m_fabs(e0) < m_fabs(e1) ? m_fabs(e0) : m_fabs(e1);
-        int i;
-        if (n_b < PM_INVERT_POLE_RUNS)
-            i = n_b++;
-        else if (sc < bs[PM_INVERT_POLE_RUNS - 1])
-            i = PM_INVERT_POLE_RUNS - 1; /* (replaces the last) */
-        else
-            continue;
-        for (; i > 0 && sc < bs[i - 1]; i--) {
-            bt[i] = bt[i - 1];
-            bd[i] = bd[i - 1];
-            bs[i] = bs[i - 1];
-        }
-        bt[i] = tj;
-        bd[i] = dj;
-        bs[i] = sc;
-    }
+    PoleScan ps;
+    pole_ring(m, k, ctx, f, q0, turn, &ps);
+    pole_brackets(m, k, q0, turn, side, &ps);
     for (int r = 0; r < PM_INVERT_POLE_RUNS && !found; r++) {
         double tj, dj, ej;
         pm_status sj;
-        if (r < n_b) {
-            tj = bt[r];
-            dj = bd[r];
+        if (r < ps.n_b) {
+            tj = ps.bt[r];
+            dj = ps.bd[r];
             sj = newton(m, k, ctx, a, turn, &tj, &dj, &ej, side, PM_INVERT_POLE_NEWTON);
         } else {
-            const int e = r - n_b;
-            if (e >= n_edge || !(edge[e].err >= 0))
+            const int e = r - ps.n_b;
+            if (e >= ps.n_edge || !(ps.edge[e].err >= 0))
                 break;
-            tj = edge[e].t;
-            dj = edge[e].d;
+            tj = ps.edge[e].t;
+            dj = ps.edge[e].d;
             sj = newton(m, k, ctx, a, turn, &tj, &dj, &ej, side, PM_INVERT_POLE_NEWTON,
-                        &edge[e]);
+                        &ps.edge[e]);
         }
         if (side_of(m, dj) != side)
             continue;
