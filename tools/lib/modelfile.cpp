@@ -138,6 +138,200 @@ extern "C" int pmmodel_save(const char *path, const pm_model *m, const char *com
     return write_atomic(path, out, err, errlen);
 }
 
+namespace {
+
+// A model file being read (pmmodel_load): where it is, what it said so far.
+struct Loader {
+    enum State { HEADER, MOUNT, ORDER, TERMS, BODY, DONE } state = HEADER;
+    int lineno = 0, end_line = 0;
+    int mount = 0, version = 2;
+    long order = 0, nterms = 0;
+    int base = -1; // index of the first added term
+    int got = 0;   // terms read
+    double latitude = 0;
+    pm_model m;
+    std::vector<int> term_line; // line of each term, for the term-list check
+    Loader() { std::memset(&m, 0, sizeof m); }
+};
+
+// A version-1 file's anisotropic tilt term: it was evaluated at the
+// encoder reading, this version at the index-shifted position.
+std::string old_tilt(const std::string &name)
+{
+    return "term " + name + " of a 'pm-model 1' file: versions before 2 evaluated the "
+           "anisotropic tilt terms (k = 1, 2) at the encoder reading, this one at the "
+           "index-shifted position (docs/model.md, \"The tilt terms\"); the model would "
+           "point differently: refit the run and save it again";
+}
+
+// The header's lines, one state each: "" when the line is right, else why.
+std::string header_line(Loader &L, const std::vector<std::string> &tok)
+{
+    switch (L.state) {
+    case Loader::HEADER:
+        if (tok.size() != 2 || tok[0] != "pm-model")
+            return "expected 'pm-model 2' (is this a pm model file?)";
+        if (tok[1] != "1" && tok[1] != "2")
+            return "model file version '" + tok[1] + "' not supported (expected 2, or 1)";
+        L.version = tok[1] == "1" ? 1 : 2;
+        L.state = Loader::MOUNT;
+        return "";
+    case Loader::MOUNT:
+        if (tok.size() != 2 || tok[0] != "mount" || (tok[1] != "equatorial" && tok[1] != "altaz"))
+            return "expected 'mount equatorial' or 'mount altaz'";
+        L.mount = tok[1] == "altaz" ? PM_MOUNT_ALTAZ : PM_MOUNT_EQUATORIAL;
+        L.state = Loader::ORDER;
+        return "";
+    case Loader::ORDER:
+        if (tok.size() != 2 || tok[0] != "order" || !parse_int(tok[1], 0, 1000, &L.order))
+            return "expected 'order L' with an integer L >= 0";
+        if (L.order > PM_MAX_L)
+            return "model order " + std::to_string(L.order) + " exceeds this build's PM_MAX_L = " +
+                   std::to_string(PM_MAX_L) + " (rebuild with -DPM_MAX_L=" +
+                   std::to_string(L.order) + ")";
+        L.state = Loader::TERMS;
+        return "";
+    default: // TERMS
+        if (tok.size() == 2 && tok[0] == "latitude") {
+            if (!parse_double(tok[1], &L.latitude) || std::fabs(L.latitude) > 1.5707963267948966)
+                return "bad latitude '" + tok[1] + "' (expected radians, |lat| <= pi/2)";
+            return "";
+        }
+        if (tok.size() != 2 || tok[0] != "terms" || !parse_int(tok[1], 6, 100000, &L.nterms))
+            return "expected 'terms P' with an integer P >= 6";
+        if (L.nterms > PM_MAX_TERMS)
+            return std::to_string(L.nterms) + " terms exceed this build's capacity of " +
+                   std::to_string(PM_MAX_TERMS) + " (rebuild with -DPM_MAX_EXTRA=" +
+                   std::to_string(L.nterms - PM_SH_TERMS(PM_MAX_L)) + ")";
+        L.m.mount = L.mount;
+        L.m.order = (int)L.order;
+        L.m.n_terms = (int)L.nterms;
+        L.m.latitude = L.latitude;
+        L.state = Loader::BODY;
+        return "";
+    }
+}
+
+// xterm NAME KIND k l m side aux param value: an added term.
+std::string added_term(Loader &L, const std::vector<std::string> &tok)
+{
+    long k, l, mm, side, aux;
+    double v, param;
+    if (L.got >= L.nterms)
+        return "more terms than the header's " + std::to_string(L.nterms);
+    if (L.got < 6)
+        return "an added term (xterm) before the six isotropic terms";
+    int kind = kind_of(tok[2]);
+    if (kind < 0)
+        return "unknown term kind '" + tok[2] + "' (expected sh, fourier, sectoral, zenith or aux)";
+    if (!parse_int(tok[3], 0, 6, &k) || !parse_int(tok[4], -100, 100, &l) ||
+        !parse_int(tok[5], -100, 100, &mm) || !parse_int(tok[6], -1, 1, &side) ||
+        !parse_int(tok[7], 0, 255, &aux))
+        return "bad fields of an added term (expected xterm NAME KIND k l m side aux param value)";
+    if (!parse_double(tok[8], &param) || !parse_double(tok[9], &v))
+        return "bad parameter or value (expected finite numbers)";
+    if (L.version == 1 && (k == 1 || k == 2) && v != 0)
+        return old_tilt(tok[1]);
+    if (L.base < 0)
+        L.base = L.got;
+    pm_term &nt = L.m.term[L.got];
+    nt.kind = (unsigned char)kind;
+    nt.k = (unsigned char)k;
+    nt.l = (signed char)l;
+    nt.m = (signed char)mm;
+    nt.side = (signed char)side;
+    nt.aux = (unsigned char)aux;
+    nt.param = param;
+    L.m.coef[L.got] = v;
+    L.term_line.push_back(L.lineno);
+    L.got++;
+    return "";
+}
+
+// term NAME k l m value: a harmonic term (before any added term).
+std::string harmonic_term(Loader &L, const std::vector<std::string> &tok)
+{
+    long k, l, mm;
+    double v;
+    if (L.got >= L.nterms)
+        return "more terms than the header's " + std::to_string(L.nterms);
+    if (L.base >= 0)
+        return "a harmonic term after an added term (xterm lines come last)";
+    if (!parse_int(tok[2], 1, 6, &k) || !parse_int(tok[3], 0, L.order, &l) ||
+        !parse_int(tok[4], -l, l, &mm))
+        return "bad term indices '" + tok[2] + " " + tok[3] + " " + tok[4] +
+               "' (expected k in 1..6, l in 0..order, |m| <= l)";
+    if (!parse_double(tok[5], &v))
+        return "bad value '" + tok[5] + "' (expected a finite number, radians)";
+    if (L.version == 1 && (k == 1 || k == 2) && l >= 1 && v != 0)
+        return old_tilt(tok[1]);
+    L.m.term[L.got].kind = PM_TERM_SH;
+    L.m.term[L.got].k = (unsigned char)k;
+    L.m.term[L.got].l = (signed char)l;
+    L.m.term[L.got].m = (signed char)mm;
+    L.m.coef[L.got] = v;
+    L.term_line.push_back(L.lineno);
+    L.got++;
+    return "";
+}
+
+// One line of the file (not blank, not a comment): "" or why it is wrong.
+std::string file_line(Loader &L, const std::vector<std::string> &tok)
+{
+    if (L.state == Loader::DONE)
+        return "text after 'end'";
+    if (L.state != Loader::BODY)
+        return header_line(L, tok);
+    if (tok.size() == 1 && tok[0] == "end") {
+        if (L.got != L.nterms)
+            return "'end' after " + std::to_string(L.got) + " terms; the header says " +
+                   std::to_string(L.nterms);
+        L.end_line = L.lineno;
+        L.state = Loader::DONE;
+        return "";
+    }
+    if (tok.size() == 10 && tok[0] == "xterm")
+        return added_term(L, tok);
+    if (tok.size() != 6 || tok[0] != "term")
+        return "expected 'term NAME k l m value', 'xterm ...' or 'end'";
+    return harmonic_term(L, tok);
+}
+
+// The harmonic terms must be the set pm_model_init makes for the order, in
+// its order (pm.h: the first n_base terms are that set): "" or why not,
+// with L.lineno set to the line to blame (0: none).
+std::string check_term_list(Loader &L)
+{
+    const pm_model &m = L.m;
+    const long order = L.order;
+    pm_model ref;
+    if (pm_model_init(&ref, L.mount, (int)order) != PM_OK) {
+        L.lineno = 0;
+        return "cannot build the order-" + std::to_string(order) + " term list";
+    }
+    for (int i = 0; i < ref.n_terms || i < m.n_base; i++) {
+        if (i >= m.n_base || i >= ref.n_terms) {
+            L.lineno = i < m.n_base ? L.term_line[i] : (i < m.n_terms ? L.term_line[i] : L.end_line);
+            return "the term list does not match 'order " + std::to_string(order) +
+                   "': the order-" + std::to_string(order) + " model has " +
+                   std::to_string(ref.n_terms) + " harmonic terms, the file " +
+                   std::to_string(m.n_base) + " (expected the term lines pmfit writes)";
+        }
+        const pm_term &a = m.term[i], &b = ref.term[i];
+        if (a.k != b.k || a.l != b.l || a.m != b.m) {
+            L.lineno = L.term_line[i];
+            return "term " + std::to_string(i + 1) + " is k l m = " + std::to_string(a.k) + " " +
+                   std::to_string(a.l) + " " + std::to_string(a.m) + ", expected " +
+                   name_of(&ref, i) + " = " + std::to_string(b.k) + " " + std::to_string(b.l) +
+                   " " + std::to_string(b.m) + ": the term list does not match 'order " +
+                   std::to_string(order) + "' (expected the term lines pmfit writes)";
+        }
+    }
+    return "";
+}
+
+} // namespace
+
 extern "C" int pmmodel_load(const char *path, pm_model *out, char *err, size_t errlen)
 {
     if (!path || !out) {
@@ -151,31 +345,13 @@ extern "C" int pmmodel_load(const char *path, pm_model *out, char *err, size_t e
     }
     const size_t MAX_LINE = 4096;
     std::string line;
-    int lineno = 0;
+    Loader L;
     auto fail = [&](const std::string &msg) {
-        set_err(err, errlen, std::string(path) + ":" + std::to_string(lineno) + ": " + msg);
+        set_err(err, errlen, std::string(path) + ":" + std::to_string(L.lineno) + ": " + msg);
         return -1;
     };
-    enum { HEADER, MOUNT, ORDER, TERMS, BODY, DONE } state = HEADER;
-    int mount = 0;
-    long order = 0, nterms = 0;
-    int base = -1; // index of the first added term
-    double latitude = 0;
-    pm_model m;
-    std::memset(&m, 0, sizeof m);
-    int got = 0, version = 2;
-    std::vector<int> term_line; // line of each term, for the term-list check
-    // a version-1 file's anisotropic tilt term: it was evaluated at the
-    // encoder reading, this version at the index-shifted position
-    auto old_tilt = [](const std::string &name) {
-        return "term " + name + " of a 'pm-model 1' file: versions before 2 evaluated the "
-               "anisotropic tilt terms (k = 1, 2) at the encoder reading, this one at the "
-               "index-shifted position (docs/model.md, \"The tilt terms\"); the model would "
-               "point differently: refit the run and save it again";
-    };
-    int end_line = 0;
     for (int r; (r = read_line(in, line, MAX_LINE)) != 0;) {
-        lineno++;
+        L.lineno++;
         if (r < 0)
             return fail("line longer than " + std::to_string(MAX_LINE) + " bytes");
         if (line.find('\0') != std::string::npos)
@@ -189,157 +365,24 @@ extern "C" int pmmodel_load(const char *path, pm_model *out, char *err, size_t e
             tok.push_back(t);
         if (tok.empty() || tok[0][0] == '#')
             continue;
-        switch (state) {
-        case HEADER:
-            if (tok.size() != 2 || tok[0] != "pm-model")
-                return fail("expected 'pm-model 2' (is this a pm model file?)");
-            if (tok[1] != "1" && tok[1] != "2")
-                return fail("model file version '" + tok[1] + "' not supported (expected 2, or 1)");
-            version = tok[1] == "1" ? 1 : 2;
-            state = MOUNT;
-            break;
-        case MOUNT:
-            if (tok.size() != 2 || tok[0] != "mount" || (tok[1] != "equatorial" && tok[1] != "altaz"))
-                return fail("expected 'mount equatorial' or 'mount altaz'");
-            mount = tok[1] == "altaz" ? PM_MOUNT_ALTAZ : PM_MOUNT_EQUATORIAL;
-            state = ORDER;
-            break;
-        case ORDER:
-            if (tok.size() != 2 || tok[0] != "order" || !parse_int(tok[1], 0, 1000, &order))
-                return fail("expected 'order L' with an integer L >= 0");
-            if (order > PM_MAX_L)
-                return fail("model order " + std::to_string(order) +
-                            " exceeds this build's PM_MAX_L = " + std::to_string(PM_MAX_L) +
-                            " (rebuild with -DPM_MAX_L=" + std::to_string(order) + ")");
-            state = TERMS;
-            break;
-        case TERMS:
-            if (tok.size() == 2 && tok[0] == "latitude") {
-                if (!parse_double(tok[1], &latitude) || std::fabs(latitude) > 1.5707963267948966)
-                    return fail("bad latitude '" + tok[1] + "' (expected radians, |lat| <= pi/2)");
-                break;
-            }
-            if (tok.size() != 2 || tok[0] != "terms" || !parse_int(tok[1], 6, 100000, &nterms))
-                return fail("expected 'terms P' with an integer P >= 6");
-            if (nterms > PM_MAX_TERMS)
-                return fail(std::to_string(nterms) + " terms exceed this build's capacity of " +
-                            std::to_string(PM_MAX_TERMS) + " (rebuild with -DPM_MAX_EXTRA=" +
-                            std::to_string(nterms - PM_SH_TERMS(PM_MAX_L)) + ")");
-            m.mount = mount;
-            m.order = (int)order;
-            m.n_terms = (int)nterms;
-            m.latitude = latitude;
-            state = BODY;
-            break;
-        case BODY: {
-            if (tok.size() == 1 && tok[0] == "end") {
-                if (got != nterms)
-                    return fail("'end' after " + std::to_string(got) + " terms; the header says " +
-                                std::to_string(nterms));
-                end_line = lineno;
-                state = DONE;
-                break;
-            }
-            long k, l, mm;
-            double v;
-            if (tok.size() == 10 && tok[0] == "xterm") {
-                if (got >= nterms)
-                    return fail("more terms than the header's " + std::to_string(nterms));
-                if (got < 6)
-                    return fail("an added term (xterm) before the six isotropic terms");
-                long side, aux;
-                double param;
-                int kind = kind_of(tok[2]);
-                if (kind < 0)
-                    return fail("unknown term kind '" + tok[2] +
-                                "' (expected sh, fourier, sectoral, zenith or aux)");
-                if (!parse_int(tok[3], 0, 6, &k) || !parse_int(tok[4], -100, 100, &l) ||
-                    !parse_int(tok[5], -100, 100, &mm) || !parse_int(tok[6], -1, 1, &side) ||
-                    !parse_int(tok[7], 0, 255, &aux))
-                    return fail("bad fields of an added term (expected xterm NAME KIND k l m "
-                                "side aux param value)");
-                if (!parse_double(tok[8], &param) || !parse_double(tok[9], &v))
-                    return fail("bad parameter or value (expected finite numbers)");
-                if (version == 1 && (k == 1 || k == 2) && v != 0)
-                    return fail(old_tilt(tok[1]));
-                if (base < 0)
-                    base = got;
-                pm_term &nt = m.term[got];
-                nt.kind = (unsigned char)kind;
-                nt.k = (unsigned char)k;
-                nt.l = (signed char)l;
-                nt.m = (signed char)mm;
-                nt.side = (signed char)side;
-                nt.aux = (unsigned char)aux;
-                nt.param = param;
-                m.coef[got] = v;
-                term_line.push_back(lineno);
-                got++;
-                break;
-            }
-            if (tok.size() != 6 || tok[0] != "term")
-                return fail("expected 'term NAME k l m value', 'xterm ...' or 'end'");
-            if (got >= nterms)
-                return fail("more terms than the header's " + std::to_string(nterms));
-            if (base >= 0)
-                return fail("a harmonic term after an added term (xterm lines come last)");
-            if (!parse_int(tok[2], 1, 6, &k) || !parse_int(tok[3], 0, order, &l) ||
-                !parse_int(tok[4], -l, l, &mm))
-                return fail("bad term indices '" + tok[2] + " " + tok[3] + " " + tok[4] +
-                            "' (expected k in 1..6, l in 0..order, |m| <= l)");
-            if (!parse_double(tok[5], &v))
-                return fail("bad value '" + tok[5] + "' (expected a finite number, radians)");
-            if (version == 1 && (k == 1 || k == 2) && l >= 1 && v != 0)
-                return fail(old_tilt(tok[1]));
-            m.term[got].kind = PM_TERM_SH;
-            m.term[got].k = (unsigned char)k;
-            m.term[got].l = (signed char)l;
-            m.term[got].m = (signed char)mm;
-            m.coef[got] = v;
-            term_line.push_back(lineno);
-            got++;
-            break;
-        }
-        case DONE:
-            return fail("text after 'end'");
-        }
+        std::string why = file_line(L, tok);
+        if (!why.empty())
+            return fail(why);
     }
     if (in.bad()) {
         set_err(err, errlen, std::string(path) + ": cannot read: " + std::strerror(errno));
         return -1;
     }
-    if (state != DONE) {
-        lineno++;
-        return fail(state == HEADER ? "empty file; expected a pm model file"
-                                    : "file ends before 'end' (truncated?)");
+    if (L.state != Loader::DONE) {
+        L.lineno++;
+        return fail(L.state == Loader::HEADER ? "empty file; expected a pm model file"
+                                              : "file ends before 'end' (truncated?)");
     }
-    m.n_base = base < 0 ? (int)nterms : base;
-    // The harmonic terms must be the set pm_model_init makes for the order,
-    // in its order (pm.h: the first n_base terms are that set).
-    pm_model ref;
-    if (pm_model_init(&ref, mount, (int)order) != PM_OK) {
-        lineno = 0;
-        return fail("cannot build the order-" + std::to_string(order) + " term list");
-    }
-    for (int i = 0; i < ref.n_terms || i < m.n_base; i++) {
-        if (i >= m.n_base || i >= ref.n_terms) {
-            lineno = i < m.n_base ? term_line[i] : (i < m.n_terms ? term_line[i] : end_line);
-            return fail("the term list does not match 'order " + std::to_string(order) +
-                        "': the order-" + std::to_string(order) + " model has " +
-                        std::to_string(ref.n_terms) + " harmonic terms, the file " +
-                        std::to_string(m.n_base) + " (expected the term lines pmfit writes)");
-        }
-        const pm_term &a = m.term[i], &b = ref.term[i];
-        if (a.k != b.k || a.l != b.l || a.m != b.m) {
-            lineno = term_line[i];
-            return fail("term " + std::to_string(i + 1) + " is k l m = " + std::to_string(a.k) +
-                        " " + std::to_string(a.l) + " " + std::to_string(a.m) + ", expected " +
-                        name_of(&ref, i) + " = " + std::to_string(b.k) + " " +
-                        std::to_string(b.l) + " " + std::to_string(b.m) +
-                        ": the term list does not match 'order " + std::to_string(order) +
-                        "' (expected the term lines pmfit writes)");
-        }
-    }
+    L.m.n_base = L.base < 0 ? (int)L.nterms : L.base;
+    std::string why = check_term_list(L);
+    if (!why.empty())
+        return fail(why);
+    pm_model &m = L.m;
     pm_status st = pm_model_prepare(&m);
     if (st == PM_ERR_NONFINITE) {
         set_err(err, errlen, std::string(path) + ": the polar-axis coefficients a, b are too "
