@@ -1134,7 +1134,10 @@ std::string compare_run(const Model *old_model, const std::shared_ptr<RunData> &
         }
     } catch (const std::runtime_error &e) {
         std::string w = e.what();
-        fail(w.rfind("--add", 0) == 0 ? K_ARGUMENT : K_FILE, w);
+        // an effect pmfit does not know, a file that cannot be opened, or
+        // one that cannot be read (its file:line)
+        fail(w.rfind("--add", 0) == 0 ? K_ARGUMENT
+             : w.find("cannot open") != std::string::npos ? K_FILE : K_FORMAT, w);
     }
     if (os.is_run && os.fit.status != PM_OK)
         fail_fit(os.fit, (old_path.empty() ? std::string("old run") : old_path) + " (the old run)", passes);

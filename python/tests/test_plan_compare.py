@@ -94,5 +94,9 @@ def test_compare_equals_pmfit(tmp_path):
         pm.compare(real_run("mmt/k_and_e.dat"), gem)
     with pytest.raises(pm.FileError, match="nothing.dat"):
         pm.compare(tmp_path / "nothing.dat", SIM)
+    bad = tmp_path / "bad.pm"
+    bad.write_text("pm-model 2\nmount equatorial\norder one\n")
+    with pytest.raises(pm.FormatError, match="bad.pm:3"):
+        pm.compare(bad, SIM)
     with pytest.raises(pm.ArgumentError, match="--add"):
         pm.compare(SIM, SIM, add="nonsense")
