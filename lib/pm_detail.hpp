@@ -295,6 +295,18 @@ template <typename T> struct Trig {
     bool have_angles;
 };
 
+/* g with its angles (from its sines and cosines where g does not have them). */
+template <typename T> inline Trig<T> with_angles(const Trig<T> &g)
+{
+    Trig<T> r = g;
+    if (!r.have_angles) {
+        r.t = m_atan2(r.st, r.ct);
+        r.d = m_atan2(r.sd, r.cd);
+        r.have_angles = true;
+    }
+    return r;
+}
+
 /*
 ** Raw harmonics: for j = l*l + l + m,
 **   Y[j] = P_l^|m|(sin d) * (cos m t  if m >= 0,  sin |m| t  if m < 0)
@@ -1064,12 +1076,7 @@ aniso_of_sums(const pm_model *m, const Iso<T> &k, const Trig<T> &g0, const pm_co
     *dt = ((g0.cd * S[2] + S[5]) - sc * S[0]) - (ss * S[1] + g0.sd * S[3]);
     *dd = (S[0] * stp - S[4]) - S[1] * ctp;
     if (m->n_terms > m->n_base) {
-        Trig<T> g = g0;
-        if (!g.have_angles) {
-            g.t = m_atan2(g.st, g.ct);
-            g.d = m_atan2(g.sd, g.cd);
-            g.have_angles = true;
-        }
+        const Trig<T> g = with_angles(g0);
         Site<T> s = site_of<T>(m, k, g, ctx);
         for (int i = m->n_base; i < m->n_terms; i++) {
             T u, v;
@@ -1195,12 +1202,7 @@ inline void aniso_jac(const pm_model *m, const Iso<double> &k, const Trig<double
         /* the added terms: factor f times base vector k, so (f, ft, fd)
         ** join the harmonic sums of k (the J below differentiates the base
         ** vectors); the zenith terms apart */
-        Trig<double> g = g0;
-        if (!g.have_angles) {
-            g.t = m_atan2(g.st, g.ct);
-            g.d = m_atan2(g.sd, g.cd);
-            g.have_angles = true;
-        }
+        const Trig<double> g = with_angles(g0);
         Site<double> s = site_of<double>(m, k, g, ctx);
         V3<double> z, zt, zd;
         bool have_z = false;
