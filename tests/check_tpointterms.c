@@ -239,11 +239,8 @@ static void read_text(const char *file, char *text, size_t len)
 static double file_value(const char *text, const char *name)
 {
     char pat[16];
-    const char *p;
     snprintf(pat, sizeof pat, "     %-4s ", name);
-    p = strstr(text, pat);
-    ck_assert_msg(p != NULL, "no %s in %s", name, text);
-    return atof(p + strlen(pat));
+    return tu_number_after(text, pat, name);
 }
 
 /* pmfit fit tests/data/<run> --order <order> [--add ...] --tpoint-terms

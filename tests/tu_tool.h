@@ -41,15 +41,21 @@ static inline int tu_capture(const char *cmd, char *out, size_t len)
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
+/* The number right after the text pat in text (fails the test, naming
+** `what`, if pat is absent). */
+static inline double tu_number_after(const char *text, const char *pat, const char *what)
+{
+    const char *p = strstr(text, pat);
+    ck_assert_msg(p != NULL, "no %s in: %.400s", what, text);
+    return atof(p + strlen(pat));
+}
+
 /* The number after "key": in JSON text (fails the test if absent). */
 static inline double tu_json_num(const char *json, const char *key)
 {
     char pat[128];
-    const char *p;
     snprintf(pat, sizeof pat, "\"%s\": ", key);
-    p = strstr(json, pat);
-    ck_assert_msg(p != NULL, "no %s in: %.400s", key, json);
-    return atof(p + strlen(pat));
+    return tu_number_after(json, pat, key);
 }
 
 /* The value (arcsec) of term `name` in pmfit fit --json's "terms" (fails
@@ -57,11 +63,8 @@ static inline double tu_json_num(const char *json, const char *key)
 static inline double tu_term_value(const char *json, const char *name)
 {
     char pat[128];
-    const char *p;
     snprintf(pat, sizeof pat, "{\"name\": \"%s\", \"value_arcsec\": ", name);
-    p = strstr(json, pat);
-    ck_assert_msg(p != NULL, "no term %s in: %.300s", name, json);
-    return atof(p + strlen(pat));
+    return tu_number_after(json, pat, name);
 }
 
 /* A fresh directory /tmp/<prefix>XXXXXX into dir (at least 64 bytes). */
