@@ -67,7 +67,7 @@ $(B)/probe/%.o: lib/%.cpp tests/probe.h $(wildcard include/*.h lib/*.hpp)
 	@mkdir -p $(@D)
 	$(CXX) $(CORE_FLAGS) -include tests/probe.h '-DPM_EVAL_PROBE()=pm_probe_hit()' -c $< -o $@
 
-$(B)/tests/check_bounded: tests/check_bounded.c $(PROBE_OBJ) $(wildcard tests/*.h)
+$(B)/tests/check_bounded $(B)/tests/check_track: $(B)/tests/%: tests/%.c $(PROBE_OBJ) $(wildcard tests/*.h)
 	@mkdir -p $(@D)
 	$(CC) $(TEST_CFLAGS) $< -o $@ $(PROBE_OBJ) $(TEST_LIBS)
 

@@ -93,8 +93,7 @@ int main(void)
             for (op = 0; op < BENCH_NOPS; op++) {
                 char name[96];
                 double n;
-                if (bench_apis[a] != &bench_api_double &&
-                    (op == BENCH_NAIVE_FWD || op == BENCH_NAIVE_INV))
+                if (!bench_op_supported(bench_apis[a], op))
                     continue;
                 n = op == BENCH_EMPTY ? loop
                                       : insns_per_call(bench_apis[a], s, op, &bad) - loop;

@@ -13,8 +13,18 @@
 
 const int bench_orders[BENCH_NORDERS] = {0, 1, 2, 4};
 
-const char *const bench_op_name[BENCH_NOPS] = {"empty", "fwd", "inv", "inv_near",
-                                               "naive_fwd", "naive_inv"};
+const char *const bench_op_name[BENCH_NOPS] = {"empty",     "fwd",       "inv",
+                                               "inv_near",  "naive_fwd", "naive_inv",
+                                               "track10",   "track1k"};
+
+int bench_op_supported(const bench_api *api, int op)
+{
+    if (op == BENCH_NAIVE_FWD || op == BENCH_NAIVE_INV)
+        return api == &bench_api_double;
+    if (op == BENCH_TRACK10 || op == BENCH_TRACK1K)
+        return api->track != 0;
+    return 1;
+}
 
 /* ---------------------------------------------------------------------- */
 /* The double API.                                                        */
@@ -45,7 +55,13 @@ static int d_invert_near(int slot, double ah, double ad, double sh, double sd,
     return pm_model_invert_near(d_model[slot], 0, ah, ad, sh, sd, eh, ed);
 }
 
-const bench_api bench_api_double = {"double", d_load, d_apply, d_invert, d_invert_near};
+static int d_track(int slot, pm_track *t, double ah, double ad, double *eh, double *ed)
+{
+    return pm_model_track(d_model[slot], 0, t, ah, ad, eh, ed);
+}
+
+const bench_api bench_api_double = {"double", d_load,        d_apply,
+                                    d_invert, d_invert_near, d_track};
 
 /* ---------------------------------------------------------------------- */
 /* The float build of the evaluation (pm_model_f: single precision inside,
@@ -76,7 +92,7 @@ static int f_invert_near(int slot, double ah, double ad, double sh, double sd,
     return pm_model_invert_near_f(&f_model[slot], 0, ah, ad, sh, sd, eh, ed);
 }
 
-const bench_api bench_api_float = {"float", f_load, f_apply, f_invert, f_invert_near};
+const bench_api bench_api_float = {"float", f_load, f_apply, f_invert, f_invert_near, 0};
 
 const bench_api *const bench_apis[] = {&bench_api_double, &bench_api_float};
 const int bench_n_apis = (int)(sizeof bench_apis / sizeof bench_apis[0]);
@@ -131,6 +147,47 @@ static int empty_eval(int slot, double x, double y, double *a, double *b)
 }
 static int (*volatile empty_ptr)(int, double, double, double *, double *) = empty_eval;
 
+/* pm_model_track's states, one per position, for the tracking ops: each
+** call moves the target one tick on or back (alternately), so every timed
+** call is a tick of a loop in its steady state (J carried from the tick it
+** was taken at, at most one tick away; the call that takes it afresh, 1 in
+** ~200 at 1 kHz and never at 10 Hz in the bench's positions, is left to
+** the distribution bench) and the batches can be repeated. */
+static struct {
+    const bench_input *in;
+    const bench_api *api;
+    int slot;
+    pm_track t[BENCH_NPOS];
+    unsigned char on[BENCH_NPOS]; /* the state's target is the later one */
+} track_state[2];
+
+static int track_run(const bench_api *api, int slot, int op, const bench_input *in, int n,
+                     double *acc)
+{
+    const double tick = op == BENCH_TRACK10 ? 0.1 : 0.001;
+    int w = op == BENCH_TRACK10 ? 0 : 1, i, bad = 0;
+    double a, b;
+    if (track_state[w].in != in || track_state[w].api != api || track_state[w].slot != slot) {
+        /* start at the previous tick's encoders, then a tick on: J taken */
+        for (i = 0; i < BENCH_NPOS; i++) {
+            bad += pm_track_start(&track_state[w].t[i], in->eh[i], in->ed[i]) != PM_OK;
+            bad += api->track(slot, &track_state[w].t[i], in->ah[i], in->ad[i], &a, &b) != PM_OK;
+            track_state[w].on[i] = 0;
+        }
+        track_state[w].in = in;
+        track_state[w].api = api;
+        track_state[w].slot = slot;
+    }
+    for (i = 0; i < n; i++) {
+        int on = !track_state[w].on[i];
+        bad += api->track(slot, &track_state[w].t[i], in->ah[i] + (on ? tick * 7.2921159e-5 : 0),
+                          in->ad[i], &a, &b) != PM_OK;
+        track_state[w].on[i] = (unsigned char)on;
+        *acc += a + b;
+    }
+    return bad;
+}
+
 int bench_run(const bench_api *api, int slot, int op, const bench_input *in, int n,
               volatile double *sink)
 {
@@ -162,6 +219,12 @@ int bench_run(const bench_api *api, int slot, int op, const bench_input *in, int
                                     &b) != PM_OK;
             acc += a + b;
         }
+        break;
+    case BENCH_TRACK10:
+    case BENCH_TRACK1K:
+        if (!api->track)
+            return n;
+        bad += track_run(api, slot, op, in, n, &acc);
         break;
     case BENCH_NAIVE_FWD:
         for (i = 0; i < n; i++) {

@@ -28,6 +28,8 @@ typedef struct bench_api {
     int (*invert)(int slot, double ah, double ad, double *eh, double *ed);
     int (*invert_near)(int slot, double ah, double ad, double sh, double sd,
                        double *eh, double *ed);
+    /* pm_model_track, or 0 where the build has none */
+    int (*track)(int slot, pm_track *t, double ah, double ad, double *eh, double *ed);
 } bench_api;
 
 /* The double API of include/pm.h and its float build (pm_model_f); a
@@ -61,9 +63,15 @@ enum {
     BENCH_INV_NEAR,  /* pm_model_invert_near (tracking: from the last tick) */
     BENCH_NAIVE_FWD, /* the paper's formulas as written (naive.h) */
     BENCH_NAIVE_INV, /* the paper's inverse: the same with -coefficients */
+    BENCH_TRACK10,   /* pm_model_track, ticks of 0.1 s (bench_run) */
+    BENCH_TRACK1K,   /* pm_model_track, ticks of 1 ms */
     BENCH_NOPS
 };
 extern const char *const bench_op_name[BENCH_NOPS];
+
+/* Whether api has operation op (the naive ones and pm_model_track: the
+** double API only). */
+int bench_op_supported(const bench_api *api, int op);
 
 /* Run operation op of api over the n first positions of in (slot: the
 ** api's model slot loaded from in->m); returns the number of calls that

@@ -139,8 +139,7 @@ int main(int argc, char **argv)
             for (s = 0; s < BENCH_NORDERS; s++)
                 for (op = 0; op < BENCH_NOPS; op++) {
                     char name[96], dump[128];
-                    if (bench_apis[a] != &bench_api_double &&
-                        (op == BENCH_NAIVE_FWD || op == BENCH_NAIVE_INV))
+                    if (!bench_op_supported(bench_apis[a], op))
                         continue;
                     bench_case_name(name, sizeof name, "host", op, bench_orders[s],
                                     bench_apis[a]->prec);
@@ -171,8 +170,7 @@ int main(int argc, char **argv)
         for (a = 0; a < bench_n_apis; a++)
             for (s = 0; s < BENCH_NORDERS; s++)
                 for (op = 0; op < BENCH_NOPS; op++) {
-                    if (bench_apis[a] != &bench_api_double &&
-                        (op == BENCH_NAIVE_FWD || op == BENCH_NAIVE_INV))
+                    if (!bench_op_supported(bench_apis[a], op))
                         continue;
                     if (nc < MAXC && a < MAXA) {
                         c_api[nc] = bench_apis[a];

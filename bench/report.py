@@ -20,8 +20,9 @@ import re
 import subprocess
 import sys
 
-OPS = ["fwd", "inv", "inv_near", "naive_fwd", "naive_inv"]
-NAIVE_OF = {"fwd": "naive_fwd", "inv": "naive_inv", "inv_near": "naive_inv"}
+OPS = ["fwd", "inv", "inv_near", "track10", "track1k", "naive_fwd", "naive_inv"]
+NAIVE_OF = {"fwd": "naive_fwd", "inv": "naive_inv", "inv_near": "naive_inv",
+            "track10": "naive_inv", "track1k": "naive_inv"}
 
 
 def read_jsonl(path):
@@ -57,7 +58,7 @@ def callgrind(dirname):
         if "_empty_" in name:
             out[name] = v
             continue
-        loop = raw.get(re.sub(r"_(fwd|inv_near|inv|naive_fwd|naive_inv)_", "_empty_", name), 0)
+        loop = raw.get(re.sub(r"_(fwd|inv_near|inv|track10|track1k|naive_fwd|naive_inv)_", "_empty_", name), 0)
         out[name] = v - loop
     return out
 
@@ -213,8 +214,8 @@ def main():
         for name, v in raw.items():
             # the loop's own cost subtracted, as for the host (libm rows: loop included)
             loop = None
-            if re.search(r"_(fwd|inv_near|inv|naive_fwd|naive_inv)_L", name):
-                loop = raw.get(re.sub(r"_(fwd|inv_near|inv|naive_fwd|naive_inv)_", "_empty_", name))
+            if re.search(r"_(fwd|inv_near|inv|track10|track1k|naive_fwd|naive_inv)_L", name):
+                loop = raw.get(re.sub(r"_(fwd|inv_near|inv|track10|track1k|naive_fwd|naive_inv)_", "_empty_", name))
             insns[name] = v - loop if loop is not None else v
     dist = dist_rows(D, targets)
     fit = read_jsonl(os.path.join(D, "fit.jsonl"))
@@ -230,7 +231,7 @@ def main():
             e["ticks_median"] = ticks[n]
         if n in insns:
             e["instructions"] = round(insns[n], 1)
-        m = re.match(r"([a-z0-9]+)_(fwd|inv|inv_near)_L(\d+)_(\w+)$", n)
+        m = re.match(r"([a-z0-9]+)_(fwd|inv|inv_near|track10|track1k)_L(\d+)_(\w+)$", n)
         if m:
             vs = "%s_%s_L%s_double" % (m.group(1), NAIVE_OF[m.group(2)], m.group(3))
             key = "ticks_median" if n in ticks else "instructions"
@@ -336,7 +337,7 @@ def main():
             f2, verdict(f2 <= 120)))
     for t, prec in (("host", "double"), ("m7", "double"), ("m4f", "float"), ("m7", "float")):
         fw = g(ticks if t == "host" else insns, t, "fwd", 2, prec)
-        for op in ("inv", "inv_near"):
+        for op in ("inv", "inv_near", "track10", "track1k"):
             iv = g(ticks if t == "host" else insns, t, op, 2, prec)
             if fw and iv:
                 say("   issue 18: %s %s %s L=2 <= 2x forward (%s): %.2fx  %s" % (
@@ -348,6 +349,10 @@ def main():
             if fi and ii and ni:
                 say("   issue 18: host %s L=2 in instructions: invert %.2fx, invert_near %.2fx"
                     " the forward" % (prec, ii / fi, ni / fi))
+            t10, t1k = g(insns, t, "track10", 2, prec), g(insns, t, "track1k", 2, prec)
+            if fi and t10 and t1k:
+                say("   issue 18: host %s L=2 in instructions: pm_model_track 10 Hz %.2fx,"
+                    " 1 kHz %.2fx the forward" % (prec, t10 / fi, t1k / fi))
     trk = [r for r in dist if r["measure"] == "evals" and r["prec"] == "double" and
            "_track" in r["name"] and "_pole_" not in r["name"]]
     if trk:

@@ -275,6 +275,11 @@ typedef struct pm_model {
                                       infinite where the inverse does not
                                       predict its stop */
     double dense[PM_N_HARM(PM_MAX_L)][6]; /* per harmonic, per base vector k */
+    unsigned long ident[2];        /* two 32-bit digests of the prepared
+                                      model (mount, order, latitude,
+                                      terms, coefficients): pm_model_track
+                                      keeps a Jacobian only for the model
+                                      it was taken with */
 } pm_model;
 
 /*
@@ -569,6 +574,81 @@ pm_status pm_model_invert_near(const pm_model *m, const pm_context *ctx,
                                double app_ha, double app_dec,
                                double start_ha, double start_dec,
                                double *enc_ha, double *enc_dec);
+
+/*
+**  pm_track_start, pm_model_track - a tracking loop's inverse, with a state
+**  carried from tick to tick.
+**
+**  Given (pm_track_start):
+**     enc_ha, enc_dec  double  encoder position the loop starts from (as
+**                              pm_model_invert_near's start; |.| at most
+**                              PM_START_MAX)
+**  Given (pm_model_track):
+**     m        const pm_model*   prepared model
+**     ctx      const pm_context* per-evaluation inputs, or NULL
+**     app_ha, app_dec  double    this tick's target, as pm_model_invert
+**  Given and returned:
+**     t        pm_track*         the loop's state (pm_track_start first)
+**  Returned:
+**     enc_ha, enc_dec  double*   encoder position, as pm_model_invert_near
+**                                from the state's last position
+**  Returned (function value):
+**              pm_status   as pm_model_invert_near; PM_ERR_ARG also for a
+**                          state pm_track_start did not fill
+**  Notes:
+**  1) pm_model_track(m, ctx, t, ...) is pm_model_invert_near from the
+**     state's position t->enc, with one difference: the Jacobian J = dD/dx
+**     that the iteration needs (pm_model_invert Note 1) is carried in the
+**     state from the tick where it was taken, and reused while the start
+**     is within PM_TRACK_J_REACH of that point (the model and the inputs
+**     of its AUX terms unchanged: pm_model.ident and a digest of those
+**     inputs say so).  Each tick then costs a plain evaluation where
+**     pm_model_invert_near makes one with the Jacobian (about three
+**     evaluations' worth of arithmetic).  Where the state's J is used
+**     the predicted stop's bound holds as written there, with |x - x_J|
+**     the distance from the point J was taken at (Taylor's theorem does
+**     not care where J came from), so PM_OK still promises the round trip
+**     within PM_INVERT_TOL, and the bound of PM_INVERT_NEAR_MAX_EVALS
+**     evaluations holds as for pm_model_invert_near.  The results differ
+**     from pm_model_invert_near's in the last bits (other iterates).
+**  2) On PM_OK the state's position becomes the result; on a warning or
+**     an error it stays (the next tick starts from the last good one),
+**     and a J taken in the call is kept (it is right wherever it was
+**     taken).  Every call is independent of the earlier ones otherwise:
+**     a new target far away is solved from the state's position as
+**     pm_model_invert_near would, J taken afresh.
+**  3) The state is plain data of the caller's (no pointers): copy it,
+**     keep one per axis pair, or start again with pm_track_start at any
+**     time (e.g. after a slew).  Use it with one model at a time: another
+**     model, or this one prepared with other coefficients, makes the next
+**     call take J afresh (a 64-bit digest: two models that share it are
+**     treated as one, with probability 2^-64 for a change of
+**     coefficients).
+*/
+/* How far (radians, along the encoder axes) from the point it was taken
+** at pm_model_track reuses a Jacobian (pm_model_track, Note 1). */
+#define PM_TRACK_J_REACH 1e-3
+typedef struct pm_track {
+    double enc[2];          /* the last position (encoder axes 1 and 2) */
+    /* Set by pm_track_start and pm_model_track; do not set by hand. */
+    int magic;              /* PM_TRACK_MAGIC once started */
+    int flags;              /* PM_TRACK_HAVE_*, PM_TRACK_REFRESH */
+    double jac[4];          /* J = dD/dx, row-major */
+    double jac_at[4];       /* sin, cos of both axes where J was taken */
+    double ni[4];           /* the chord's matrix (I - J F_D)^-1 with it */
+    double trig[4];         /* sin, cos of both axes at enc */
+    unsigned long ident[2]; /* the model's digest (pm_model.ident) */
+    unsigned long inputs[2]; /* digest of the AUX terms' inputs then */
+} pm_track;
+#define PM_TRACK_HAVE_J 1
+#define PM_TRACK_HAVE_NI 2
+#define PM_TRACK_HAVE_TRIG 4
+#define PM_TRACK_REFRESH 8
+#define PM_TRACK_MAGIC 0x7472616b
+pm_status pm_track_start(pm_track *t, double enc_ha, double enc_dec);
+pm_status pm_model_track(const pm_model *m, const pm_context *ctx, pm_track *t,
+                         double app_ha, double app_dec, double *enc_ha,
+                         double *enc_dec);
 
 /*
 **  pm_model_residual - observed minus model in the tangent plane.

@@ -99,6 +99,69 @@ double second_rate(const pm_model *m)
     return s;
 }
 
+/* Two 32-bit digests (FNV-1a with two offsets, and the second also
+** rotated per word) of a sequence of 32-bit words: pm_model.ident and
+** pm_track's inputs. */
+struct Digest {
+    unsigned long a, b;
+};
+inline void digest_word(Digest *h, unsigned long w)
+{
+    w &= 0xffffffffUL;
+    h->a = ((h->a ^ w) * 16777619UL) & 0xffffffffUL;
+    h->b = ((h->b ^ ((w << 7 | w >> 25) & 0xffffffffUL)) * 16777619UL) & 0xffffffffUL;
+    h->b ^= h->b >> 15;
+}
+inline void digest_double(Digest *h, double x)
+{
+    unsigned char c[sizeof(double)];
+    __builtin_memcpy(c, &x, sizeof c);
+    for (unsigned i = 0; i < sizeof c; i += 4)
+        digest_word(h, (unsigned long)c[i] | (unsigned long)c[i + 1] << 8 |
+                           (unsigned long)c[i + 2] << 16 | (unsigned long)c[i + 3] << 24);
+}
+inline Digest digest_start()
+{
+    Digest h;
+    h.a = 2166136261UL;
+    h.b = 0x9e3779b9UL;
+    return h;
+}
+
+/* The digest of a prepared model's content (pm_model.ident). */
+void model_digest(pm_model *m)
+{
+    Digest h = digest_start();
+    digest_word(&h, (unsigned long)m->mount);
+    digest_word(&h, (unsigned long)m->order);
+    digest_word(&h, (unsigned long)m->n_terms);
+    digest_word(&h, (unsigned long)m->n_base);
+    digest_double(&h, m->latitude);
+    for (int i = 0; i < m->n_terms; i++) {
+        const pm_term &t = m->term[i];
+        digest_word(&h, (unsigned long)t.kind | (unsigned long)t.k << 8 |
+                            (unsigned long)(unsigned char)t.l << 16 |
+                            (unsigned long)(unsigned char)t.m << 24);
+        digest_word(&h, (unsigned long)(unsigned char)t.side | (unsigned long)t.aux << 8);
+        digest_double(&h, t.param);
+        digest_double(&h, m->coef[i]);
+    }
+    m->ident[0] = h.a;
+    m->ident[1] = h.b;
+}
+
+/* The digest of the inputs the model's AUX terms read at ctx (J's part
+** from them depends on those). */
+Digest inputs_digest(const pm_model *m, const pm_context *ctx)
+{
+    Digest h = digest_start();
+    if (m->needs_ctx && ctx)
+        for (int i = m->n_base; i < m->n_terms; i++)
+            if (m->term[i].kind == PM_TERM_AUX)
+                digest_double(&h, aux_input(ctx, m->term[i].aux));
+    return h;
+}
+
 /* Which side of the mount's pole an encoder declination is on: the sign of
 ** cos(dec - e'). */
 int side_of(const pm_model *m, double d)
@@ -759,6 +822,19 @@ inline bool newton_prep0(const Iso<double> &k, const Trig<double> &g, const doub
 ** registers. */
 #define PM_HOT __attribute__((always_inline)) inline
 
+/* pm_model_track's state (pm_track) in a call: J, the point it was taken
+** at and the chord's matrix Ni made with it are read where have_j (and
+** have_ni); the start's sines and cosines where have_trig; J, its point
+** and Ni are written where J is taken afresh (fresh, out_ni), the result's
+** sines and cosines where it converged without Newton (out_trig). */
+struct Carry {
+    pm_track *t;
+    bool have_j, have_ni, have_trig; /* in */
+    double reach;                    /* in: J is carried within this distance */
+    bool fresh, out_ni, out_trig;    /* out */
+    int used;                        /* out: evaluations made */
+};
+
 /* The state of solve_branch's iteration.
 **
 ** Iteration: g = F(D^), the closed form for the displacement D^; the
@@ -777,6 +853,7 @@ struct Branch {
     const Aim *a;
     const Target<double> *tg;
     const double *start;
+    Carry *carry;        /* pm_model_track's J, or 0 */
     double ref_t, ref_d; /* the turn the angles are kept on (turn_of) */
     double lip2;         /* the second-derivative bound; -1: no predicted stop */
     bool raw;            /* a term reads the raw angles (on_turn at every point) */
@@ -820,6 +897,46 @@ PM_HOT bool iso_only(const pm_model *m)
     return m->order == 0 && m->n_terms == m->n_base;
 }
 
+/* A bound on the length in angle of the step whose sines are (ht, hd). */
+PM_HOT double step_len(double ht, double hd)
+{
+    const double h2 = ht * ht + hd * hd;
+    return m_sqrt(h2) * (1 + h2 * 0.2);
+}
+
+/* pm_model_track's J at the start g, where the state's applies (its point
+** within reach of g): then it is s->J, with its distance from g in
+** dist_j (the predicted stop's bound holds for J taken anywhere, Note 1
+** of pm_model_invert), and the state's chord matrix Ni where it has one
+** (F_D moves with the point: only the speed depends on it). */
+PM_HOT bool carried_j(Branch *s, const Trig<double> &g)
+{
+    const Carry *c = s->carry;
+    if (!c->have_j)
+        return false;
+    const pm_track *t = c->t;
+    Trig<double> gj = g;
+    gj.st = t->jac_at[0];
+    gj.ct = t->jac_at[1];
+    gj.sd = t->jac_at[2];
+    gj.cd = t->jac_at[3];
+    double ht, hd;
+    if (!small_step(g, gj, &ht, &hd))
+        return false;
+    const double hn = step_len(ht, hd);
+    if (!(hn <= c->reach))
+        return false;
+    for (int i = 0; i < 4; i++)
+        s->J[i] = t->jac[i];
+    s->dist_j = hn;
+    if (c->have_ni) {
+        for (int i = 0; i < 4; i++)
+            s->Ni[i] = t->ni[i];
+        s->tried_n = s->have_n = true;
+    }
+    return true;
+}
+
 /* The first point, in slot 0: the closed form at D^ = 0 (a cold call), or
 ** the start (one evaluation, with J); the branch (side) and whether the
 ** closed form reaches the target. */
@@ -844,9 +961,32 @@ PM_HOT void first_point(Branch *s)
         /* The branch of the start: the sign of the x-component of
         ** Pd(d - e') T(i) w there, the quantity iso_inverse chooses by
         ** (near the mount's pole it differs from the sign of cos(dec)). */
-        g = trig_of(s->start[0], s->start[1]);
+        if (s->carry && s->carry->have_trig) {
+            const double *tr = s->carry->t->trig;
+            g.st = tr[0];
+            g.ct = tr[1];
+            g.sd = tr[2];
+            g.cd = tr[3];
+            g.t = s->start[0];
+            g.d = s->start[1];
+            g.have_angles = true;
+        } else {
+            g = trig_of(s->start[0], s->start[1]);
+        }
         double dt, dd; /* (locals: the Branch's address stays in here) */
-        aniso_jac(m, k, g, s->ctx, &dt, &dd, s->J);
+        const bool carried = s->carry && carried_j(s, g);
+        if (!carried)
+            aniso_jac(m, k, g, s->ctx, &dt, &dd, s->J);
+        else
+            aniso<double>(m, k, g, s->ctx, &dt, &dd);
+        if (s->carry && !carried) {
+            double *at = s->carry->t->jac_at;
+            s->carry->fresh = true;
+            at[0] = g.st;
+            at[1] = g.ct;
+            at[2] = g.sd;
+            at[3] = g.cd;
+        }
         s->d0t = dt;
         s->d0d = dd;
         s->used = 1;
@@ -900,13 +1040,6 @@ PM_HOT void chord_step(const Branch *s, double dt, double dd, double *nt, double
     const double *Ni = s->Ni;
     *nt = s->dh_t + (Ni[0] * (dt - s->dh_t) + Ni[1] * (dd - s->dh_d));
     *nd = s->dh_d + (Ni[2] * (dt - s->dh_t) + Ni[3] * (dd - s->dh_d));
-}
-
-/* A bound on the length in angle of the step whose sines are (ht, hd). */
-PM_HOT double step_len(double ht, double hd)
-{
-    const double h2 = ht * ht + hd * hd;
-    return m_sqrt(h2) * (1 + h2 * 0.2);
 }
 
 /* The predicted stop for the step (ht, hd) of length hn to D^ = (nt, nd)
@@ -1253,11 +1386,31 @@ PM_HOT pm_status finish_branch(Branch *s, int want, const double *turn, double *
     bool converged = s->converged && rounding_safe(s, gb, t, d);
     pm_status result = PM_OK;
     double err = 0;
+    if (s->carry)
+        s->carry->out_trig = false;
     if (!converged || !reachable || (want && side_of(s->m, d) != want)) {
         result = newton(s->m, *s->k, s->ctx, *s->a, turn, &t, &d, &err, want,
                         PM_INVERT_MAX_FIXED + PM_INVERT_MAX_NEWTON - s->used);
         if (result != PM_OK && !reachable)
             result = PM_WARN_UNREACHABLE;
+    } else if (s->carry) {
+        double *tr = s->carry->t->trig; /* (read in first_point: done) */
+        tr[0] = gb.st;
+        tr[1] = gb.ct;
+        tr[2] = gb.sd;
+        tr[3] = gb.cd;
+        s->carry->out_trig = true;
+    }
+    if (s->carry) {
+        Carry *c = s->carry;
+        c->used = s->used;
+        if (c->fresh) { /* J, and Ni where the iteration made one with it */
+            c->out_ni = s->have_n;
+            for (int i = 0; i < 4; i++) {
+                c->t->jac[i] = s->J[i];
+                c->t->ni[i] = s->Ni[i];
+            }
+        }
     }
     *t_out = t;
     *d_out = d;
@@ -1272,9 +1425,10 @@ PM_HOT pm_status finish_branch(Branch *s, int want, const double *turn, double *
 ** where the typical iteration applies, the general loop where it does not
 ** or from where it ends; Newton on the forward model where neither
 ** certifies a point (finish_branch). */
+template <bool TRACK>
 pm_status solve_branch(const pm_model *m, const Iso<double> &k,
                        const pm_context *ctx, const Aim &a, int side, int want,
-                       const double *start,
+                       const double *start, Carry *carry,
                        const double *turn, double *t_out, double *d_out, double *err_out)
 {
     const Target<double> tg = target_of(k, a.q);
@@ -1287,6 +1441,7 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
     s.a = &a;
     s.tg = &tg;
     s.start = start;
+    s.carry = TRACK ? carry : 0; /* (the other calls compile without it) */
     /* Periodic terms of non-integer G read the raw angle itself, not only
     ** its sine and cosine: iterate with the angles on the returned turn
     ** (on_turn at every point), else once, at the end. */
@@ -1542,8 +1697,8 @@ __attribute__((noinline)) pm_status pole_rescue(const pm_model *m, const Iso<dou
 
 /* Shared inverse: side = +1/-1, or use the start position. */
 pm_status invert(const pm_model *m, const pm_context *ctx, double app_ha,
-                 double app_dec, int side, const double *start, double *enc_ha,
-                 double *enc_dec)
+                 double app_dec, int side, const double *start, Carry *carry,
+                 double *enc_ha, double *enc_dec)
 {
     pm_status st = eval_ready(m, ctx);
     if (st != PM_OK)
@@ -1566,14 +1721,16 @@ pm_status invert(const pm_model *m, const pm_context *ctx, double app_ha,
     a.q = v3(a.cd * a.ch, a.cd * a.sh, a.sd);
     double turn[2], t, d, err;
     turn_of(start, side, m->coef[4], turn);
-    pm_status result = solve_branch(m, k, ctx, a, side, start ? 0 : side, start, turn, &t, &d, &err);
+    pm_status result = carry ? solve_branch<true>(m, k, ctx, a, side, 0, start, carry, turn, &t, &d, &err)
+              : solve_branch<false>(m, k, ctx, a, side, start ? 0 : side, start, 0, turn, &t,
+                                    &d, &err);
     if (!start && (result != PM_OK || side_of(m, d) != side)) {
         /* Within the anisotropic amplitude of the mount's pole the closed
         ** form's branches (sign of cos(dec - e' + displacement angle)) and
         ** the sides of the pole (sign of cos(dec - e')) differ: the other
         ** branch may hold the solution on the requested side. */
         double t2, d2, err2;
-        pm_status r2 = solve_branch(m, k, ctx, a, -side, side, 0, turn, &t2, &d2, &err2);
+        pm_status r2 = solve_branch<false>(m, k, ctx, a, -side, side, 0, 0, turn, &t2, &d2, &err2);
         if (r2 == PM_OK && side_of(m, d2) == side) {
             result = r2;
             t = t2;
@@ -1756,6 +1913,7 @@ pm_status pm_model_prepare(pm_model *m)
     }
     m->lip = lipschitz(m);
     m->lip2 = second_rate(m);
+    model_digest(m);
     for (int i = 0; i < PM_MAX_TERMS; i++)
         m->prep_coef[i] = i < m->n_terms ? m->coef[i] : 0.0;
     m->prepared = 1;
@@ -1899,7 +2057,7 @@ pm_status pm_model_invert(const pm_model *m, const pm_context *ctx,
 {
     if (side != PM_SIDE_NORMAL && side != PM_SIDE_FLIPPED)
         return PM_ERR_ARG;
-    return invert(m, ctx, app_ha, app_dec, side == PM_SIDE_NORMAL ? 1 : -1, 0,
+    return invert(m, ctx, app_ha, app_dec, side == PM_SIDE_NORMAL ? 1 : -1, 0, 0,
                   enc_ha, enc_dec);
 }
 
@@ -1909,7 +2067,73 @@ pm_status pm_model_invert_near(const pm_model *m, const pm_context *ctx,
                                double *enc_dec)
 {
     double start[2] = {start_ha, start_dec};
-    return invert(m, ctx, app_ha, app_dec, 1, start, enc_ha, enc_dec);
+    return invert(m, ctx, app_ha, app_dec, 1, start, 0, enc_ha, enc_dec);
+}
+
+pm_status pm_track_start(pm_track *t, double enc_ha, double enc_dec)
+{
+    if (!t)
+        return PM_ERR_ARG;
+    if (!finite(enc_ha) || !finite(enc_dec))
+        return PM_ERR_NONFINITE;
+    if (m_fabs(enc_ha) > PM_START_MAX || m_fabs(enc_dec) > PM_START_MAX)
+        return PM_ERR_ARG;
+    __builtin_memset(t, 0, sizeof *t);
+    t->enc[0] = enc_ha;
+    t->enc[1] = enc_dec;
+    t->magic = PM_TRACK_MAGIC;
+    return PM_OK;
+}
+
+pm_status pm_model_track(const pm_model *m, const pm_context *ctx, pm_track *t,
+                         double app_ha, double app_dec, double *enc_ha, double *enc_dec)
+{
+    if (!m || !t || t->magic != PM_TRACK_MAGIC || !enc_ha || !enc_dec)
+        return PM_ERR_ARG;
+    /* (invert checks the model and the context before either is used) */
+    const Digest in = inputs_digest(m, ctx);
+    Carry c;
+    c.t = t;
+    c.have_j = (t->flags & PM_TRACK_HAVE_J) && !(t->flags & PM_TRACK_REFRESH) &&
+               t->ident[0] == m->ident[0] && t->ident[1] == m->ident[1] &&
+               t->inputs[0] == in.a && t->inputs[1] == in.b;
+    c.have_ni = c.have_j && (t->flags & PM_TRACK_HAVE_NI);
+    c.have_trig = t->flags & PM_TRACK_HAVE_TRIG;
+    c.reach = PM_TRACK_J_REACH;
+    c.fresh = c.out_ni = c.out_trig = false;
+    c.used = 0;
+    double eh = 0, ed = 0;
+    const double start[2] = {t->enc[0], t->enc[1]};
+    pm_status st = invert(m, ctx, app_ha, app_dec, 1, start, &c, &eh, &ed);
+    if (st < 0 && !c.fresh && !c.out_trig)
+        return st; /* (the state as it was) */
+    int f = t->flags & ~(PM_TRACK_HAVE_TRIG | PM_TRACK_REFRESH);
+    if (c.fresh) { /* J is right wherever it was taken: kept whatever st */
+        f = (f & ~PM_TRACK_HAVE_NI) | PM_TRACK_HAVE_J | (c.out_ni ? PM_TRACK_HAVE_NI : 0);
+        t->ident[0] = m->ident[0];
+        t->ident[1] = m->ident[1];
+        t->inputs[0] = in.a;
+        t->inputs[1] = in.b;
+    } else if (c.used >= 2 && st == PM_OK) {
+        /* J carried so far that its distance kept the predicted stop from
+        ** certifying a step that a J taken at the start would have (ticks
+        ** of 1 kHz, J carried for many): take it afresh next time */
+        const double ht = eh - start[0], hd = ed - start[1];
+        if (m->lip2 * 0.5 * (ht * ht + hd * hd) <= 0.25 * PM_INVERT_TOL)
+            f |= PM_TRACK_REFRESH;
+    }
+    if (st == PM_OK) {
+        t->enc[0] = eh;
+        t->enc[1] = ed;
+        if (c.out_trig)
+            f |= PM_TRACK_HAVE_TRIG;
+    }
+    t->flags = f;
+    if (st < 0)
+        return st;
+    *enc_ha = eh;
+    *enc_dec = ed;
+    return st;
 }
 
 pm_status pm_model_residual(const pm_model *m, const pm_context *ctx,
