@@ -148,41 +148,42 @@ static int empty_eval(int slot, double x, double y, double *a, double *b)
 static int (*volatile empty_ptr)(int, double, double, double *, double *) = empty_eval;
 
 /* pm_model_track's states, one per position, for the tracking ops: each
-** call moves the target one tick on or back (alternately), so every timed
-** call is a tick of a loop in its steady state (J carried from the tick it
-** was taken at, at most one tick away; the call that takes it afresh, 1 in
-** ~200 at 1 kHz and never at 10 Hz in the bench's positions, is left to
-** the distribution bench) and the batches can be repeated. */
+** call is the next tick of that position's loop (the target a tick on),
+** so every timed call is a tick of a loop in its steady state, the calls
+** that take J afresh included (J's reach, PM_TRACK_J_REACH, is ~14 s of
+** sidereal motion: about once in 140 calls at 0.1 s ticks, and not at all
+** within a 1 ms run of the bench's length); the first two ticks (J taken,
+** no step to predict from yet) are made when the states are set up. */
 static struct {
     const bench_input *in;
     const bench_api *api;
     int slot;
     pm_track t[BENCH_NPOS];
-    unsigned char on[BENCH_NPOS]; /* the state's target is the later one */
+    long k[BENCH_NPOS]; /* the tick the state is at */
 } track_state[2];
 
 static int track_run(const bench_api *api, int slot, int op, const bench_input *in, int n,
                      double *acc)
 {
-    const double tick = op == BENCH_TRACK10 ? 0.1 : 0.001;
+    const double tick = (op == BENCH_TRACK10 ? 0.1 : 0.001) * 7.2921159e-5;
     int w = op == BENCH_TRACK10 ? 0 : 1, i, bad = 0;
     double a, b;
     if (track_state[w].in != in || track_state[w].api != api || track_state[w].slot != slot) {
-        /* start at the previous tick's encoders, then a tick on: J taken */
         for (i = 0; i < BENCH_NPOS; i++) {
-            bad += pm_track_start(&track_state[w].t[i], in->eh[i], in->ed[i]) != PM_OK;
-            bad += api->track(slot, &track_state[w].t[i], in->ah[i], in->ad[i], &a, &b) != PM_OK;
-            track_state[w].on[i] = 0;
+            pm_track *t = &track_state[w].t[i];
+            bad += pm_track_start(t, in->eh[i], in->ed[i]) != PM_OK;
+            bad += api->track(slot, t, in->ah[i] + tick, in->ad[i], &a, &b) != PM_OK;
+            bad += api->track(slot, t, in->ah[i] + 2 * tick, in->ad[i], &a, &b) != PM_OK;
+            track_state[w].k[i] = 2;
         }
         track_state[w].in = in;
         track_state[w].api = api;
         track_state[w].slot = slot;
     }
     for (i = 0; i < n; i++) {
-        int on = !track_state[w].on[i];
-        bad += api->track(slot, &track_state[w].t[i], in->ah[i] + (on ? tick * 7.2921159e-5 : 0),
-                          in->ad[i], &a, &b) != PM_OK;
-        track_state[w].on[i] = (unsigned char)on;
+        long k = ++track_state[w].k[i];
+        bad += api->track(slot, &track_state[w].t[i], in->ah[i] + (double)k * tick, in->ad[i],
+                          &a, &b) != PM_OK;
         *acc += a + b;
     }
     return bad;

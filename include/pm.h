@@ -637,6 +637,8 @@ typedef struct pm_track {
     double jac_at[4];       /* sin, cos of both axes where J was taken */
     double ni[4];           /* the chord's matrix (I - J F_D)^-1 with it */
     double trig[4];         /* sin, cos of both axes at enc */
+    double step[2];         /* the last step of enc (radians) */
+    double step_trig[4];    /* sin, cos of it on both axes */
     unsigned long ident[2]; /* the model's digest (pm_model.ident) */
     unsigned long inputs[2]; /* digest of the AUX terms' inputs then */
 } pm_track;
@@ -644,6 +646,7 @@ typedef struct pm_track {
 #define PM_TRACK_HAVE_NI 2
 #define PM_TRACK_HAVE_TRIG 4
 #define PM_TRACK_REFRESH 8
+#define PM_TRACK_HAVE_STEP 16
 #define PM_TRACK_MAGIC 0x7472616b
 pm_status pm_track_start(pm_track *t, double enc_ha, double enc_dec);
 pm_status pm_model_track(const pm_model *m, const pm_context *ctx, pm_track *t,

@@ -824,15 +824,18 @@ inline bool newton_prep0(const Iso<double> &k, const Trig<double> &g, const doub
 
 /* pm_model_track's state (pm_track) in a call: J, the point it was taken
 ** at and the chord's matrix Ni made with it are read where have_j (and
-** have_ni); the start's sines and cosines where have_trig; J, its point
-** and Ni are written where J is taken afresh (fresh, out_ni), the result's
-** sines and cosines where it converged without Newton (out_trig). */
+** have_ni); the start's sines and cosines from strig where given; J, its
+** point and Ni are written where J is taken afresh (fresh, out_ni), the
+** result's sines and cosines where it converged without Newton (out_trig,
+** rtrig). */
 struct Carry {
     pm_track *t;
-    bool have_j, have_ni, have_trig; /* in */
-    double reach;                    /* in: J is carried within this distance */
-    bool fresh, out_ni, out_trig;    /* out */
-    int used;                        /* out: evaluations made */
+    bool have_j, have_ni;         /* in */
+    const double *strig;          /* in: the start's sines and cosines, or 0 */
+    double reach;                 /* in: J is carried within this distance */
+    bool fresh, out_ni, out_trig; /* out */
+    double rtrig[4];              /* out: the result's sines and cosines */
+    int used;                     /* out: evaluations made */
 };
 
 /* The state of solve_branch's iteration.
@@ -961,8 +964,8 @@ PM_HOT void first_point(Branch *s)
         /* The branch of the start: the sign of the x-component of
         ** Pd(d - e') T(i) w there, the quantity iso_inverse chooses by
         ** (near the mount's pole it differs from the sign of cos(dec)). */
-        if (s->carry && s->carry->have_trig) {
-            const double *tr = s->carry->t->trig;
+        if (s->carry && s->carry->strig) {
+            const double *tr = s->carry->strig;
             g.st = tr[0];
             g.ct = tr[1];
             g.sd = tr[2];
@@ -1394,7 +1397,7 @@ PM_HOT pm_status finish_branch(Branch *s, int want, const double *turn, double *
         if (result != PM_OK && !reachable)
             result = PM_WARN_UNREACHABLE;
     } else if (s->carry) {
-        double *tr = s->carry->t->trig; /* (read in first_point: done) */
+        double *tr = s->carry->rtrig;
         tr[0] = gb.st;
         tr[1] = gb.ct;
         tr[2] = gb.sd;
@@ -2085,12 +2088,67 @@ pm_status pm_track_start(pm_track *t, double enc_ha, double enc_dec)
     return PM_OK;
 }
 
+/* The start of pm_model_track's call (Note 1 of pm_model_track): the
+** state's position moved on by its last step where it has one, as angles
+** (start) and as sines and cosines (trig, from the position's and the
+** step's by the angle-sum formulas); where the step would take it to the
+** other side of the mount's pole, the position itself. */
+static void track_start(const pm_model *m, const pm_track *t, double start[2], double trig[4])
+{
+    const double *p = t->trig, *h = t->step_trig;
+    start[0] = t->enc[0];
+    start[1] = t->enc[1];
+    for (int i = 0; i < 4; i++)
+        trig[i] = p[i];
+    if (!(t->flags & PM_TRACK_HAVE_STEP))
+        return;
+    const double sd = p[2] * h[3] + p[3] * h[2], cd = p[3] * h[3] - p[2] * h[2];
+    if ((cd * m->ce + sd * m->se >= 0) != (p[3] * m->ce + p[2] * m->se >= 0))
+        return;
+    start[0] = t->enc[0] + t->step[0];
+    start[1] = t->enc[1] + t->step[1];
+    trig[0] = p[0] * h[1] + p[1] * h[0];
+    trig[1] = p[1] * h[1] - p[0] * h[0];
+    trig[2] = sd;
+    trig[3] = cd;
+}
+
+/* The step from the state's position to the new one (eh, ed; sines and
+** cosines r): kept where both axes moved by less than 0.01 rad. */
+static int track_step(pm_track *t, double eh, double ed, const double r[4])
+{
+    const double *p = t->trig;
+    double *h = t->step_trig;
+    h[0] = r[0] * p[1] - r[1] * p[0];
+    h[1] = r[1] * p[1] + r[0] * p[0];
+    h[2] = r[2] * p[3] - r[3] * p[2];
+    h[3] = r[3] * p[3] + r[2] * p[2];
+    t->step[0] = eh - t->enc[0];
+    t->step[1] = ed - t->enc[1];
+    return m_fabs(h[0]) <= 0.01 && h[1] > 0 && m_fabs(h[2]) <= 0.01 && h[3] > 0 &&
+           m_fabs(t->step[0]) <= 0.01 && m_fabs(t->step[1]) <= 0.01;
+}
+
 pm_status pm_model_track(const pm_model *m, const pm_context *ctx, pm_track *t,
                          double app_ha, double app_dec, double *enc_ha, double *enc_dec)
 {
     if (!m || !t || t->magic != PM_TRACK_MAGIC || !enc_ha || !enc_dec)
         return PM_ERR_ARG;
     /* (invert checks the model and the context before either is used) */
+    if (iso_only(m)) { /* the closed form: nothing to carry */
+        double eh = 0, ed = 0;
+        pm_status st = invert(m, ctx, app_ha, app_dec, 1, t->enc, 0, &eh, &ed);
+        if (st == PM_OK) {
+            t->enc[0] = eh;
+            t->enc[1] = ed;
+            t->flags &= ~(PM_TRACK_HAVE_TRIG | PM_TRACK_HAVE_STEP);
+        }
+        if (st >= 0) {
+            *enc_ha = eh;
+            *enc_dec = ed;
+        }
+        return st;
+    }
     const Digest in = inputs_digest(m, ctx);
     Carry c;
     c.t = t;
@@ -2098,16 +2156,23 @@ pm_status pm_model_track(const pm_model *m, const pm_context *ctx, pm_track *t,
                t->ident[0] == m->ident[0] && t->ident[1] == m->ident[1] &&
                t->inputs[0] == in.a && t->inputs[1] == in.b;
     c.have_ni = c.have_j && (t->flags & PM_TRACK_HAVE_NI);
-    c.have_trig = t->flags & PM_TRACK_HAVE_TRIG;
+    double start[2], strig[4];
+    if (t->flags & PM_TRACK_HAVE_TRIG) {
+        track_start(m, t, start, strig);
+        c.strig = strig;
+    } else {
+        start[0] = t->enc[0];
+        start[1] = t->enc[1];
+        c.strig = 0;
+    }
     c.reach = PM_TRACK_J_REACH;
     c.fresh = c.out_ni = c.out_trig = false;
     c.used = 0;
     double eh = 0, ed = 0;
-    const double start[2] = {t->enc[0], t->enc[1]};
     pm_status st = invert(m, ctx, app_ha, app_dec, 1, start, &c, &eh, &ed);
-    if (st < 0 && !c.fresh && !c.out_trig)
+    if (st < 0 && !c.fresh)
         return st; /* (the state as it was) */
-    int f = t->flags & ~(PM_TRACK_HAVE_TRIG | PM_TRACK_REFRESH);
+    int f = t->flags & ~PM_TRACK_REFRESH;
     if (c.fresh) { /* J is right wherever it was taken: kept whatever st */
         f = (f & ~PM_TRACK_HAVE_NI) | PM_TRACK_HAVE_J | (c.out_ni ? PM_TRACK_HAVE_NI : 0);
         t->ident[0] = m->ident[0];
@@ -2123,10 +2188,16 @@ pm_status pm_model_track(const pm_model *m, const pm_context *ctx, pm_track *t,
             f |= PM_TRACK_REFRESH;
     }
     if (st == PM_OK) {
+        f &= ~(PM_TRACK_HAVE_TRIG | PM_TRACK_HAVE_STEP);
+        if (c.out_trig) {
+            if ((t->flags & PM_TRACK_HAVE_TRIG) && track_step(t, eh, ed, c.rtrig))
+                f |= PM_TRACK_HAVE_STEP;
+            f |= PM_TRACK_HAVE_TRIG;
+            for (int i = 0; i < 4; i++)
+                t->trig[i] = c.rtrig[i];
+        }
         t->enc[0] = eh;
         t->enc[1] = ed;
-        if (c.out_trig)
-            f |= PM_TRACK_HAVE_TRIG;
     }
     t->flags = f;
     if (st < 0)
