@@ -1699,6 +1699,7 @@ __attribute__((noinline)) pm_status pole_rescue(const pm_model *m, const Iso<dou
 }
 
 /* Shared inverse: side = +1/-1, or use the start position. */
+template <bool TRACK>
 pm_status invert(const pm_model *m, const pm_context *ctx, double app_ha,
                  double app_dec, int side, const double *start, Carry *carry,
                  double *enc_ha, double *enc_dec)
@@ -1724,7 +1725,8 @@ pm_status invert(const pm_model *m, const pm_context *ctx, double app_ha,
     a.q = v3(a.cd * a.ch, a.cd * a.sh, a.sd);
     double turn[2], t, d, err;
     turn_of(start, side, m->coef[4], turn);
-    pm_status result = carry ? solve_branch<true>(m, k, ctx, a, side, 0, start, carry, turn, &t, &d, &err)
+    pm_status result =
+        TRACK ? solve_branch<true>(m, k, ctx, a, side, 0, start, carry, turn, &t, &d, &err)
               : solve_branch<false>(m, k, ctx, a, side, start ? 0 : side, start, 0, turn, &t,
                                     &d, &err);
     if (!start && (result != PM_OK || side_of(m, d) != side)) {
@@ -2060,7 +2062,7 @@ pm_status pm_model_invert(const pm_model *m, const pm_context *ctx,
 {
     if (side != PM_SIDE_NORMAL && side != PM_SIDE_FLIPPED)
         return PM_ERR_ARG;
-    return invert(m, ctx, app_ha, app_dec, side == PM_SIDE_NORMAL ? 1 : -1, 0, 0,
+    return invert<false>(m, ctx, app_ha, app_dec, side == PM_SIDE_NORMAL ? 1 : -1, 0, 0,
                   enc_ha, enc_dec);
 }
 
@@ -2070,7 +2072,7 @@ pm_status pm_model_invert_near(const pm_model *m, const pm_context *ctx,
                                double *enc_dec)
 {
     double start[2] = {start_ha, start_dec};
-    return invert(m, ctx, app_ha, app_dec, 1, start, 0, enc_ha, enc_dec);
+    return invert<false>(m, ctx, app_ha, app_dec, 1, start, 0, enc_ha, enc_dec);
 }
 
 pm_status pm_track_start(pm_track *t, double enc_ha, double enc_dec)
@@ -2137,7 +2139,7 @@ pm_status pm_model_track(const pm_model *m, const pm_context *ctx, pm_track *t,
     /* (invert checks the model and the context before either is used) */
     if (iso_only(m)) { /* the closed form: nothing to carry */
         double eh = 0, ed = 0;
-        pm_status st = invert(m, ctx, app_ha, app_dec, 1, t->enc, 0, &eh, &ed);
+        pm_status st = invert<false>(m, ctx, app_ha, app_dec, 1, t->enc, 0, &eh, &ed);
         if (st == PM_OK) {
             t->enc[0] = eh;
             t->enc[1] = ed;
@@ -2169,7 +2171,7 @@ pm_status pm_model_track(const pm_model *m, const pm_context *ctx, pm_track *t,
     c.fresh = c.out_ni = c.out_trig = false;
     c.used = 0;
     double eh = 0, ed = 0;
-    pm_status st = invert(m, ctx, app_ha, app_dec, 1, start, &c, &eh, &ed);
+    pm_status st = invert<true>(m, ctx, app_ha, app_dec, 1, start, &c, &eh, &ed);
     if (st < 0 && !c.fresh)
         return st; /* (the state as it was) */
     int f = t->flags & ~PM_TRACK_REFRESH;
