@@ -76,12 +76,12 @@ int main(void)
             printf("cannot build situation %d\n", s);
             return 1;
         }
-        for (p = is_m7 ? 0 : 1; p < 2; p++) {
+        for (p = is_m7 ? 0 : 1; p < (is_m7 ? DIST_NPREC : 2); p++) {
             double loop, med, p99, worst;
             int n = 0, ok = 0, warn = 0, err = 0, st;
             loop = (double)measure(empty_ptr, p, &calls[0], &st) / DIST_REP;
             for (i = 0; i < sit.n; i++) {
-                if (p == 1 && !have_f[calls[i].model])
+                if (!dist_runnable(&calls[i], p, have_f))
                     continue;
                 v[n++] = (double)measure(run_ptr, p, &calls[i], &st) / DIST_REP - loop;
                 ok += st == PM_OK;
@@ -94,7 +94,7 @@ int main(void)
             printf("BENCH {\"name\": \"dist_%s\", \"prec\": \"%s\", \"measure\": \"%s_insn\", "
                    "\"n\": %d, \"median\": %.1f, \"p99\": %.1f, \"worst\": %.1f, \"ok\": %d, "
                    "\"warn\": %d, \"err\": %d}\n",
-                   sit.name, p ? "float" : "double", fw_target(), n, med, p99, worst, ok, warn,
+                   sit.name, dist_prec_name[p], fw_target(), n, med, p99, worst, ok, warn,
                    err);
         }
     }

@@ -32,7 +32,6 @@ static unsigned long probe_count;
 void pm_probe_hit(void) { probe_count++; }
 #endif
 
-static const char *const prec_name[2] = {"double", "float"};
 
 typedef struct sit_data {
     dist_situation sit;
@@ -40,18 +39,16 @@ typedef struct sit_data {
     pm_model_f mf[DIST_MAX_MODELS];
     int have_f[DIST_MAX_MODELS];
     dist_call calls[DIST_N];
-    int status[2][DIST_N];
+    int status[DIST_NPREC][DIST_N];
 } sit_data;
 
 static sit_data *all;
 static int n_sit;
 static volatile double sink;
 
-/* May call c run in precision prec?  (The float build refuses some of the
-** hard models.) */
 static int runnable(const sit_data *d, int prec, int i)
 {
-    return prec == 0 || d->have_f[d->calls[i].model];
+    return dist_runnable(&d->calls[i], prec, d->have_f);
 }
 
 static void emit(FILE *out, const sit_data *d, int prec, const char *measure, double *v,
@@ -73,8 +70,8 @@ static void emit(FILE *out, const sit_data *d, int prec, const char *measure, do
     fprintf(out, "{\"name\": \"dist_%s\", \"prec\": \"%s\", \"measure\": \"%s\", \"n\": %d, "
                  "\"median\": %.1f, \"p99\": %.1f, \"worst\": %.1f, \"bound\": %d, "
                  "\"ok\": %d, \"warn\": %d, \"err\": %d}\n",
-            d->sit.name, prec_name[prec], measure, n, med, p99, worst,
-            prec == 0 ? d->sit.bound : PM_INVERT_F_MAX_EVALS, ok, warn, err);
+            d->sit.name, dist_prec_name[prec], measure, n, med, p99, worst,
+            prec == 1 ? PM_INVERT_F_MAX_EVALS : d->sit.bound, ok, warn, err);
 }
 
 int main(int argc, char **argv)
@@ -121,7 +118,7 @@ int main(int argc, char **argv)
         double *v = malloc(sizeof(double) * DIST_N);
 #endif
         for (s = 0; s < n_sit; s++)
-            for (p = 0; p < 2; p++) {
+            for (p = 0; p < DIST_NPREC; p++) {
                 int n = 0;
                 for (i = 0; i < all[s].sit.n; i++) {
                     double eh, ed;
@@ -151,7 +148,7 @@ int main(int argc, char **argv)
 #endif
     }
     if (callgrind) {
-        for (p = 0; p < 2; p++)
+        for (p = 0; p < DIST_NPREC; p++)
             for (s = 0; s < n_sit; s++)
                 for (i = 0; i < all[s].sit.n; i += every) {
                     char dump[96];
@@ -159,7 +156,7 @@ int main(int argc, char **argv)
                     if (!runnable(&all[s], p, i))
                         continue;
                     dist_run(p, all[s].models, all[s].mf, &all[s].calls[i], &eh, &ed);
-                    snprintf(dump, sizeof dump, "dist/%s/%s/%d", prec_name[p],
+                    snprintf(dump, sizeof dump, "dist/%s/%s/%d", dist_prec_name[p],
                              all[s].sit.name, i);
                     CALLGRIND_ZERO_STATS;
                     dist_run(p, all[s].models, all[s].mf, &all[s].calls[i], &eh, &ed);
@@ -169,9 +166,9 @@ int main(int argc, char **argv)
     }
     pin_one_cpu();
     {
-        /* t[((s * 2 + p) * DIST_N + i) * rounds + r] */
+        /* t[((s * DIST_NPREC + p) * DIST_N + i) * rounds + r] */
         size_t per = (size_t)DIST_N * (size_t)rounds;
-        double *t = malloc(sizeof(double) * per * 2 * (size_t)n_sit), *v, timer[64];
+        double *t = malloc(sizeof(double) * per * DIST_NPREC * (size_t)n_sit), *v, timer[64];
         double tmed, x1, x2;
         int r;
         if (!t)
@@ -184,7 +181,7 @@ int main(int argc, char **argv)
         dist_stats(timer, 64, &tmed, &x1, &x2);
         for (r = 0; r < rounds; r++)
             for (s = 0; s < n_sit; s++)
-                for (p = 0; p < 2; p++)
+                for (p = 0; p < DIST_NPREC; p++)
                     for (i = 0; i < all[s].sit.n; i++) {
                         double eh, ed;
                         unsigned long long a, b;
@@ -194,18 +191,18 @@ int main(int argc, char **argv)
                         dist_run(p, all[s].models, all[s].mf, &all[s].calls[i], &eh, &ed);
                         b = ticks();
                         sink += eh;
-                        t[((size_t)(s * 2 + p) * DIST_N + (size_t)i) * (size_t)rounds +
+                        t[((size_t)(s * DIST_NPREC + p) * DIST_N + (size_t)i) * (size_t)rounds +
                           (size_t)r] = (double)(b - a) - tmed;
                     }
         v = malloc(sizeof(double) * DIST_N);
         for (s = 0; s < n_sit; s++)
-            for (p = 0; p < 2; p++) {
+            for (p = 0; p < DIST_NPREC; p++) {
                 int n = 0;
                 for (i = 0; i < all[s].sit.n; i++) {
                     double med;
                     if (!runnable(&all[s], p, i))
                         continue;
-                    dist_stats(t + ((size_t)(s * 2 + p) * DIST_N + (size_t)i) * (size_t)rounds,
+                    dist_stats(t + ((size_t)(s * DIST_NPREC + p) * DIST_N + (size_t)i) * (size_t)rounds,
                                rounds, &med, &x1, &x2);
                     v[n++] = med;
                 }

@@ -46,6 +46,34 @@ static int real_model(pm_model *m, tu_rng *r)
     return pm_model_prepare(m) == PM_OK ? 0 : -1;
 }
 
+const char *const dist_prec_name[DIST_NPREC] = {"double", "float", "track"};
+
+int dist_runnable(const dist_call *c, int prec, const int *have_f)
+{
+    return prec == 0 || (prec == 1 && have_f[c->model]) || (prec == 2 && c->have_tk);
+}
+
+/* pm_model_track's state at the tick before c's, in a loop that has been
+** tracking c's target (the solution (t, d) of c's tick known) for three
+** ticks of dh radians of hour angle: started at the solution three ticks
+** before, J taken there, the last step known (where the ticks before got
+** PM_OK: within the anisotropic amplitude of the mount's pole they may
+** not, and the state is then as those calls left it). */
+static int track_state(const pm_model *m, dist_call *c, double t, double d, double dh)
+{
+    double x[2], y[2];
+    int k;
+    if (pm_model_invert_near(m, NULL, c->ah - 3 * dh, c->ad, t, d, &x[0], &x[1]) < 0)
+        return -1;
+    if (pm_track_start(&c->tk, x[0], x[1]) != PM_OK)
+        return -1;
+    for (k = 2; k >= 1; k--)
+        if (pm_model_track(m, NULL, &c->tk, c->ah - k * dh, c->ad, &y[0], &y[1]) < 0)
+            return -1;
+    c->have_tk = 1;
+    return 0;
+}
+
 int dist_make(int s, dist_situation *sit, pm_model *models, pm_model_f *mf, int *have_f,
               dist_call *calls)
 {
@@ -133,6 +161,8 @@ int dist_make(int s, dist_situation *sit, pm_model *models, pm_model_f *mf, int 
                 c->op = DIST_NEAR;
                 if (pm_model_invert_near(m, NULL, ph, c->ad, t, d, &c->sh, &c->sd) < 0)
                     return -1;
+                if (track_state(m, c, t, d, SIDEREAL * mode_dt[mode]) != 0)
+                    return -1;
             }
         }
     }
@@ -143,6 +173,10 @@ pm_status dist_run(int prec, const pm_model *models, const pm_model_f *mf,
                    const dist_call *c, double *eh, double *ed)
 {
     const pm_context *ctx = c->use_ctx ? &c->ctx : NULL;
+    if (prec == 2) {
+        pm_track t = c->tk;
+        return pm_model_track(&models[c->model], ctx, &t, c->ah, c->ad, eh, ed);
+    }
     if (prec == 0)
         return c->op == DIST_COLD
                    ? pm_model_invert(&models[c->model], ctx, c->ah, c->ad, c->side, eh, ed)

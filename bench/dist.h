@@ -42,7 +42,19 @@ typedef struct dist_call {
     pm_context ctx;
     double ah, ad;  /* target */
     double sh, sd;  /* start (near) */
+    int have_tk;    /* tk: tracking situations (pm_model_track) */
+    pm_track tk;    /* the loop's state at the tick before (a copy is used) */
 } dist_call;
+
+/* The builds a call can be run in: the double inverses, the float ones,
+** and pm_model_track (double, from the loop's state: tracking situations
+** of the bench and real sets only). */
+#define DIST_NPREC 3
+extern const char *const dist_prec_name[DIST_NPREC];
+
+/* May call c run in precision prec?  (The float build refuses some of the
+** hard models; only tracking calls have a state.) */
+int dist_runnable(const dist_call *c, int prec, const int *have_f);
 
 typedef struct dist_situation {
     char name[48];  /* "<set>_<mode>[_<band>_<side>]" */
@@ -65,7 +77,8 @@ int dist_count(void);
 int dist_make(int s, dist_situation *sit, pm_model *models, pm_model_f *mf, int *have_f,
               dist_call *calls);
 
-/* Run one call in double (prec 0) or float (prec 1); returns the status. */
+/* Run one call in double (prec 0), float (prec 1) or by pm_model_track
+** from a copy of its state (prec 2); returns the status. */
 pm_status dist_run(int prec, const pm_model *models, const pm_model_f *mf,
                    const dist_call *c, double *eh, double *ed);
 

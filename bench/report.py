@@ -111,15 +111,16 @@ def dist_table(dist, targets, say):
         by.setdefault((r["prec"], base), {})[r["measure"]] = r
     measures = [("evals", "evaluations"), ("host_ticks", "host ticks"),
                 ("host_insn", "host insn")] + [(t + "_insn", t + " insn") for t in targets]
-    for prec in ("double", "float"):
+    for prec in ("double", "float", "track"):
         sits = [b for (p, b) in by if p == prec]
         if not sits:
             continue
         order = {b: i for i, b in enumerate(dict.fromkeys(
             r["name"].rsplit("_" + r["prec"] + "_", 1)[0][len("dist_"):] for r in dist))}
         sits.sort(key=lambda b: order[b])
-        say("== the %s inverse per situation (bench/dist.h): median / p99 / worst per call"
-            % prec)
+        say("== the %s per situation (bench/dist.h): median / p99 / worst per call"
+            % ("pm_model_track (double, from the loop's state)" if prec == "track"
+               else prec + " inverse"))
         hdr = "%-27s %14s %5s" % ("situation", "evaluations", "bound")
         for m, title in measures[1:]:
             hdr += " %20s" % title
@@ -353,12 +354,13 @@ def main():
             if fi and t10 and t1k:
                 say("   issue 18: host %s L=2 in instructions: pm_model_track 10 Hz %.2fx,"
                     " 1 kHz %.2fx the forward" % (prec, t10 / fi, t1k / fi))
-    trk = [r for r in dist if r["measure"] == "evals" and r["prec"] == "double" and
-           "_track" in r["name"] and "_pole_" not in r["name"]]
-    if trk:
-        w = max(r["worst"] for r in trk)
-        say("   issue 18: tracking beyond 0.5 deg of the pole, worst evaluations <= 4: %g  %s"
-            " (bound %s)" % (w, verdict(w <= 4), trk[0].get("bound")))
+    for prec, call in (("double", "pm_model_invert_near"), ("track", "pm_model_track")):
+        trk = [r for r in dist if r["measure"] == "evals" and r["prec"] == prec and
+               "_track" in r["name"] and "_pole_" not in r["name"]]
+        if trk:
+            w = max(r["worst"] for r in trk)
+            say("   issue 18: tracking beyond 0.5 deg of the pole (%s), worst evaluations <= 4:"
+                " %g  %s (bound %s)" % (call, w, verdict(w <= 4), trk[0].get("bound")))
     if f2 is not None:
         say("   forward L=2 double <= 150 TSC ticks: %.0f  %s%s" % (
             f2, verdict(f2 <= 150), "" if f2 <= 150 else " (%.1fx over)" % (f2 / 150)))
