@@ -117,6 +117,9 @@ extern "C" {
 **   3,640 before the typical iteration's lean loop, 3,870 before the
 **   Jacobian's sums were fused); PM_BUDGET_M7_TRACK_INSNS adds 5 more evaluations of
 **   PM_BUDGET_M7_INSNS_PER_EVAL each, for the bound of 8.
+**   pm_model_track's ticks, under the same conditions: at most 3,300
+**   instructions measured (3 evaluations; its typical tick ~1,900 against
+**   invert_near's ~2,700), so PM_BUDGET_M7_TRACK_INSNS holds for it too.
 **   PM_BUDGET_M7_INSNS_PER_EVAL: an evaluation of the Newton iteration
 **   (the displacement with its Jacobian, sin/cos of the point, the
 **   rotations and their first and second derivatives, the step's
