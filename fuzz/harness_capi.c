@@ -4,7 +4,9 @@
 **  goes through a random sequence of operations: coefficients set to any
 **  double (NaN, Inf, 1e300, subnormals), terms added (valid and invalid),
 **  fields of the struct overwritten, prepare, apply, invert, invert_near,
-**  residual, the float build, pm_terms_eval, pm_term_name, pm_model_find.
+**  pm_model_track (a state carried across the operations, the model
+**  changing under it), residual, the float build, pm_terms_eval,
+**  pm_term_name, pm_model_find.
 **
 **  Invariants (README.md): every call returns one of its documented
 **  statuses; what the header makes certain is checked exactly (a stale
@@ -49,6 +51,7 @@ typedef struct ca_state {
     pm_model m;
     int prepared;                /* a prepare (init, add_term) succeeded */
     double pcoef[PM_MAX_TERMS];  /* the coefficients it prepared */
+    pm_track tk;                 /* pm_model_track's state (zero: not started) */
 } ca_state;
 
 static void ca_mark(ca_state *s)
@@ -197,11 +200,13 @@ static int ca_op_apply(pmfz_in *in, ca_state *s)
     return ca_apply(s, ctx, eh, ed, &t, &d, &st);
 }
 
-/* Checks common to invert and invert_near; start NULL for invert. */
+/* Checks common to invert, invert_near and track; start NULL for invert;
+** reach: how far from start the result may be (pi; pm_model_track starts
+** at most 0.01 rad on from its state's position on each axis). */
 static int ca_check_inverse(ca_state *s, const pm_context *ctx, double ah, double ad,
-                            int side, const double *start, double et, double ed, pm_status st)
+                            int side, const double *start, double reach, const char *fn,
+                            double et, double ed, pm_status st)
 {
-    const char *fn = start ? "invert_near" : "invert";
     int args_ok = pmfz_finite(ah) && pmfz_finite(ad) && fabs(ad) <= M_PI / 2 &&
                   (start ? fabs(start[0]) <= PM_START_MAX && fabs(start[1]) <= PM_START_MAX
                          : side == PM_SIDE_NORMAL || side == PM_SIDE_FLIPPED);
@@ -232,11 +237,11 @@ static int ca_check_inverse(ca_state *s, const pm_context *ctx, double ah, doubl
     if (st != PM_OK)
         return 0;
     if (start) {
-        double tol_t = M_PI + CA_EPS * (1 + fabs(start[0]));
-        double tol_d = M_PI + CA_EPS * (1 + fabs(start[1]));
+        double tol_t = reach + CA_EPS * (1 + fabs(start[0]));
+        double tol_d = reach + CA_EPS * (1 + fabs(start[1]));
         if (!(fabs(et - start[0]) <= tol_t) || !(fabs(ed - start[1]) <= tol_d))
-            return pmfz_fail("invert_near: (%.17g, %.17g) not within pi of the start "
-                             "(%.17g, %.17g)", et, ed, start[0], start[1]);
+            return pmfz_fail("%s: (%.17g, %.17g) not within %g of the start (%.17g, %.17g)",
+                             fn, et, ed, reach, start[0], start[1]);
     } else {
         double de = ed - s->m.coef[4];
         int off;
@@ -295,7 +300,55 @@ static int ca_op_invert(pmfz_in *in, ca_state *s, int near)
         if (s2 >= 0 || !pmfz_status_in(s2, ca_invert_st) || x != CA_SENTINEL)
             return pmfz_fail("invert: NULL output gave %d", s2);
     }
-    return ca_check_inverse(s, ctx, ah, ad, side, near ? start : NULL, et, ed, st);
+    return ca_check_inverse(s, ctx, ah, ad, side, near ? start : NULL, M_PI,
+                            near ? "invert_near" : "invert", et, ed, st);
+}
+
+/* pm_model_track: start the state anew (any angles), or a tick with any
+** target from wherever the state is, the model as the operations left
+** it; an unstarted state and NULL outputs are refused. */
+static int ca_op_track(pmfz_in *in, ca_state *s)
+{
+    pm_context c;
+    const pm_context *ctx;
+    double ah, ad, et = CA_SENTINEL, ed = CA_SENTINEL, before[2];
+    unsigned sel = pmfz_u8(in);
+    pm_status st;
+    if ((sel & 3u) == 0) {
+        double h = pmfz_angle(in), d = pmfz_angle(in);
+        int want = !pmfz_finite(h) || !pmfz_finite(d) ? PM_ERR_NONFINITE
+                   : fabs(h) > PM_START_MAX || fabs(d) > PM_START_MAX ? PM_ERR_ARG
+                                                                       : PM_OK;
+        st = pm_track_start(&s->tk, h, d);
+        if (st != want)
+            return pmfz_fail("track_start(%.17g, %.17g) gave %d, expected %d", h, d, st, want);
+        return 0;
+    }
+    ctx = pmfz_context(in, &c);
+    ah = pmfz_angle(in);
+    ad = pmfz_angle(in);
+    if (sel & 4u)
+        ad = fmod(ad, M_PI / 2);
+    if (s->tk.magic != PM_TRACK_MAGIC) {
+        st = pm_model_track(&s->m, ctx, &s->tk, ah, ad, &et, &ed);
+        if (st != PM_ERR_ARG || et != CA_SENTINEL || ed != CA_SENTINEL)
+            return pmfz_fail("track: an unstarted state gave %d", st);
+        return 0;
+    }
+    if ((sel & 0xC0u) == 0xC0u) {
+        double x = CA_SENTINEL;
+        st = pm_model_track(&s->m, ctx, &s->tk, ah, ad, NULL, &x);
+        if (st != PM_ERR_ARG || x != CA_SENTINEL)
+            return pmfz_fail("track: NULL output gave %d", st);
+    }
+    before[0] = s->tk.enc[0];
+    before[1] = s->tk.enc[1];
+    st = pm_model_track(&s->m, ctx, &s->tk, ah, ad, &et, &ed);
+    if (st == PM_OK && (s->tk.enc[0] != et || s->tk.enc[1] != ed))
+        return pmfz_fail("track: PM_OK without the state's position moved to the result");
+    if (st != PM_OK && (s->tk.enc[0] != before[0] || s->tk.enc[1] != before[1]))
+        return pmfz_fail("track: status %d moved the state's position", st);
+    return ca_check_inverse(s, ctx, ah, ad, 0, before, M_PI + 0.0101, "track", et, ed, st);
 }
 
 static int ca_op_residual(pmfz_in *in, ca_state *s)
@@ -654,7 +707,7 @@ int pmfz_capi(const unsigned char *data, size_t size)
         case 3: r = ca_op_add(&in, &s); break;
         case 4: case 5: r = ca_op_apply(&in, &s); break;
         case 6: case 7: r = ca_op_invert(&in, &s, 0); break;
-        case 8: r = ca_op_invert(&in, &s, 1); break;
+        case 8: r = (pmfz_u8(&in) & 1u) ? ca_op_track(&in, &s) : ca_op_invert(&in, &s, 1); break;
         case 9: r = ca_op_residual(&in, &s); break;
         case 10: r = ca_op_terms_eval(&in); break;
         case 11: r = ca_op_float(&in, &s); break;
