@@ -367,178 +367,236 @@ Options parse_report(Options o, int argc, char **argv)
     return o;
 }
 
-Options parse_args(int argc, char **argv)
+/* The command line of parse_args: the argument at i (a), its value. */
+struct Args {
+    int argc;
+    char **argv;
+    int i;
+    std::string a;
+    /* The next argument, the value of option a (what it should be). */
+    const char *need(const char *what)
+    {
+        if (i + 1 >= argc)
+            die(a + " needs " + what);
+        return argv[++i];
+    }
+};
+
+/* Which command parse_args reads the options of. */
+struct Cmd {
+    bool sim, eval, expl, cmp, pln;
+};
+
+/* Options of fitting and explaining (fit, explain, compare, plan); true
+** where a was one. */
+bool fit_option(Options &o, const Cmd &c, Args &g)
 {
-    Options o;
-    if (argc < 2) {
-        usage(stderr);
-        std::exit(2);
+    const std::string &a = g.a;
+    if (!c.eval && a == "--order") {
+        if (c.sim)
+            o.shape_opt = a;
+        const char *v = g.need("an order");
+        if (!parse_int(v, &o.order) || o.order < 0 || o.order > PM_MAX_L)
+            die(std::string("--order: expected an integer 0..") + std::to_string(PM_MAX_L) +
+                ", got '" + v + "'");
+    } else if (!c.sim && !c.eval && !c.expl && a == "--pier") {
+        std::string v = g.need("joint or split");
+        if (v == "split")
+            o.split = true;
+        else if (v == "joint")
+            o.split = false;
+        else
+            die("--pier: expected joint or split, got '" + v + "'");
+    } else if (!c.sim && a == "--json") {
+        o.json = true;
+    } else if (!c.sim && a == "--residuals") {
+        o.residuals = g.need("a file name");
+    } else if (!c.sim && !c.eval && a == "--add") {
+        o.adds.push_back(g.need("an effect (see pmfit --help)"));
+    } else if (!c.sim && !c.eval && !c.expl && a == "--save") {
+        o.save = g.need("a file name");
+    } else if (!c.sim && !c.eval && !c.expl && a == "--error-map") {
+        o.error_map = g.need("a file name (SVG)");
+    } else if (!c.sim && !c.eval && !c.expl && a == "--emit-c") {
+        o.emit_c = g.need("a file name");
+    } else if (!c.sim && !c.eval && !c.expl && a == "--tpoint-terms") {
+        o.tpoint_terms = g.need("a file name");
+    } else if (!c.sim && !c.eval && a == "--robust") {
+        o.robust = true;
+    } else if (!c.sim && !c.eval && a == "--clip") {
+        o.clip = number(a, g.need("a threshold in robust sigmas"), 2, 1000);
+        o.clip_given = true;
+    } else {
+        return false;
     }
-    o.cmd = argv[1];
-    if (o.cmd == "-h" || o.cmd == "--help" || o.cmd == "help") {
-        usage(stdout);
-        std::exit(0);
-    }
-    if (o.cmd == "report")
-        return parse_report(o, argc, argv);
-    if (o.cmd != "fit" && o.cmd != "simulate" && o.cmd != "eval" && o.cmd != "explain" &&
-        o.cmd != "compare" && o.cmd != "plan")
-        die("unknown command '" + o.cmd +
-            "' (expected: fit, explain, eval, compare, plan, report or simulate); see pmfit --help");
-    bool sim = o.cmd == "simulate", eval = o.cmd == "eval", expl = o.cmd == "explain";
-    bool cmp = o.cmd == "compare", pln = o.cmd == "plan";
-    for (int i = 2; i < argc; i++) {
-        std::string a = argv[i];
-        auto need = [&](const char *what) -> const char * {
-            if (i + 1 >= argc)
-                die(a + " needs " + what);
-            return argv[++i];
-        };
-        if (!eval && a == "--order") {
-            if (sim)
-                o.shape_opt = a;
-            const char *v = need("an order");
-            if (!parse_int(v, &o.order) || o.order < 0 || o.order > PM_MAX_L)
-                die(std::string("--order: expected an integer 0..") +
-                    std::to_string(PM_MAX_L) + ", got '" + v + "'");
-        } else if (!sim && !eval && !expl && a == "--pier") {
-            std::string v = need("joint or split");
-            if (v == "split")
-                o.split = true;
-            else if (v == "joint")
-                o.split = false;
-            else
-                die("--pier: expected joint or split, got '" + v + "'");
-        } else if (!sim && a == "--json") {
-            o.json = true;
-        } else if (!sim && a == "--residuals") {
-            o.residuals = need("a file name");
-        } else if (expl && a == "--plots") {
-            o.plots = need("a directory");
-        } else if (expl && a == "--alpha") {
-            o.alpha = number(a, need("a probability"), 1e-12, 0.5);
-        } else if (expl && a == "--gear") {
-            std::string v = need("a gear period in cycles per revolution ([ha:|dec:]G)");
-            bool ha = true, dec = true;
-            if (v.rfind("ha:", 0) == 0) {
-                dec = false;
-                v = v.substr(3);
-            } else if (v.rfind("dec:", 0) == 0) {
-                ha = false;
-                v = v.substr(4);
-            }
-            double g = number(a, v.c_str(), 1e-6, 1e6);
-            if (ha)
-                o.gears_ha.push_back(g);
-            if (dec)
-                o.gears_dec.push_back(g);
-        } else if (!sim && !eval && a == "--add") {
-            o.adds.push_back(need("an effect (see pmfit --help)"));
-        } else if (!sim && !eval && !expl && a == "--save") {
-            o.save = need("a file name");
-        } else if (!sim && !eval && !expl && a == "--error-map") {
-            o.error_map = need("a file name (SVG)");
-        } else if (!sim && !eval && !expl && a == "--emit-c") {
-            o.emit_c = need("a file name");
-        } else if (pln && a == "--next") {
-            o.next = (int)number(a, need("a count"), 1, 1000);
-        } else if (pln && a == "--min-el") {
-            o.min_el = number(a, need("degrees"), -10, 80);
-            o.min_el_given = true;
-        } else if (pln && a == "--grid") {
-            o.grid = number(a, need("degrees"), 1, 30);
-        } else if (pln && a == "--horizon") {
-            o.horizon = need("a horizon file");
-        } else if (pln && (a == "--catalog" || a == "--catalogue")) {
-            o.catalogue = need("a star catalogue file");
-        } else if (pln && a == "--lst") {
-            o.lst = number(a, need("hours"), 0, 23.999999999);
-        } else if (pln && a == "--utc") {
-            o.utc = need("a UTC time YYYY-MM-DDTHH:MM[:SS]");
-        } else if (pln && a == "--lon") {
-            o.lon = number(a, need("degrees (east)"), -180, 360);
-        } else if (pln && a == "--criterion") {
-            std::string v = need("I or D");
-            if (v != "I" && v != "D" && v != "i" && v != "d")
-                die("--criterion: expected I (mean predicted error) or D (determinant), got '" + v +
-                    "'");
-            o.d_optimal = v == "D" || v == "d";
-        } else if (pln && a == "--slew") {
-            o.slew_rate = number(a, need("the slew rate in deg/s"), 0.01, 100);
-        } else if (pln && a == "--settle") {
-            o.settle = number(a, need("seconds"), 0, 3600);
-        } else if (pln && a == "--point-time") {
-            o.point_time = number(a, need("seconds"), 0, 36000);
-        } else if (pln && a == "--flip-time") {
-            o.flip_time = number(a, need("seconds"), 0, 3600);
-        } else if (pln && a == "--sides") {
-            o.sides = need("run, meridian or both");
-            if (o.sides != "run" && o.sides != "meridian" && o.sides != "both")
-                die("--sides: expected run, meridian or both, got '" + o.sides + "'");
-        } else if (pln && a == "--meridian-limit") {
-            o.meridian_limit = number(a, need("degrees"), 0, 90);
-        } else if (sim && a == "--inject") {
-            o.inject.push_back(need("EFFECT[=SIZE]"));
-        } else if (sim && a == "--into") {
-            o.into = need("a run file");
-        } else if (sim && a == "--n" && (o.shape_opt = a, true)) {
-            o.n = (long)number(a, need("a count"), 1, 1e7);
-        } else if (sim && a == "--seed") {
-            o.seed = (unsigned long long)number(a, need("a seed"), 0, 1e15);
-        } else if ((sim || pln) && a == "--lat" && (o.shape_opt = a, true)) {
-            o.lat = number(a, need("degrees"), -90, 90);
-        } else if (sim && a == "--el-limit" && (o.shape_opt = a, true)) {
-            o.el_limit = number(a, need("degrees"), -10, 80);
-        } else if ((sim || pln) && a == "--noise" && (o.shape_opt = a, true)) {
-            o.noise = number(a, need("arcseconds"), 0, 1e5);
-        } else if (sim && a == "--random-aniso" && (o.shape_opt = a, true)) {
-            o.random_aniso = number(a, need("arcseconds"), 0, 1e5);
-        } else if ((sim || pln) && a == "--fork" && (o.shape_opt = a, true)) {
-            o.fork = true;
-        } else if ((sim || pln) && a == "--mount" && (o.shape_opt = a, true)) {
-            std::string v = need("equatorial or altaz");
-            if (v != "equatorial" && v != "altaz")
-                die("--mount: expected equatorial or altaz, got '" + v + "'");
-            o.altaz = v == "altaz";
-        } else if (sim && a == "--effect" && (o.shape_opt = a, true)) {
-            std::string v = need("SPEC=ARCSEC");
-            size_t eq = v.rfind('=');
-            if (eq == std::string::npos || eq == 0)
-                die("--effect: expected SPEC=ARCSEC (SPEC as for fit --add), got '" + v + "'");
-            o.effects.push_back({v.substr(0, eq), number(a, v.c_str() + eq + 1, -1e6, 1e6)});
-        } else if (sim && a == "--phase") {
-            o.phase_deg = number(a, need("degrees"), -360, 360);
-        } else if (sim && a == "--term" && (o.shape_opt = a, true)) {
-            std::string v = need("NAME=ARCSEC");
-            size_t eq = v.rfind('=');
-            if (eq == std::string::npos || eq == 0)
-                die("--term: expected NAME=ARCSEC, got '" + v + "'");
-            o.terms.push_back({v.substr(0, eq), number(a, v.c_str() + eq + 1, -1e6, 1e6)});
-        } else if (a == "--format") {
-            set_format(o, need("a format name"));
-        } else if (a == "--equinox") {
-            set_equinox(o, need("J2000 or JNow"));
-        } else if (!sim && !eval && !expl && a == "--tpoint-terms") {
-            o.tpoint_terms = need("a file name");
-        } else if (a == "--no-refraction") {
-            o.refraction = false;
-        } else if (a == "--skip-bad") {
-            o.skip_bad = true;
-        } else if (!sim && !eval && a == "--robust") {
-            o.robust = true;
-        } else if (!sim && !eval && a == "--clip") {
-            o.clip = number(a, need("a threshold in robust sigmas"), 2, 1000);
-            o.clip_given = true;
-        } else if (!a.empty() && a[0] == '-') {
-            die("unknown option '" + a + "'; see pmfit --help");
-        } else if ((eval || cmp) && o.model.empty()) {
-            o.model = a;
-        } else if (o.run.empty()) {
-            o.run = a;
-        } else {
-            die("more than one run file given ('" + o.run + "', '" + a + "')");
+    return true;
+}
+
+/* Options of explain alone. */
+bool explain_option(Options &o, const Cmd &c, Args &g)
+{
+    const std::string &a = g.a;
+    if (!c.expl)
+        return false;
+    if (a == "--plots") {
+        o.plots = g.need("a directory");
+    } else if (a == "--alpha") {
+        o.alpha = number(a, g.need("a probability"), 1e-12, 0.5);
+    } else if (a == "--gear") {
+        std::string v = g.need("a gear period in cycles per revolution ([ha:|dec:]G)");
+        bool ha = true, dec = true;
+        if (v.rfind("ha:", 0) == 0) {
+            dec = false;
+            v = v.substr(3);
+        } else if (v.rfind("dec:", 0) == 0) {
+            ha = false;
+            v = v.substr(4);
         }
+        double gp = number(a, v.c_str(), 1e-6, 1e6);
+        if (ha)
+            o.gears_ha.push_back(gp);
+        if (dec)
+            o.gears_dec.push_back(gp);
+    } else {
+        return false;
     }
+    return true;
+}
+
+/* Options of plan alone (the catalogue, the slew model). */
+bool plan_option(Options &o, const Cmd &c, Args &g)
+{
+    const std::string &a = g.a;
+    if (!c.pln)
+        return false;
+    if (a == "--next") {
+        o.next = (int)number(a, g.need("a count"), 1, 1000);
+    } else if (a == "--min-el") {
+        o.min_el = number(a, g.need("degrees"), -10, 80);
+        o.min_el_given = true;
+    } else if (a == "--grid") {
+        o.grid = number(a, g.need("degrees"), 1, 30);
+    } else if (a == "--horizon") {
+        o.horizon = g.need("a horizon file");
+    } else if (a == "--catalog" || a == "--catalogue") {
+        o.catalogue = g.need("a star catalogue file");
+    } else if (a == "--lst") {
+        o.lst = number(a, g.need("hours"), 0, 23.999999999);
+    } else if (a == "--utc") {
+        o.utc = g.need("a UTC time YYYY-MM-DDTHH:MM[:SS]");
+    } else if (a == "--lon") {
+        o.lon = number(a, g.need("degrees (east)"), -180, 360);
+    } else if (a == "--criterion") {
+        std::string v = g.need("I or D");
+        if (v != "I" && v != "D" && v != "i" && v != "d")
+            die("--criterion: expected I (mean predicted error) or D (determinant), got '" + v +
+                "'");
+        o.d_optimal = v == "D" || v == "d";
+    } else if (a == "--slew") {
+        o.slew_rate = number(a, g.need("the slew rate in deg/s"), 0.01, 100);
+    } else if (a == "--settle") {
+        o.settle = number(a, g.need("seconds"), 0, 3600);
+    } else if (a == "--point-time") {
+        o.point_time = number(a, g.need("seconds"), 0, 36000);
+    } else if (a == "--flip-time") {
+        o.flip_time = number(a, g.need("seconds"), 0, 3600);
+    } else if (a == "--sides") {
+        o.sides = g.need("run, meridian or both");
+        if (o.sides != "run" && o.sides != "meridian" && o.sides != "both")
+            die("--sides: expected run, meridian or both, got '" + o.sides + "'");
+    } else if (a == "--meridian-limit") {
+        o.meridian_limit = number(a, g.need("degrees"), 0, 90);
+    } else {
+        return false;
+    }
+    return true;
+}
+
+/* Options that shape a simulated run (simulate; --lat, --noise, --fork and
+** --mount also plan's sky); each noted in shape_opt. */
+bool shape_option(Options &o, const Cmd &c, Args &g)
+{
+    const std::string &a = g.a;
+    bool both = c.sim || c.pln;
+    if (c.sim && a == "--n") {
+        o.n = (long)number(a, g.need("a count"), 1, 1e7);
+    } else if (both && a == "--lat") {
+        o.lat = number(a, g.need("degrees"), -90, 90);
+    } else if (c.sim && a == "--el-limit") {
+        o.el_limit = number(a, g.need("degrees"), -10, 80);
+    } else if (both && a == "--noise") {
+        o.noise = number(a, g.need("arcseconds"), 0, 1e5);
+    } else if (c.sim && a == "--random-aniso") {
+        o.random_aniso = number(a, g.need("arcseconds"), 0, 1e5);
+    } else if (both && a == "--fork") {
+        o.fork = true;
+    } else if (both && a == "--mount") {
+        std::string v = g.need("equatorial or altaz");
+        if (v != "equatorial" && v != "altaz")
+            die("--mount: expected equatorial or altaz, got '" + v + "'");
+        o.altaz = v == "altaz";
+    } else if (c.sim && a == "--effect") {
+        std::string v = g.need("SPEC=ARCSEC");
+        size_t eq = v.rfind('=');
+        if (eq == std::string::npos || eq == 0)
+            die("--effect: expected SPEC=ARCSEC (SPEC as for fit --add), got '" + v + "'");
+        o.effects.push_back({v.substr(0, eq), number(a, v.c_str() + eq + 1, -1e6, 1e6)});
+    } else if (c.sim && a == "--term") {
+        std::string v = g.need("NAME=ARCSEC");
+        size_t eq = v.rfind('=');
+        if (eq == std::string::npos || eq == 0)
+            die("--term: expected NAME=ARCSEC, got '" + v + "'");
+        o.terms.push_back({v.substr(0, eq), number(a, v.c_str() + eq + 1, -1e6, 1e6)});
+    } else {
+        return false;
+    }
+    o.shape_opt = a;
+    return true;
+}
+
+/* Options of simulate that do not shape the run, and of reading a run. */
+bool run_option(Options &o, const Cmd &c, Args &g)
+{
+    const std::string &a = g.a;
+    if (c.sim && a == "--inject") {
+        o.inject.push_back(g.need("EFFECT[=SIZE]"));
+    } else if (c.sim && a == "--into") {
+        o.into = g.need("a run file");
+    } else if (c.sim && a == "--seed") {
+        o.seed = (unsigned long long)number(a, g.need("a seed"), 0, 1e15);
+    } else if (c.sim && a == "--phase") {
+        o.phase_deg = number(a, g.need("degrees"), -360, 360);
+    } else if (a == "--format") {
+        set_format(o, g.need("a format name"));
+    } else if (a == "--equinox") {
+        set_equinox(o, g.need("J2000 or JNow"));
+    } else if (a == "--no-refraction") {
+        o.refraction = false;
+    } else if (a == "--skip-bad") {
+        o.skip_bad = true;
+    } else {
+        return false;
+    }
+    return true;
+}
+
+/* The file arguments (RUN, and eval's and compare's MODEL or OLD first). */
+void positional(Options &o, const Cmd &c, const std::string &a)
+{
+    if (!a.empty() && a[0] == '-')
+        die("unknown option '" + a + "'; see pmfit --help");
+    if ((c.eval || c.cmp) && o.model.empty())
+        o.model = a;
+    else if (o.run.empty())
+        o.run = a;
+    else
+        die("more than one run file given ('" + o.run + "', '" + a + "')");
+}
+
+/* The combinations of options a command refuses. */
+void check_combinations(const Options &o, const Cmd &c, int argc, char **argv)
+{
+    const bool sim = c.sim, eval = c.eval, cmp = c.cmp, pln = c.pln;
     if (sim && !o.into.empty() && !o.shape_opt.empty())
         die(o.shape_opt + " shapes a simulated run; with --into the run is the recording (only "
                           "--inject, --phase, --seed, --no-refraction and --skip-bad apply)");
@@ -584,6 +642,36 @@ Options parse_args(int argc, char **argv)
                 die(a + " belongs to the slew model; add --slew DEG_PER_S");
         }
     }
+}
+
+Options parse_args(int argc, char **argv)
+{
+    Options o;
+    if (argc < 2) {
+        usage(stderr);
+        std::exit(2);
+    }
+    o.cmd = argv[1];
+    if (o.cmd == "-h" || o.cmd == "--help" || o.cmd == "help") {
+        usage(stdout);
+        std::exit(0);
+    }
+    if (o.cmd == "report")
+        return parse_report(o, argc, argv);
+    if (o.cmd != "fit" && o.cmd != "simulate" && o.cmd != "eval" && o.cmd != "explain" &&
+        o.cmd != "compare" && o.cmd != "plan")
+        die("unknown command '" + o.cmd +
+            "' (expected: fit, explain, eval, compare, plan, report or simulate); see pmfit --help");
+    const Cmd c = {o.cmd == "simulate", o.cmd == "eval", o.cmd == "explain", o.cmd == "compare",
+                   o.cmd == "plan"};
+    Args g = {argc, argv, 2, std::string()};
+    for (; g.i < argc; g.i++) {
+        g.a = argv[g.i];
+        if (!fit_option(o, c, g) && !explain_option(o, c, g) && !plan_option(o, c, g) &&
+            !shape_option(o, c, g) && !run_option(o, c, g))
+            positional(o, c, g.a);
+    }
+    check_combinations(o, c, argc, argv);
     for (int i = 2; i < argc; i++) {
         std::string a = argv[i];
         o.lat_given = o.lat_given || a == "--lat";
