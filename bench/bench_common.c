@@ -55,13 +55,18 @@ static int d_invert_near(int slot, double ah, double ad, double sh, double sd,
     return pm_model_invert_near(d_model[slot], 0, ah, ad, sh, sd, eh, ed);
 }
 
-static int d_track(int slot, pm_track *t, double ah, double ad, double *eh, double *ed)
+static int d_track_start(void *t, double eh, double ed)
 {
-    return pm_model_track(d_model[slot], 0, t, ah, ad, eh, ed);
+    return pm_track_start((pm_track *)t, eh, ed);
 }
 
-const bench_api bench_api_double = {"double", d_load,        d_apply,
-                                    d_invert, d_invert_near, d_track};
+static int d_track(int slot, void *t, double ah, double ad, double *eh, double *ed)
+{
+    return pm_model_track(d_model[slot], 0, (pm_track *)t, ah, ad, eh, ed);
+}
+
+const bench_api bench_api_double = {"double",      d_load,        d_apply, d_invert,
+                                    d_invert_near, d_track_start, d_track};
 
 /* ---------------------------------------------------------------------- */
 /* The float build of the evaluation (pm_model_f: single precision inside,
@@ -92,7 +97,18 @@ static int f_invert_near(int slot, double ah, double ad, double sh, double sd,
     return pm_model_invert_near_f(&f_model[slot], 0, ah, ad, sh, sd, eh, ed);
 }
 
-const bench_api bench_api_float = {"float", f_load, f_apply, f_invert, f_invert_near, 0};
+static int f_track_start(void *t, double eh, double ed)
+{
+    return pm_track_f_start((pm_track_f *)t, eh, ed);
+}
+
+static int f_track(int slot, void *t, double ah, double ad, double *eh, double *ed)
+{
+    return pm_model_track_f(&f_model[slot], 0, (pm_track_f *)t, ah, ad, eh, ed);
+}
+
+const bench_api bench_api_float = {"float",       f_load,        f_apply, f_invert,
+                                   f_invert_near, f_track_start, f_track};
 
 const bench_api *const bench_apis[] = {&bench_api_double, &bench_api_float};
 const int bench_n_apis = (int)(sizeof bench_apis / sizeof bench_apis[0]);
@@ -158,7 +174,10 @@ static struct {
     const bench_input *in;
     const bench_api *api;
     int slot;
-    pm_track t[BENCH_NPOS];
+    union {
+        pm_track d;
+        pm_track_f f;
+    } t[BENCH_NPOS];
     long k[BENCH_NPOS]; /* the tick the state is at */
 } track_state[2];
 
@@ -170,8 +189,8 @@ static int track_run(const bench_api *api, int slot, int op, const bench_input *
     double a, b;
     if (track_state[w].in != in || track_state[w].api != api || track_state[w].slot != slot) {
         for (i = 0; i < BENCH_NPOS; i++) {
-            pm_track *t = &track_state[w].t[i];
-            bad += pm_track_start(t, in->eh[i], in->ed[i]) != PM_OK;
+            void *t = &track_state[w].t[i];
+            bad += api->track_start(t, in->eh[i], in->ed[i]) != PM_OK;
             bad += api->track(slot, t, in->ah[i] + tick, in->ad[i], &a, &b) != PM_OK;
             bad += api->track(slot, t, in->ah[i] + 2 * tick, in->ad[i], &a, &b) != PM_OK;
             track_state[w].k[i] = 2;

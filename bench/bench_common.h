@@ -28,8 +28,10 @@ typedef struct bench_api {
     int (*invert)(int slot, double ah, double ad, double *eh, double *ed);
     int (*invert_near)(int slot, double ah, double ad, double sh, double sd,
                        double *eh, double *ed);
-    /* pm_model_track, or 0 where the build has none */
-    int (*track)(int slot, pm_track *t, double ah, double ad, double *eh, double *ed);
+    /* pm_track_start and pm_model_track, or their float build's, on the
+    ** state at t (a pm_track or a pm_track_f) */
+    int (*track_start)(void *t, double eh, double ed);
+    int (*track)(int slot, void *t, double ah, double ad, double *eh, double *ed);
 } bench_api;
 
 /* The double API of include/pm.h and its float build (pm_model_f); a
@@ -69,8 +71,7 @@ enum {
 };
 extern const char *const bench_op_name[BENCH_NOPS];
 
-/* Whether api has operation op (the naive ones and pm_model_track: the
-** double API only). */
+/* Whether api has operation op (the naive ones: the double API only). */
 int bench_op_supported(const bench_api *api, int op);
 
 /* Run operation op of api over the n first positions of in (slot: the

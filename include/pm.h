@@ -793,6 +793,40 @@ pm_status pm_model_invert_near_f(const pm_model_f *m, const pm_context *ctx,
                                  double start_ha, double start_dec,
                                  double *enc_ha, double *enc_dec);
 
+/*
+**  pm_track_f_start, pm_model_track_f - the float build's tracking loop:
+**  as pm_model_invert_near_f from the state's last position, the fixed
+**  point started from the correction the last ticks converged to, moved
+**  on by its last change.
+**
+**  Notes:
+**  1) The correction changes by |dC/dx| times a tick's motion (1e-9 rad
+**     at 10 Hz with arcminute terms), and that change by far less, so the
+**     first step's change already predicts a point within PM_INVERT_F_TOL,
+**     and the
+**     forward model's check (Note 2 above) certifies it: two evaluations
+**     a tick where pm_model_invert_near_f makes three.  The check is
+**     what makes the result right, whatever the state holds (a state
+**     from another model only costs steps).
+**  2) Arguments, statuses and the state's updates as pm_model_track
+**     (PM_ERR_ARG for a state pm_track_f_start did not fill); the state
+**     is plain data of the caller's.
+*/
+typedef struct pm_track_f {
+    double enc[2];  /* the last position (encoder axes 1 and 2) */
+    /* Set by pm_track_f_start and pm_model_track_f; do not set by hand. */
+    int magic;      /* PM_TRACK_F_MAGIC once started */
+    int have_corr;  /* corr holds the last tick's correction (1), and
+                       corr_prev the one before (2) */
+    float corr[2];  /* the correction (frame, radians) it converged to */
+    float corr_prev[2];
+} pm_track_f;
+#define PM_TRACK_F_MAGIC 0x7472616c
+pm_status pm_track_f_start(pm_track_f *t, double enc_ha, double enc_dec);
+pm_status pm_model_track_f(const pm_model_f *m, const pm_context *ctx, pm_track_f *t,
+                           double app_ha, double app_dec, double *enc_ha,
+                           double *enc_dec);
+
 /* ---------------------------------------------------------------------- */
 /* Fit.                                                                   */
 /* ---------------------------------------------------------------------- */

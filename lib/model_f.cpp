@@ -330,7 +330,8 @@ void encoder_of(const pm_model_f *m, double T0, double D, float dT, float dD, bo
 ** PM_WARN_NOT_CONVERGED where it does not contract (close to the mount's
 ** pole, or beyond its edge): the Newton iteration then takes over. */
 pm_status fixed_f(const pm_model_f *m, const pm_context *ctx, double T, double D, bool flip,
-                  const double ref[2], double *t_out, double *d_out)
+                  const double ref[2], const float *warm, float *corr, double *t_out,
+                  double *d_out)
 {
     const double T0 = wrap_pi(T);
     float sT, cT;
@@ -339,7 +340,9 @@ pm_status fixed_f(const pm_model_f *m, const pm_context *ctx, double T, double D
     dec_trig_f(D, &sD, &cD);
     const bool raw = reads_angles_f(m);
     const float tol = (float)PM_INVERT_F_TOL;
-    float dT = 0, dD = 0, last = 0;
+    /* (from the correction of the tick before where pm_model_track_f has
+    ** one: it then changes by far less than the tolerance per step) */
+    float dT = warm ? warm[0] : 0.0f, dD = warm ? warm[1] : 0.0f, last = 0;
     for (int it = 0; it < PM_INVERT_F_FIXED; it++) {
         float s1, c1, s2, c2;
         sincos_small(dT, &s1, &c1);
@@ -379,7 +382,7 @@ pm_status fixed_f(const pm_model_f *m, const pm_context *ctx, double T, double D
         ** forward model itself, as the Newton iteration judges its points
         ** (one more evaluation); Newton takes over if it misses. */
         float rho = last > 0 ? change / last : change == 0 ? 0.0f : 1.0f;
-        if (it > 0 && change * rho <= 0.25f * tol) {
+        if ((it > 0 || warm) && change * rho <= 0.25f * tol) {
             double t, d, tr, dr;
             float kT, kD; /* the correction there */
             encoder_of(m, T0, D, dT, dD, flip, ref, &t, &d);
@@ -399,6 +402,10 @@ pm_status fixed_f(const pm_model_f *m, const pm_context *ctx, double T, double D
                 return PM_WARN_NOT_CONVERGED;
             *t_out = t;
             *d_out = d;
+            if (corr) {
+                corr[0] = dT;
+                corr[1] = dD;
+            }
             return PM_OK;
         }
         last = change;
@@ -407,7 +414,8 @@ pm_status fixed_f(const pm_model_f *m, const pm_context *ctx, double T, double D
 }
 
 pm_status invert_f(const pm_model_f *m, const pm_context *ctx, double T, double D, int side,
-                   const double *start, double *enc_ha, double *enc_dec)
+                   const double *start, const float *warm, float *corr, bool *have_corr,
+                   double *enc_ha, double *enc_dec)
 {
     pm_status st = check_f(m, ctx);
     if (st != PM_OK)
@@ -430,10 +438,12 @@ pm_status invert_f(const pm_model_f *m, const pm_context *ctx, double T, double 
             flip = abs_beyond(wrap_pi(start[1] - m->e), PI / 2);
         /* (within float noise of the pole's edge the frame can put the
         ** point a hair beyond it: the side is checked in double) */
-        if (fixed_f(m, ctx, T, D, flip, turn, &t, &d) == PM_OK &&
+        if (fixed_f(m, ctx, T, D, flip, turn, warm, corr, &t, &d) == PM_OK &&
             (start || !abs_beyond(wrap_pi(d - m->e), PI / 2) == !flip)) {
             *enc_ha = t;
             *enc_dec = d;
+            if (have_corr)
+                *have_corr = true;
             return PM_OK;
         }
     }
@@ -606,8 +616,8 @@ pm_status pm_model_invert_f(const pm_model_f *m, const pm_context *ctx, double a
 {
     if (side != PM_SIDE_NORMAL && side != PM_SIDE_FLIPPED)
         return PM_ERR_ARG;
-    return invert_f(m, ctx, app_ha, app_dec, side == PM_SIDE_NORMAL ? 1 : -1, 0, enc_ha,
-                    enc_dec);
+    return invert_f(m, ctx, app_ha, app_dec, side == PM_SIDE_NORMAL ? 1 : -1, 0, 0, 0, 0,
+                    enc_ha, enc_dec);
 }
 
 pm_status pm_model_invert_near_f(const pm_model_f *m, const pm_context *ctx, double app_ha,
@@ -615,7 +625,54 @@ pm_status pm_model_invert_near_f(const pm_model_f *m, const pm_context *ctx, dou
                                  double *enc_ha, double *enc_dec)
 {
     double start[2] = {start_ha, start_dec};
-    return invert_f(m, ctx, app_ha, app_dec, 1, start, enc_ha, enc_dec);
+    return invert_f(m, ctx, app_ha, app_dec, 1, start, 0, 0, 0, enc_ha, enc_dec);
+}
+
+pm_status pm_track_f_start(pm_track_f *t, double enc_ha, double enc_dec)
+{
+    if (!t)
+        return PM_ERR_ARG;
+    if (!finite(enc_ha) || !finite(enc_dec))
+        return PM_ERR_NONFINITE;
+    if (abs_beyond(enc_ha, PM_START_MAX) || abs_beyond(enc_dec, PM_START_MAX))
+        return PM_ERR_ARG;
+    __builtin_memset(t, 0, sizeof *t);
+    t->enc[0] = enc_ha;
+    t->enc[1] = enc_dec;
+    t->magic = PM_TRACK_F_MAGIC;
+    return PM_OK;
+}
+
+pm_status pm_model_track_f(const pm_model_f *m, const pm_context *ctx, pm_track_f *t,
+                           double app_ha, double app_dec, double *enc_ha, double *enc_dec)
+{
+    if (!t || t->magic != PM_TRACK_F_MAGIC || !enc_ha || !enc_dec)
+        return PM_ERR_ARG;
+    float corr[2] = {0, 0}, warm[2];
+    bool have = false;
+    double eh = 0, ed = 0;
+    /* the correction moved on by its last change (a target moving
+    ** uniformly: second order), or as it was */
+    for (int i = 0; i < 2; i++)
+        warm[i] = t->have_corr > 1 ? t->corr[i] + (t->corr[i] - t->corr_prev[i]) : t->corr[i];
+    pm_status st = invert_f(m, ctx, app_ha, app_dec, 1, t->enc, t->have_corr ? warm : 0, corr,
+                            &have, &eh, &ed);
+    if (st < 0)
+        return st;
+    if (st == PM_OK) {
+        t->enc[0] = eh;
+        t->enc[1] = ed;
+        t->have_corr = have ? (t->have_corr ? 2 : 1) : 0;
+        t->corr_prev[0] = t->corr[0];
+        t->corr_prev[1] = t->corr[1];
+        t->corr[0] = corr[0];
+        t->corr[1] = corr[1];
+    } else {
+        t->have_corr = 0;
+    }
+    *enc_ha = eh;
+    *enc_dec = ed;
+    return st;
 }
 
 } /* extern "C" */

@@ -332,6 +332,100 @@ START_TEST(test_track_isotropic)
 }
 END_TEST
 
+/* The float build's loop: models whose correction its fixed point takes
+** (pm.h, pm_model_invert_f Note 2: below 0.01 rad after the index shifts;
+** index terms within 1 deg, the polar axis, d and i within 0.1 deg,
+** harmonic terms within 10'), ticks of 1 ms, 0.1 s and 1 s, up to 70 deg
+** from the mount's equator, both sides: the same status as
+** pm_model_invert_near_f from the same start, every PM_OK result
+** round-tripping through the float forward model within
+** 2 PM_INVERT_F_TOL, and two evaluations a tick (the correction and the
+** forward model's check) where pm_model_invert_near_f makes three. */
+START_TEST(test_track_float)
+{
+    static const double dts[3] = {0.001, 0.1, 1.0};
+    tu_rng r;
+    long calls = 0, ok = 0, ev_t[3] = {0, 0, 0}, ev_n[3] = {0, 0, 0};
+    int j, i, k;
+    tu_seed(&r, 81);
+    for (j = 0; j < 8; j++) {
+        pm_model m;
+        pm_model_f mf;
+        ck_assert_int_eq(pm_model_init(&m, PM_MOUNT_EQUATORIAL, 2), PM_OK);
+        for (i = 0; i < m.n_terms; i++)
+            m.coef[i] = (2 * tu_uniform(&r) - 1) *
+                        (i == 2 || i == 4 ? 1 * DEG : i < 6 ? 0.1 * DEG : 10 * 60 * ARCSEC);
+        ck_assert_int_eq(pm_model_prepare(&m), PM_OK);
+        ck_assert_int_eq(pm_model_f_prepare(&mf, &m), PM_OK);
+        for (i = 0; i < 3; i++) {
+            const double x = (2 * tu_uniform(&r) - 1) * 70 * DEG, e = m.coef[4];
+            const int flip = tu_uniform(&r) < 0.5;
+            double eh = (2 * tu_uniform(&r) - 1) * M_PI, ed = e + (flip ? M_PI - x : x);
+            double ha0, dec;
+            pm_track_f t;
+            ck_assert_int_eq(pm_model_apply_f(&mf, NULL, eh, ed, &ha0, &dec), PM_OK);
+            ck_assert_int_eq(pm_track_f_start(&t, eh, ed), PM_OK);
+            for (k = 1; k <= 40; k++) {
+                double ah = ha0 + k * dts[i] * SIDEREAL, th, td, nh, nd, bh, bd;
+                pm_track_f before = t;
+                unsigned long e0 = probe_count;
+                pm_status st = pm_model_track_f(&mf, NULL, &t, ah, dec, &th, &td), sn;
+                if (k > 2)
+                    ev_t[i] += (long)(probe_count - e0);
+                ck_assert_uint_le(probe_count - e0, PM_INVERT_F_MAX_EVALS);
+                e0 = probe_count;
+                sn = pm_model_invert_near_f(&mf, NULL, ah, dec, before.enc[0], before.enc[1], &nh,
+                                            &nd);
+                if (k > 2)
+                    ev_n[i] += (long)(probe_count - e0);
+                calls++;
+                ck_assert_msg(st == sn, "tick %d: track_f %d, invert_near_f %d", k, (int)st,
+                              (int)sn);
+                if (st != PM_OK)
+                    continue;
+                ok++;
+                ck_assert_int_eq(pm_model_apply_f(&mf, NULL, th, td, &bh, &bd), PM_OK);
+                ck_assert_msg(tu_angle(bh, bd, ah, dec) <= 2 * PM_INVERT_F_TOL,
+                              "tick %d: float round trip %.3g", k, tu_angle(bh, bd, ah, dec));
+                ck_assert(t.enc[0] == th && t.enc[1] == td);
+            }
+        }
+    }
+    printf("track_f: %ld calls, %ld PM_OK; evaluations from the third tick on: 1 ms %ld "
+           "(invert_near_f %ld), 0.1 s %ld (%ld), 1 s %ld (%ld)\n",
+           calls, ok, ev_t[0], ev_n[0], ev_t[1], ev_n[1], ev_t[2], ev_n[2]);
+    ck_assert_int_eq(ok, calls);
+    ck_assert_int_le(ev_t[0], ev_n[0] * 3 / 4);
+    ck_assert_int_le(ev_t[1], ev_n[1] * 3 / 4);
+    ck_assert_int_le(ev_t[2], ev_n[2]);
+}
+END_TEST
+
+/* The float state's errors: as pm_model_track's. */
+START_TEST(test_track_float_errors)
+{
+    pm_model m;
+    pm_model_f mf;
+    pm_track_f t, z;
+    double th, td;
+    ck_assert_int_eq(pm_model_init(&m, PM_MOUNT_EQUATORIAL, 1), PM_OK);
+    m.coef[7] = 30 * ARCSEC;
+    ck_assert_int_eq(pm_model_prepare(&m), PM_OK);
+    ck_assert_int_eq(pm_model_f_prepare(&mf, &m), PM_OK);
+    ck_assert_int_eq(pm_track_f_start(NULL, 0, 0), PM_ERR_ARG);
+    ck_assert_int_eq(pm_track_f_start(&t, NAN, 0), PM_ERR_NONFINITE);
+    ck_assert_int_eq(pm_track_f_start(&t, 0, 2 * PM_START_MAX), PM_ERR_ARG);
+    memset(&z, 0, sizeof z);
+    ck_assert_int_eq(pm_model_track_f(&mf, NULL, &z, 0.1, 0.2, &th, &td), PM_ERR_ARG);
+    ck_assert_int_eq(pm_track_f_start(&t, 0.1, 0.2), PM_OK);
+    ck_assert_int_eq(pm_model_track_f(&mf, NULL, &t, 0.1, 0.2, NULL, &td), PM_ERR_ARG);
+    ck_assert_int_eq(pm_model_track_f(NULL, NULL, &t, 0.1, 0.2, &th, &td), PM_ERR_ARG);
+    ck_assert_int_eq(pm_model_track_f(&mf, NULL, &t, INFINITY, 0.2, &th, &td),
+                     PM_ERR_NONFINITE);
+    ck_assert_int_eq(pm_model_track_f(&mf, NULL, &t, 0.1, 0.2, &th, &td), PM_OK);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("track");
@@ -343,6 +437,8 @@ int main(void)
     tcase_add_test(tc, test_track_aux_inputs);
     tcase_add_test(tc, test_track_errors);
     tcase_add_test(tc, test_track_isotropic);
+    tcase_add_test(tc, test_track_float);
+    tcase_add_test(tc, test_track_float_errors);
     suite_add_tcase(s, tc);
     return tu_run_suite(s);
 }
