@@ -2079,10 +2079,9 @@ pm_status pm_track_start(pm_track *t, double enc_ha, double enc_dec)
 {
     if (!t)
         return PM_ERR_ARG;
-    if (!finite(enc_ha) || !finite(enc_dec))
-        return PM_ERR_NONFINITE;
-    if (m_fabs(enc_ha) > PM_START_MAX || m_fabs(enc_dec) > PM_START_MAX)
-        return PM_ERR_ARG;
+    pm_status st = start_status(enc_ha, enc_dec);
+    if (st != PM_OK)
+        return st;
     __builtin_memset(t, 0, sizeof *t);
     t->enc[0] = enc_ha;
     t->enc[1] = enc_dec;

@@ -70,6 +70,17 @@ inline bool abs_beyond(double a, double b)
 #endif
 }
 
+/* A tracking state's start position (pm_track_start, pm_track_f_start):
+** PM_OK, PM_ERR_NONFINITE or PM_ERR_ARG (beyond PM_START_MAX). */
+inline pm_status start_status(double h, double d)
+{
+    if (!finite(h) || !finite(d))
+        return PM_ERR_NONFINITE;
+    if (abs_beyond(h, PM_START_MAX) || abs_beyond(d, PM_START_MAX))
+        return PM_ERR_ARG;
+    return PM_OK;
+}
+
 /* a == b for b not NaN and not zero (one bit pattern each). */
 inline bool same_as(double a, double b)
 {
