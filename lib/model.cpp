@@ -164,16 +164,18 @@ inline double pi_minus(double x, double s)
 ** offset beyond 0.01 rad (near the pole) -- and the caller takes atan2.
 */
 bool frame_angles(const pm_model *m, double t, double d, const double sh[4],
-                  const V3<double> &p, double *T, double *D)
+                  const V3<double> &pf, double *T, double *D)
 {
     const double c = m->coef[2], e = m->coef[4];
     if (abs_beyond(t, 64) || abs_beyond(d, 4) || abs_beyond(c, 0.5) || abs_beyond(e, 0.5))
         return false;
     /* |d - e'| <= 4.5 < 3 pi/2: the normal side is d - e' in [-pi/2, pi/2] */
     const bool flip = sh[3] < 0;
-    const double sT = flip ? -sh[0] : sh[0], cT = flip ? -sh[1] : sh[1];
     const double sD = sh[2], cD = flip ? -sh[3] : sh[3];
-    double x1 = cT * p.x + sT * p.y, y1 = cT * p.y - sT * p.x;
+    /* p turned by -(t + c' (+ pi)): pf (forward_framed), negated beyond
+    ** the pole */
+    const double x1 = flip ? -pf.x : pf.x, y1 = flip ? -pf.y : pf.y;
+    const V3<double> &p = pf;
     double rho = m_sqrt(x1 * x1 + y1 * y1);
     /* sin(D - D0) = p_z cos D0 - rho sin D0 (|p| = 1 to rounding: asin, no
     ** division after the square root) */
@@ -1881,8 +1883,9 @@ pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
         return PM_ERR_NONFINITE;
     const Iso<double> &k = iso_of(m);
     double sh[4], t, d;
-    V3<double> p = forward_vec<double>(m, k, trig_of(enc_ha, enc_dec), ctx, sh);
-    if (!frame_angles(m, enc_ha, enc_dec, sh, p, &t, &d)) {
+    const V3<double> pf = forward_framed<double>(m, k, trig_of(enc_ha, enc_dec), ctx, sh);
+    if (!frame_angles(m, enc_ha, enc_dec, sh, pf, &t, &d)) {
+        const V3<double> p = rot_z<double>(sh[0], sh[1], pf);
         t = m_atan2(p.y, p.x);
         d = m_atan2(p.z, m_sqrt(p.x * p.x + p.y * p.y));
     }

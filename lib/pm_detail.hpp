@@ -491,22 +491,28 @@ inline void base_uv_at(int k, const Trig<T> &g, const Trig<T> &gs, T *u, T *v)
 
 /* Unit vector displaced from (1,0,0) by the tangent offset (a, b) along y
 ** and z: the exponential map.  Series below 1e-2 (error < 1e-15). */
-template <typename T> inline V3<T> expmap(T a, T b)
+/* expmap(a, b) = (c, a s, b s): c = cos r and s = sin(r)/r, r^2 = a^2 +
+** b^2. */
+template <typename T> __attribute__((always_inline)) inline void expmap_cs(T a, T b, T *c, T *s)
 {
     T r2 = a * a + b * b;
-    T c, s;
     if (r2 < (T)1e-4) {
         /* (by the reciprocals: no division; the r^4 part beside the
         ** leading terms, so that the chain is short: it is on the
         ** inverse's iteration path) */
         T r4 = r2 * r2;
-        c = (1 - (T)0.5 * r2) + r4 * ((T)(1.0 / 24) - r2 * (T)(1.0 / 720));
-        s = (1 - (T)(1.0 / 6) * r2) + r4 * ((T)(1.0 / 120) - r2 * (T)(1.0 / 5040));
+        *c = (1 - (T)0.5 * r2) + r4 * ((T)(1.0 / 24) - r2 * (T)(1.0 / 720));
+        *s = (1 - (T)(1.0 / 6) * r2) + r4 * ((T)(1.0 / 120) - r2 * (T)(1.0 / 5040));
     } else {
         T r = m_sqrt(r2);
-        c = m_cos(r);
-        s = m_sin(r) / r;
+        *c = m_cos(r);
+        *s = m_sin(r) / r;
     }
+}
+template <typename T> inline V3<T> expmap(T a, T b)
+{
+    T c, s;
+    expmap_cs<T>(a, b, &c, &s);
     return v3(c, a * s, b * s);
 }
 
@@ -1110,6 +1116,80 @@ inline V3<T> forward_vec(const pm_model *m, const Iso<T> &k, const Trig<T> &g,
     w = rot_x<T>(k.sd, k.cd, w);
     w = rot_z<T>(stp, ctp, w);
     return mat_mul<T>(k.h, w);
+}
+
+/* The forward model's rotations composed, seen from the shifted hour angle
+** t' = t + c': F = Pt(t')^T H Pt(t') X(d) Pd(d') T(i) (row-major), so that
+** Pt(t')^T p = F expmap(D).  F depends only on the shifted position's trig
+** (stp, ctp, sdp, cdp) and the model's constants: it is formed beside the
+** displacement, and one product with expmap(D) follows it (a short chain)
+** instead of five rotations in a row. */
+template <typename T>
+__attribute__((always_inline)) inline void framed_rotations(const Iso<T> &k, T stp, T ctp,
+                                                            T sdp, T cdp, T *F)
+{
+    /* B = X(d) Pd(d') T(i), written out (its columns: the three axes
+    ** through T(i), Pd(d'), X(d)) */
+    const T a0 = sdp * k.ci, a1 = sdp * k.si;
+    const T b0 = cdp * k.ci, b1 = -(cdp * k.si), b2 = -sdp;
+    const T b3 = k.cd * k.si - k.sd * a0, b4 = k.cd * k.ci + k.sd * a1, b5 = -(k.sd * cdp);
+    const T b6 = k.sd * k.si + k.cd * a0, b7 = k.sd * k.ci - k.cd * a1, b8 = k.cd * cdp;
+    /* G = Pt(t')^T H Pt(t'): H's upper 2 x 2 block P turned, Q^T P Q =
+    ** P + s E with c^2 = 1 - s^2 (E from P's difference and sum across),
+    ** its third column and row turned once */
+    const T *h = k.h;
+    const T d04 = h[0] - h[4], s13 = h[1] + h[3];
+    const T e0 = stp * (stp * d04 - ctp * s13), e1 = stp * (stp * s13 + ctp * d04);
+    const T g0 = h[0] - e0, g4 = h[4] + e0, g1 = h[1] - e1, g3 = h[3] - e1;
+    const T g2 = ctp * h[2] + stp * h[5], g5 = ctp * h[5] - stp * h[2];
+    const T g6 = ctp * h[6] + stp * h[7], g7 = ctp * h[7] - stp * h[6], g8 = h[8];
+    /* F = G B */
+    F[0] = (g0 * b0 + g1 * b3) + g2 * b6;
+    F[1] = (g0 * b1 + g1 * b4) + g2 * b7;
+    F[2] = (g0 * b2 + g1 * b5) + g2 * b8;
+    F[3] = (g3 * b0 + g4 * b3) + g5 * b6;
+    F[4] = (g3 * b1 + g4 * b4) + g5 * b7;
+    F[5] = (g3 * b2 + g4 * b5) + g5 * b8;
+    F[6] = (g6 * b0 + g7 * b3) + g8 * b6;
+    F[7] = (g6 * b1 + g7 * b4) + g8 * b7;
+    F[8] = (g6 * b2 + g7 * b5) + g8 * b8;
+}
+
+/* F expmap(a, b) = c F0 + s (a F1 + b F2) (Fj: F's columns): a F1 + b F2
+** is formed beside expmap's series, two operations follow it. */
+template <typename T>
+__attribute__((always_inline)) inline V3<T> framed_product(const T *F, T a, T b, T c, T s)
+{
+    const T u0 = F[1] * a + F[2] * b, u1 = F[4] * a + F[5] * b, u2 = F[7] * a + F[8] * b;
+    return v3(c * F[0] + s * u0, c * F[3] + s * u1, c * F[6] + s * u2);
+}
+template <typename T>
+__attribute__((always_inline)) inline V3<T> framed_apply(const T *F, T a, T b)
+{
+    T c, s;
+    expmap_cs<T>(a, b, &c, &s);
+    return framed_product<T>(F, a, b, c, s);
+}
+
+/* The forward model's unit vector seen from the shifted hour angle:
+** Pt(t')^T p (p of forward_vec, the same model; the rotations composed by
+** framed_rotations); sh receives the shifted position's trig as in
+** forward_vec.  pm_model_apply's path (frame_angles). */
+template <typename T>
+inline V3<T> forward_framed(const pm_model *m, const Iso<T> &k, const Trig<T> &g,
+                            const pm_context *ctx, T *sh)
+{
+    T dt, dd, stp, ctp, sdp, cdp, F[9];
+    shifted<T>(k, g, &stp, &ctp, &sdp, &cdp);
+    const T sg[4] = {stp, ctp, sdp, cdp};
+    aniso<T>(m, k, g, ctx, &dt, &dd, sg);
+    /* (after the call in the code, beside its chain in the core) */
+    framed_rotations<T>(k, stp, ctp, sdp, cdp, F);
+    sh[0] = stp;
+    sh[1] = ctp;
+    sh[2] = sdp;
+    sh[3] = cdp;
+    return framed_apply<T>(F, dt, dd);
 }
 
 /* The derivatives (ft, fd) along the axes of an added term's factor f at g

@@ -8,7 +8,7 @@
 **  core's scalar pm_model_apply (lib/model.cpp, lib/pm_detail.hpp), so that
 **  every lane gives the scalar call's doubles bit for bit.  The templates of
 **  lib/pm_detail.hpp that are written for any arithmetic type (sincos_core,
-**  quadrant, harmonics_n, shifted, the rotations, mat_mul) are instantiated
+**  quadrant, harmonics_n, shifted, framed_rotations, framed_product) are instantiated
 **  on the vector type; the parts of the forward that branch per point
 **  (expmap, frame_angles, turn_sum) are written here once more with lane
 **  masks, taking only their common branch.  A point whose lane leaves that
@@ -239,8 +239,8 @@ inline unsigned apply_block(const Consts<W, LC> &K, const double *ha, const doub
     g.t = V(t);
     g.d = V(d);
     g.have_angles = true;
-    /* forward_vec: the shifted position, aniso (sh_sums, aniso_of_sums
-    ** without added terms), expmap, the rotations */
+    /* forward_framed: the shifted position, aniso (sh_sums, aniso_of_sums
+    ** without added terms), expmap, the composed rotations */
     V stp, ctp, sdp, cdp;
     shifted<V>(k, g, &stp, &ctp, &sdp, &cdp);
     V S[6];
@@ -258,17 +258,13 @@ inline unsigned apply_block(const Consts<W, LC> &K, const double *ha, const doub
     const V r4 = r2 * r2;
     const V c = (1 - 0.5 * r2) + r4 * ((1.0 / 24) - r2 * (1.0 / 720));
     const V s = (1 - (1.0 / 6) * r2) + r4 * ((1.0 / 120) - r2 * (1.0 / 5040));
-    V3<V> w = v3<V>(c, dt * s, dd * s);
-    w = rot_z<V>(k.si, k.ci, w);
-    w = rot_d<V>(sdp, cdp, w);
-    w = rot_x<V>(k.sd, k.cd, w);
-    w = rot_z<V>(stp, ctp, w);
-    const V3<V> p = mat_mul<V>(k.h, w);
+    V F[9];
+    framed_rotations<V>(k, stp, ctp, sdp, cdp, F);
+    const V3<V> p = framed_product<V>(F, dt, dd, c, s);
     /* frame_angles (the model's |c'|, |e'| <= 0.5: apply_simd_ok) */
     const mask flip = Ln::lt(cdp.v, Ln::all(0.0));
-    const V sT(Ln::sel(flip, -stp.v, stp.v)), cT(Ln::sel(flip, -ctp.v, ctp.v));
     const V sD = sdp, cD(Ln::sel(flip, -cdp.v, cdp.v));
-    const V x1 = cT * p.x + sT * p.y, y1 = cT * p.y - sT * p.x;
+    const V x1(Ln::sel(flip, -p.x.v, p.x.v)), y1(Ln::sel(flip, -p.y.v, p.y.v));
     const V rho(Ln::sqrt((x1 * x1 + y1 * y1).v));
     const V zn = p.z * cD - rho * sD, zd = rho * cD + p.z * sD;
     ok &= Ln::le(Ln::fabs(y1.v), (0.01 * x1).v) & Ln::le(Ln::fabs(zn.v), Ln::all(0.01)) &
