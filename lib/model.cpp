@@ -1883,9 +1883,18 @@ pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
         return PM_ERR_NONFINITE;
     const Iso<double> &k = iso_of(m);
     double sh[4], t, d;
+#if PM_COMPOSED_FORWARD
     const V3<double> pf = forward_framed<double>(m, k, trig_of(enc_ha, enc_dec), ctx, sh);
+#else
+    const V3<double> p0 = forward_vec<double>(m, k, trig_of(enc_ha, enc_dec), ctx, sh);
+    const V3<double> pf = rot_zt<double>(sh[0], sh[1], p0);
+#endif
     if (!frame_angles(m, enc_ha, enc_dec, sh, pf, &t, &d)) {
+#if PM_COMPOSED_FORWARD
         const V3<double> p = rot_z<double>(sh[0], sh[1], pf);
+#else
+        const V3<double> &p = p0;
+#endif
         t = m_atan2(p.y, p.x);
         d = m_atan2(p.z, m_sqrt(p.x * p.x + p.y * p.y));
     }

@@ -1118,6 +1118,20 @@ inline V3<T> forward_vec(const pm_model *m, const Iso<T> &k, const Trig<T> &g,
     return mat_mul<T>(k.h, w);
 }
 
+/* pm_model_apply's rotations: composed beside the displacement
+** (framed_rotations) where the core runs several instructions per cycle
+** out of order and a shorter chain pays for ~80 more instructions; one
+** after the other (forward_vec's five) on 32-bit ARM (Cortex-M: in order,
+** and counted in instructions), where the results are the previous
+** library's bit for bit.  Either way within about an ulp of each other. */
+#ifndef PM_COMPOSED_FORWARD
+#if defined(__arm__)
+#define PM_COMPOSED_FORWARD 0
+#else
+#define PM_COMPOSED_FORWARD 1
+#endif
+#endif
+
 /* The forward model's rotations composed, seen from the shifted hour angle
 ** t' = t + c': F = Pt(t')^T H Pt(t') X(d) Pd(d') T(i) (row-major), so that
 ** Pt(t')^T p = F expmap(D).  F depends only on the shifted position's trig
@@ -1129,10 +1143,11 @@ __attribute__((always_inline)) inline void framed_rotations(const Iso<T> &k, T s
                                                             T sdp, T cdp, T *F)
 {
     /* B = X(d) Pd(d') T(i), written out (its columns: the three axes
-    ** through T(i), Pd(d'), X(d)) */
+    ** through T(i), Pd(d'), X(d)); nb1, nb2 = sdp, nb5: the negated
+    ** entries, whose signs the sums below take */
     const T a0 = sdp * k.ci, a1 = sdp * k.si;
-    const T b0 = cdp * k.ci, b1 = -(cdp * k.si), b2 = -sdp;
-    const T b3 = k.cd * k.si - k.sd * a0, b4 = k.cd * k.ci + k.sd * a1, b5 = -(k.sd * cdp);
+    const T b0 = cdp * k.ci, nb1 = cdp * k.si;
+    const T b3 = k.cd * k.si - k.sd * a0, b4 = k.cd * k.ci + k.sd * a1, nb5 = k.sd * cdp;
     const T b6 = k.sd * k.si + k.cd * a0, b7 = k.sd * k.ci - k.cd * a1, b8 = k.cd * cdp;
     /* G = Pt(t')^T H Pt(t'): H's upper 2 x 2 block P turned, Q^T P Q =
     ** P + s E with c^2 = 1 - s^2 (E from P's difference and sum across),
@@ -1143,16 +1158,16 @@ __attribute__((always_inline)) inline void framed_rotations(const Iso<T> &k, T s
     const T g0 = h[0] - e0, g4 = h[4] + e0, g1 = h[1] - e1, g3 = h[3] - e1;
     const T g2 = ctp * h[2] + stp * h[5], g5 = ctp * h[5] - stp * h[2];
     const T g6 = ctp * h[6] + stp * h[7], g7 = ctp * h[7] - stp * h[6], g8 = h[8];
-    /* F = G B */
+    /* F = G B (row r: (g_r0 b_0c + g_r1 b_1c) + g_r2 b_2c) */
     F[0] = (g0 * b0 + g1 * b3) + g2 * b6;
-    F[1] = (g0 * b1 + g1 * b4) + g2 * b7;
-    F[2] = (g0 * b2 + g1 * b5) + g2 * b8;
+    F[1] = (g1 * b4 - g0 * nb1) + g2 * b7;
+    F[2] = g2 * b8 - (g0 * sdp + g1 * nb5);
     F[3] = (g3 * b0 + g4 * b3) + g5 * b6;
-    F[4] = (g3 * b1 + g4 * b4) + g5 * b7;
-    F[5] = (g3 * b2 + g4 * b5) + g5 * b8;
+    F[4] = (g4 * b4 - g3 * nb1) + g5 * b7;
+    F[5] = g5 * b8 - (g3 * sdp + g4 * nb5);
     F[6] = (g6 * b0 + g7 * b3) + g8 * b6;
-    F[7] = (g6 * b1 + g7 * b4) + g8 * b7;
-    F[8] = (g6 * b2 + g7 * b5) + g8 * b8;
+    F[7] = (g7 * b4 - g6 * nb1) + g8 * b7;
+    F[8] = g8 * b8 - (g6 * sdp + g7 * nb5);
 }
 
 /* F expmap(a, b) = c F0 + s (a F1 + b F2) (Fj: F's columns): a F1 + b F2
@@ -1174,9 +1189,17 @@ __attribute__((always_inline)) inline V3<T> framed_apply(const T *F, T a, T b)
 /* The forward model's unit vector seen from the shifted hour angle:
 ** Pt(t')^T p (p of forward_vec, the same model; the rotations composed by
 ** framed_rotations); sh receives the shifted position's trig as in
-** forward_vec.  pm_model_apply's path (frame_angles). */
+** forward_vec.  pm_model_apply's path (frame_angles).  (PM_NO_SLP: gcc's
+** pairing of these scalar products into SSE2 registers costs more shuffles
+** than it saves: 1,021 host instructions per call at L = 2 with it, 981
+** without.) */
+#if defined(__GNUC__) && !defined(__clang__)
+#define PM_NO_SLP __attribute__((optimize("no-tree-slp-vectorize")))
+#else
+#define PM_NO_SLP
+#endif
 template <typename T>
-inline V3<T> forward_framed(const pm_model *m, const Iso<T> &k, const Trig<T> &g,
+PM_NO_SLP inline V3<T> forward_framed(const pm_model *m, const Iso<T> &k, const Trig<T> &g,
                             const pm_context *ctx, T *sh)
 {
     T dt, dd, stp, ctp, sdp, cdp, F[9];

@@ -258,9 +258,18 @@ inline unsigned apply_block(const Consts<W, LC> &K, const double *ha, const doub
     const V r4 = r2 * r2;
     const V c = (1 - 0.5 * r2) + r4 * ((1.0 / 24) - r2 * (1.0 / 720));
     const V s = (1 - (1.0 / 6) * r2) + r4 * ((1.0 / 120) - r2 * (1.0 / 5040));
+#if PM_COMPOSED_FORWARD
     V F[9];
     framed_rotations<V>(k, stp, ctp, sdp, cdp, F);
     const V3<V> p = framed_product<V>(F, dt, dd, c, s);
+#else
+    V3<V> w = v3<V>(c, dt * s, dd * s);
+    w = rot_z<V>(k.si, k.ci, w);
+    w = rot_d<V>(sdp, cdp, w);
+    w = rot_x<V>(k.sd, k.cd, w);
+    w = rot_z<V>(stp, ctp, w);
+    const V3<V> p = rot_zt<V>(stp, ctp, mat_mul<V>(k.h, w));
+#endif
     /* frame_angles (the model's |c'|, |e'| <= 0.5: apply_simd_ok) */
     const mask flip = Ln::lt(cdp.v, Ln::all(0.0));
     const V sD = sdp, cD(Ln::sel(flip, -cdp.v, cdp.v));
