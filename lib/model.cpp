@@ -1870,7 +1870,7 @@ pm_status pm_term_name(const pm_model *m, int index, char *buf, size_t len)
     return PM_OK;
 }
 
-pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
+PM_NO_SLP pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
                          double enc_ha, double enc_dec, double *app_ha,
                          double *app_dec)
 {

@@ -1131,6 +1131,15 @@ inline V3<T> forward_vec(const pm_model *m, const Iso<T> &k, const Trig<T> &g,
 #define PM_COMPOSED_FORWARD 1
 #endif
 #endif
+/* For pm_model_apply with the composed rotations: gcc's pairing of their
+** scalar products into SSE2 registers costs more shuffles than it saves
+** (1,021 host instructions per call at L = 2 with it, 981 without; the
+** same operations, the same results). */
+#if PM_COMPOSED_FORWARD && defined(__GNUC__) && !defined(__clang__)
+#define PM_NO_SLP __attribute__((optimize("no-tree-slp-vectorize")))
+#else
+#define PM_NO_SLP
+#endif
 
 /* The forward model's rotations composed, seen from the shifted hour angle
 ** t' = t + c': F = Pt(t')^T H Pt(t') X(d) Pd(d') T(i) (row-major), so that
@@ -1189,17 +1198,9 @@ __attribute__((always_inline)) inline V3<T> framed_apply(const T *F, T a, T b)
 /* The forward model's unit vector seen from the shifted hour angle:
 ** Pt(t')^T p (p of forward_vec, the same model; the rotations composed by
 ** framed_rotations); sh receives the shifted position's trig as in
-** forward_vec.  pm_model_apply's path (frame_angles).  (PM_NO_SLP: gcc's
-** pairing of these scalar products into SSE2 registers costs more shuffles
-** than it saves: 1,021 host instructions per call at L = 2 with it, 981
-** without.) */
-#if defined(__GNUC__) && !defined(__clang__)
-#define PM_NO_SLP __attribute__((optimize("no-tree-slp-vectorize")))
-#else
-#define PM_NO_SLP
-#endif
+** forward_vec.  pm_model_apply's path (frame_angles), inlined there. */
 template <typename T>
-PM_NO_SLP inline V3<T> forward_framed(const pm_model *m, const Iso<T> &k, const Trig<T> &g,
+__attribute__((always_inline)) inline V3<T> forward_framed(const pm_model *m, const Iso<T> &k, const Trig<T> &g,
                             const pm_context *ctx, T *sh)
 {
     T dt, dd, stp, ctp, sdp, cdp, F[9];
