@@ -144,6 +144,24 @@ inline double turn_sum(double x, double s, bool half)
     return abs_beyond(a, PI) || same_as(a, -PI) ? PI : a;
 }
 
+/* turn_sum(x, c + atan(r), half) with the small parts summed otherwise:
+** c and the parts of pi/2 that follow PIO2_1 first (from x alone: off the
+** chain), then r and the series' tail (atan_plus): the forward model's
+** hour angle, four operations shorter after r. */
+inline double turn_sum_atan(double x, double c, double r, bool half)
+{
+    double n = (x * 0.15915494309189535 + (half ? 0.5 : 0.0) + RND_INT) - RND_INT;
+    double q = 4 * n - (half ? 2 : 0);
+    double a = (x - q * PIO2_1) + atan_plus((c - q * PIO2_2) - q * PIO2_3, r);
+    if (abs_beyond(a, PI)) {
+        const double s = atan_plus(c, r);
+        n = ((x + s) * 0.15915494309189535 + (half ? 0.5 : 0.0) + RND_INT) - RND_INT;
+        q = 4 * n - (half ? 2 : 0);
+        a = (x - q * PIO2_1) + atan_plus((c - q * PIO2_2) - q * PIO2_3, r);
+    }
+    return abs_beyond(a, PI) || same_as(a, -PI) ? PI : a;
+}
+
 /* pi - x + s for a small s, pi in the parts of pi/2: 2 PIO2_1 - x is exact
 ** or rounded once, s added apart (the declination beyond the pole). */
 inline double pi_minus(double x, double s)
@@ -182,17 +200,17 @@ bool frame_angles(const pm_model *m, double t, double d, const double sh[4],
     double zn = p.z * cD - rho * sD, zd = rho * cD + p.z * sD;
     if (!(m_fabs(y1) <= 0.01 * x1) || !(m_fabs(zn) <= 0.01) || !(zd > 0))
         return false;
-    double dT = atan_small(y1 / x1), dD = asin_small(zn);
-    /* T = t + c' + dT (+ pi), in (-pi, pi] */
-    *T = turn_sum(t, c + dT, flip);
-    /* D = d - e' + dD, or beyond the pole +-pi - (d - e') + dD */
+    /* T = t + c' + atan(y1/x1) (+ pi), in (-pi, pi] */
+    *T = turn_sum_atan(t, c, y1 / x1, flip);
+    /* D = d - e' + asin(zn), or beyond the pole +-pi - (d - e') +
+    ** asin(zn) (pi_minus's sums, the small parts first) */
     double da;
     if (!flip)
-        da = d + (dD - e);
+        da = d + asin_plus(-e, zn);
     else if (d - e > 0)
-        da = pi_minus(d, e + dD);
-    else /* -pi - (d - e') + dD */
-        da = -pi_minus(-d, -(e + dD));
+        da = (2 * PIO2_1 - d) + asin_plus((e + 2 * PIO2_2) + 2 * PIO2_3, zn);
+    else /* -pi - (d - e') + asin(zn) */
+        da = -((2 * PIO2_1 + d) + asin_plus((2 * PIO2_2 - e) + 2 * PIO2_3, -zn));
     /* the exact angle is in [-pi/2, pi/2]: rounding only can leave it */
     *D = abs_beyond(da, PI / 2) ? (below0(da) ? -PI / 2 : PI / 2) : da;
     return true;

@@ -110,6 +110,23 @@ const double PIO2_1 = 1.5707963267341256, PIO2_2 = 6.077100506303966e-11,
 /* (x + RND_INT) - RND_INT is x rounded to an integer, |x| < 2^51 (1.5 2^52) */
 const double RND_INT = 6755399441055744.0;
 
+/* x0 + atan(r) and x0 + asin(r) for |r| <= 0.01 by their series to r^9
+** (the terms left out are below 1e-23): (x0 + r) and the series' tail,
+** whose terms are formed side by side, six operations deep from r (the
+** forward model's frame_angles, where the small x0 is added beside r
+** instead of after the series).  Any arithmetic type (the Python lanes). */
+template <typename T> inline T atan_plus(T x0, T r)
+{
+    const T r2 = r * r, r3 = r * r2, r4 = r2 * r2, r7 = r3 * r4;
+    return (x0 + r) + (r3 * (-1.0 / 3 + r2 * (1.0 / 5)) + r7 * (-1.0 / 7 + r2 * (1.0 / 9)));
+}
+template <typename T> inline T asin_plus(T x0, T r)
+{
+    const T r2 = r * r, r3 = r * r2, r4 = r2 * r2, r7 = r3 * r4;
+    return (x0 + r) +
+           (r3 * (1.0 / 6 + r2 * (3.0 / 40)) + r7 * (5.0 / 112 + r2 * (35.0 / 1152)));
+}
+
 /* A double from its bit pattern. */
 inline double of_bits(unsigned long long u)
 {

@@ -8,9 +8,10 @@
 **  core's scalar pm_model_apply (lib/model.cpp, lib/pm_detail.hpp), so that
 **  every lane gives the scalar call's doubles bit for bit.  The templates of
 **  lib/pm_detail.hpp that are written for any arithmetic type (sincos_core,
-**  quadrant, harmonics_n, shifted, framed_rotations, framed_product) are instantiated
+**  quadrant, harmonics_n, shifted, framed_rotations, framed_product,
+**  atan_plus, asin_plus) are instantiated
 **  on the vector type; the parts of the forward that branch per point
-**  (expmap, frame_angles, turn_sum) are written here once more with lane
+**  (expmap, frame_angles, turn_sum_atan) are written here once more with lane
 **  masks, taking only their common branch.  A point whose lane leaves that
 **  branch (|ha| > 64, |dec| > 4, a NaN or infinity, a displacement beyond
 **  the series of expmap, the pole's neighbourhood where frame_angles gives
@@ -205,18 +206,6 @@ inline void harm_sums(const Consts<W, LC> &K, const VD<W> *Y, VD<W> *S)
     }
 }
 
-/* atan_small, asin_small of lib/model.cpp. */
-template <int W> inline VD<W> atan_small_v(VD<W> r)
-{
-    VD<W> r2 = r * r, r4 = r2 * r2;
-    return r * ((1 - r2 * (1.0 / 3)) + r4 * ((1.0 / 5 - r2 * (1.0 / 7)) + r4 * (1.0 / 9)));
-}
-template <int W> inline VD<W> asin_small_v(VD<W> r)
-{
-    VD<W> r2 = r * r, r4 = r2 * r2;
-    return r * ((1 + r2 * (1.0 / 6)) + r4 * ((3.0 / 40 + r2 * (5.0 / 112)) + r4 * (35.0 / 1152)));
-}
-
 /* W points from index i: the results into a[i..], b[i..]; returns the lanes
 ** (bit j for point i + j) whose point left the common branch (to be
 ** evaluated by pm_model_apply). */
@@ -278,23 +267,22 @@ inline unsigned apply_block(const Consts<W, LC> &K, const double *ha, const doub
     const V zn = p.z * cD - rho * sD, zd = rho * cD + p.z * sD;
     ok &= Ln::le(Ln::fabs(y1.v), (0.01 * x1).v) & Ln::le(Ln::fabs(zn.v), Ln::all(0.01)) &
           Ln::lt(Ln::all(0.0), zd.v);
-    const V dT = atan_small_v<W>(y1 / x1), dD = asin_small_v<W>(zn);
-    /* turn_sum(t, c' + dT, flip), its first try (the second: the scalar
-    ** call) */
+    /* turn_sum_atan(t, c', y1 / x1, flip), its first try (the second: the
+    ** scalar call) */
     const V half(Ln::sel(flip, Ln::all(0.5), Ln::all(0.0)));
     const V two(Ln::sel(flip, Ln::all(2.0), Ln::all(0.0)));
-    const V tv(t), sv = K.c + dT;
+    const V tv(t), r = y1 / x1;
     const V n = ((tv * 0.15915494309189535 + half) + RND_INT) - RND_INT;
     const V q = 4 * n - two;
-    const V a = (tv - q * PIO2_1) + ((sv - q * PIO2_2) - q * PIO2_3);
+    const V a = (tv - q * PIO2_1) + atan_plus<V>((K.c - q * PIO2_2) - q * PIO2_3, r);
     ok &= Ln::le(Ln::fabs(a.v), Ln::all(PI));
     raw T = Ln::sel(Ln::eq(a.v, Ln::all(-PI)), Ln::all(PI), a.v);
-    /* the declination: d + (dD - e'), or beyond the pole pi_minus */
+    /* the declination: d + asin_plus(-e', zn), or beyond the pole (the
+    ** sums of frame_angles) */
     const V dv(d), ev(K.e);
-    const V d0 = dv + (dD - ev);
-    const V ed = ev + dD;
-    const V dp = (2 * PIO2_1 - dv) + ((ed + 2 * PIO2_2) + 2 * PIO2_3);
-    const V dm = -((2 * PIO2_1 - (-dv)) + (((-ed) + 2 * PIO2_2) + 2 * PIO2_3));
+    const V d0 = dv + asin_plus<V>(-ev, zn);
+    const V dp = (2 * PIO2_1 - dv) + asin_plus<V>((ev + 2 * PIO2_2) + 2 * PIO2_3, zn);
+    const V dm = -((2 * PIO2_1 + dv) + asin_plus<V>((2 * PIO2_2 - ev) + 2 * PIO2_3, -zn));
     const raw da = Ln::sel(flip, Ln::sel(Ln::lt(Ln::all(0.0), (dv - ev).v), dp.v, dm.v), d0.v);
     const mask out = ~Ln::le(Ln::fabs(da), Ln::all(PI / 2));
     const raw D = Ln::sel(out, Ln::sel(Ln::lt(da, Ln::all(0.0)), Ln::all(-PI / 2), Ln::all(PI / 2)), da);
