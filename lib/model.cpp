@@ -1892,6 +1892,22 @@ PM_NO_SLP pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
                          double enc_ha, double enc_dec, double *app_ha,
                          double *app_dec)
 {
+#if PM_COMPOSED_FORWARD
+    /* eval_ready's checks and the arguments', the same statuses in the same
+    ** order, but the comparison of the coefficients with pm_model_prepare's
+    ** copy inside the evaluation (forward_framed's stale), unless an
+    ** argument is refused */
+    pm_status st = model_shape(m);
+    if (st != PM_OK)
+        return st;
+    st = context_ok(m, ctx);
+    if (st == PM_OK && (!app_ha || !app_dec))
+        st = PM_ERR_ARG;
+    if (st == PM_OK && (!finite(enc_ha) || !finite(enc_dec)))
+        st = PM_ERR_NONFINITE;
+    if (st != PM_OK)
+        return coef_changed(m) ? PM_ERR_STATE : st;
+#else
     pm_status st = eval_ready(m, ctx);
     if (st != PM_OK)
         return st;
@@ -1899,10 +1915,24 @@ PM_NO_SLP pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
         return PM_ERR_ARG;
     if (!finite(enc_ha) || !finite(enc_dec))
         return PM_ERR_NONFINITE;
+#endif
     const Iso<double> &k = iso_of(m);
     double sh[4], t, d;
 #if PM_COMPOSED_FORWARD
-    const V3<double> pf = forward_framed<double>(m, k, trig_of(enc_ha, enc_dec), ctx, sh);
+    const Trig<double> g = trig_of(enc_ha, enc_dec);
+    /* the comparison after the sines and cosines in the code (the barrier
+    ** keeps the compiler from hoisting it to the top): the evaluation is
+    ** safe to run once model_shape passed, and its ~150 instructions (L =
+    ** 2) then enter the core while the sines and cosines are computed, not
+    ** before them, where they took the place of the next call's start in
+    ** the core's window */
+    const pm_model *mc = m;
+#if defined(__GNUC__)
+    __asm__ volatile("" : "+r"(mc) : "m"(g));
+#endif
+    if (coef_changed(mc))
+        return PM_ERR_STATE;
+    const V3<double> pf = forward_framed<double>(m, k, g, ctx, sh);
 #else
     const V3<double> p0 = forward_vec<double>(m, k, trig_of(enc_ha, enc_dec), ctx, sh);
     const V3<double> pf = rot_zt<double>(sh[0], sh[1], p0);

@@ -619,14 +619,21 @@ inline void finish_angles(const double ref[2], double *t, double *d)
 }
 
 
-/* Is the model ready for evaluation: prepared, and no coefficient changed
-** since (a stale model would be silently wrong). */
-inline pm_status model_ready(const pm_model *m)
+/* Is the model prepared, with a term count it can evaluate (model_ready's
+** first part: what makes an evaluation safe to run). */
+inline pm_status model_shape(const pm_model *m)
 {
     if (!m)
         return PM_ERR_ARG;
     if (m->prepared != 1 || m->n_terms < 6 || m->n_terms > PM_MAX_TERMS)
         return PM_ERR_STATE;
+    return PM_OK;
+}
+
+/* Has a coefficient of a model that passed model_shape changed since
+** pm_model_prepare (model_ready's second part)? */
+inline bool coef_changed(const pm_model *m)
+{
     /* Bit patterns XOR-ed and OR-ed together in the machine's words (two
     ** per double on a 32-bit core; two doubles per SSE2 register), four at
     ** a time, no early exit.  (Bitwise, so writing -0.0 over 0.0 also asks
@@ -657,7 +664,17 @@ inline pm_status model_ready(const pm_model *m)
 #else
     word any = acc0;
 #endif
-    return any ? PM_ERR_STATE : PM_OK;
+    return any != 0;
+}
+
+/* Is the model ready for evaluation: prepared, and no coefficient changed
+** since (a stale model would be silently wrong). */
+inline pm_status model_ready(const pm_model *m)
+{
+    const pm_status st = model_shape(m);
+    if (st != PM_OK)
+        return st;
+    return coef_changed(m) ? PM_ERR_STATE : PM_OK;
 }
 
 /* Model constants in working precision. */
@@ -1138,9 +1155,11 @@ inline V3<T> forward_vec(const pm_model *m, const Iso<T> &k, const Trig<T> &g,
 /* pm_model_apply's rotations: composed beside the displacement
 ** (framed_rotations) where the core runs several instructions per cycle
 ** out of order and a shorter chain pays for ~80 more instructions; one
-** after the other (forward_vec's five) on 32-bit ARM (Cortex-M: in order,
-** and counted in instructions), where the results are the previous
-** library's bit for bit.  Either way within about an ulp of each other. */
+** after the other (forward_vec's five, as before) on 32-bit ARM (Cortex-M:
+** in order, and counted in instructions).  Either way within about an ulp
+** of each other.  With the composed rotations pm_model_apply also
+** compares the coefficients with pm_model_prepare's copy after the sines
+** and cosines instead of first (lib/model.cpp). */
 #ifndef PM_COMPOSED_FORWARD
 #if defined(__arm__)
 #define PM_COMPOSED_FORWARD 0
@@ -1217,8 +1236,9 @@ __attribute__((always_inline)) inline V3<T> framed_apply(const T *F, T a, T b)
 ** framed_rotations); sh receives the shifted position's trig as in
 ** forward_vec.  pm_model_apply's path (frame_angles), inlined there. */
 template <typename T>
-__attribute__((always_inline)) inline V3<T> forward_framed(const pm_model *m, const Iso<T> &k, const Trig<T> &g,
-                            const pm_context *ctx, T *sh)
+__attribute__((always_inline)) inline V3<T> forward_framed(const pm_model *m, const Iso<T> &k,
+                                                           const Trig<T> &g,
+                                                           const pm_context *ctx, T *sh)
 {
     T dt, dd, stp, ctp, sdp, cdp, F[9];
     shifted<T>(k, g, &stp, &ctp, &sdp, &cdp);
