@@ -621,7 +621,7 @@ inline void finish_angles(const double ref[2], double *t, double *d)
 
 /* Is the model prepared, with a term count it can evaluate (model_ready's
 ** first part: what makes an evaluation safe to run). */
-inline pm_status model_shape(const pm_model *m)
+__attribute__((always_inline)) inline pm_status model_shape(const pm_model *m)
 {
     if (!m)
         return PM_ERR_ARG;
@@ -632,7 +632,7 @@ inline pm_status model_shape(const pm_model *m)
 
 /* Has a coefficient of a model that passed model_shape changed since
 ** pm_model_prepare (model_ready's second part)? */
-inline bool coef_changed(const pm_model *m)
+__attribute__((always_inline)) inline bool coef_changed(const pm_model *m)
 {
     /* Bit patterns XOR-ed and OR-ed together in the machine's words (two
     ** per double on a 32-bit core; two doubles per SSE2 register), four at
