@@ -171,11 +171,12 @@ inline double pi_minus(double x, double s)
 
 /*
 ** Apparent angles (T, D) of the forward model's unit vector p at encoder
-** (t, d), without atan2: measured from the shifted position (t + c',
-** d - e') -- beyond the mount's pole from its equivalent (t + c' + pi,
-** pi - (d - e')) -- whose trig sh (forward_vec) is known, p's offsets
-** (dT, dD) are small (the anisotropic displacement, a, b, d, i): two short
-** series.  The sums are formed so that about one rounding falls on the
+** (t, d), without atan2, from pf = Pt(t')^T p (forward_framed; p turned
+** back by the shifted hour angle t' = t + c'): measured from the shifted
+** position (t + c', d - e') -- beyond the mount's pole from its
+** equivalent (t + c' + pi, pi - (d - e')) -- whose trig sh is known, p's
+** offsets (dT, dD) are small (the anisotropic displacement, a, b, d, i):
+** two short series.  The sums are formed so that about one rounding falls on the
 ** result: multiples of pi/2 in three parts (turn_sum, pi_minus), the
 ** small parts added apart.  Returns false
 ** where this does not apply -- |t| > 64, |d| > 4, |c'| or |e'| > 0.5, an
