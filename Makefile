@@ -220,6 +220,7 @@ clean:
 #                   (rules: bench/bench.mk)
 include firmware_demo/firmware.mk
 include bench/bench.mk
+include bench/fwdchain.mk  # pmbench_fwd_latency: the forward's chain (docs/performance.md)
 include tools/plan.mk
 # Reliability (docs/reliability.md): make fuzz (libFuzzer targets, bounded
 # time; rules: fuzz/fuzz.mk) and make sanitize (the Check suite under ASan +

@@ -5,8 +5,15 @@
 **  number of model evaluations (the core built with the probe of
 **  tests/probe.h) and the same bits of both returned angles.
 **
-**    pmbench_inv_diff [SCALE]     SCALE (default 1) multiplies every
-**                                 sample's size
+**    pmbench_inv_diff [SCALE [save|load FILE]]
+**                                 SCALE (default 1) multiplies every
+**                                 sample's size; save writes the
+**                                 realistic samples' targets (the forward
+**                                 model's apparent positions) to FILE,
+**                                 load inverts FILE's targets instead of
+**                                 this core's, so that two cores whose
+**                                 forward models round differently are
+**                                 compared on the same calls
 **
 **  Samples (deterministic: tu_rng with fixed seeds; at SCALE 1 96,000 hard
 **  calls and 291,840 realistic ones, 387,840 in all):
@@ -44,6 +51,26 @@ static unsigned long probe_count;
 void pm_probe_hit(void) { probe_count++; }
 
 static long n_calls;
+
+/* The targets' file (save, load) or none. */
+static FILE *targets;
+static int loading;
+
+/* The target (ah, ad) of a realistic call: this core's forward model's,
+** saved to the targets' file, or the file's instead. */
+static void target(double *ah, double *ad)
+{
+    if (!targets)
+        return;
+    if (!loading ? fwrite(ah, sizeof *ah, 1, targets) != 1 ||
+                       fwrite(ad, sizeof *ad, 1, targets) != 1
+                 : fread(ah, sizeof *ah, 1, targets) != 1 ||
+                       fread(ad, sizeof *ad, 1, targets) != 1) {
+        fprintf(stderr, "pmbench_inv_diff: targets' file: %s failed after %ld calls\n",
+                loading ? "read" : "write", n_calls);
+        exit(2);
+    }
+}
 
 static unsigned long long bits_of(double x)
 {
@@ -157,6 +184,7 @@ static void real_sample(const char *name, unsigned long long seed, double iso, d
         (void)hc_real_position(&m, &r, 90 * DEG, 0, &side, &t, &d, &kind);
         if (pm_model_apply(&m, &c, t, d, &ah, &ad) != PM_OK)
             abort();
+        target(&ah, &ad);
         st = cold(&m, &c, ah, ad, side, &eh, &ed);
         put(name, i, 'c', st, eh, ed);
         for (k = 0; k < 3; k++) {
@@ -170,9 +198,18 @@ static void real_sample(const char *name, unsigned long long seed, double iso, d
 int main(int argc, char **argv)
 {
     long scale = argc >= 2 ? atol(argv[1]) : 1;
-    if (scale < 1) {
-        fprintf(stderr, "usage: pmbench_inv_diff [SCALE]\n");
+    if (scale < 1 || argc == 3 || argc > 4 ||
+        (argc == 4 && strcmp(argv[2], "save") != 0 && strcmp(argv[2], "load") != 0)) {
+        fprintf(stderr, "usage: pmbench_inv_diff [SCALE [save|load FILE]]\n");
         return 2;
+    }
+    if (argc == 4) {
+        loading = argv[2][0] == 'l';
+        targets = fopen(argv[3], loading ? "rb" : "wb");
+        if (!targets) {
+            fprintf(stderr, "pmbench_inv_diff: cannot open %s\n", argv[3]);
+            return 2;
+        }
     }
     hard_sample(HC_SCALE_NORMAL, "hard_normal", (int)(400 * scale));
     hard_sample(HC_SCALE_LARGE, "hard_large", (int)(400 * scale));
@@ -180,5 +217,16 @@ int main(int argc, char **argv)
     real_sample("real", 11, 10 * DEG, 10 * ARCSEC * 60, 36480 * scale);
     real_sample("small", 12, 10 * ARCSEC * 60, 15 * ARCSEC, 36480 * scale);
     printf("calls %ld\n", n_calls);
+    if (targets) {
+        char extra;
+        if (loading && fread(&extra, 1, 1, targets) != 0) {
+            fprintf(stderr, "pmbench_inv_diff: targets' file longer than the samples\n");
+            return 2;
+        }
+        if (fclose(targets) != 0) {
+            fprintf(stderr, "pmbench_inv_diff: targets' file: close failed\n");
+            return 2;
+        }
+    }
     return 0;
 }

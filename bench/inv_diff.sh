@@ -7,7 +7,10 @@
 # of REV as in the core of NEW (a revision, or . for the working tree,
 # the default).  Each core is built with its own Makefile's probe rule
 # (build/probe/*.o: the evaluation counter of tests/probe.h); both link the
-# same test program, this checkout's bench/inv_diff.c.
+# same test program, this checkout's bench/inv_diff.c.  The realistic
+# samples' targets come from REV's forward model in both runs (NEW inverts
+# the targets REV's pm_model_apply gave: bench/inv_diff.c's save/load), so
+# that a change to the forward model's rounding does not move them.
 #
 #   sh bench/inv_diff.sh REV [NEW] [SCALE]     e.g. sh bench/inv_diff.sh main
 #
@@ -20,7 +23,7 @@ new=${2:-.}
 scale=${3:-1}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT INT TERM
-build() { # build(rev, dir): the program against rev's core, output in dir/out.txt
+build() { # build(rev, dir, save|load): the program against rev's core, output in dir/out.txt
     if [ "$1" = . ]; then
         src=$top
     else
@@ -32,11 +35,11 @@ build() { # build(rev, dir): the program against rev's core, output in dir/out.t
     make -C "$src" -j2 $objs > "$2/make.log" 2>&1 || { tail -20 "$2/make.log"; exit 1; }
     gcc -std=c99 -O2 -I"$src/include" -I"$top/tests" "$top/bench/inv_diff.c" \
         $(for o in $objs; do echo "$src/$o"; done) -lstdc++ -lm -o "$2/inv_diff"
-    "$2/inv_diff" "$scale" > "$2/out.txt"
+    "$2/inv_diff" "$scale" "$3" "$tmp/targets.bin" > "$2/out.txt"
 }
 mkdir -p "$tmp/a" "$tmp/b"
-build "$1" "$tmp/a"
-build "$new" "$tmp/b"
+build "$1" "$tmp/a" save
+build "$new" "$tmp/b" load
 echo "$1: $(tail -1 "$tmp/a/out.txt"); $new: $(tail -1 "$tmp/b/out.txt")"
 if cmp -s "$tmp/a/out.txt" "$tmp/b/out.txt"; then
     echo "identical: status, evaluations and both angles' bits of every call"

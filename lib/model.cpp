@@ -207,6 +207,24 @@ inline double turn_sum(double x, double s, bool half)
     return abs_beyond(a, PI) || same_as(a, -PI) ? PI : a;
 }
 
+/* turn_sum(x, c + atan(r), half) with the small parts summed otherwise:
+** c and the parts of pi/2 that follow PIO2_1 first (from x alone: off the
+** chain), then r and the series' tail (atan_plus): the forward model's
+** hour angle, four operations shorter after r. */
+inline double turn_sum_atan(double x, double c, double r, bool half)
+{
+    double n = (x * 0.15915494309189535 + (half ? 0.5 : 0.0) + RND_INT) - RND_INT;
+    double q = 4 * n - (half ? 2 : 0);
+    double a = (x - q * PIO2_1) + atan_plus((c - q * PIO2_2) - q * PIO2_3, r);
+    if (abs_beyond(a, PI)) {
+        const double s = atan_plus(c, r);
+        n = ((x + s) * 0.15915494309189535 + (half ? 0.5 : 0.0) + RND_INT) - RND_INT;
+        q = 4 * n - (half ? 2 : 0);
+        a = (x - q * PIO2_1) + atan_plus((c - q * PIO2_2) - q * PIO2_3, r);
+    }
+    return abs_beyond(a, PI) || same_as(a, -PI) ? PI : a;
+}
+
 /* pi - x + s for a small s, pi in the parts of pi/2: 2 PIO2_1 - x is exact
 ** or rounded once, s added apart (the declination beyond the pole). */
 inline double pi_minus(double x, double s)
@@ -216,44 +234,47 @@ inline double pi_minus(double x, double s)
 
 /*
 ** Apparent angles (T, D) of the forward model's unit vector p at encoder
-** (t, d), without atan2: measured from the shifted position (t + c',
-** d - e') -- beyond the mount's pole from its equivalent (t + c' + pi,
-** pi - (d - e')) -- whose trig sh (forward_vec) is known, p's offsets
-** (dT, dD) are small (the anisotropic displacement, a, b, d, i): two short
-** series.  The sums are formed so that about one rounding falls on the
+** (t, d), without atan2, from pf = Pt(t')^T p (forward_framed; p turned
+** back by the shifted hour angle t' = t + c'): measured from the shifted
+** position (t + c', d - e') -- beyond the mount's pole from its
+** equivalent (t + c' + pi, pi - (d - e')) -- whose trig sh is known, p's
+** offsets (dT, dD) are small (the anisotropic displacement, a, b, d, i):
+** two short series.  The sums are formed so that about one rounding falls on the
 ** result: multiples of pi/2 in three parts (turn_sum, pi_minus), the
 ** small parts added apart.  Returns false
 ** where this does not apply -- |t| > 64, |d| > 4, |c'| or |e'| > 0.5, an
 ** offset beyond 0.01 rad (near the pole) -- and the caller takes atan2.
 */
 bool frame_angles(const pm_model *m, double t, double d, const double sh[4],
-                  const V3<double> &p, double *T, double *D)
+                  const V3<double> &pf, double *T, double *D)
 {
     const double c = m->coef[2], e = m->coef[4];
     if (abs_beyond(t, 64) || abs_beyond(d, 4) || abs_beyond(c, 0.5) || abs_beyond(e, 0.5))
         return false;
     /* |d - e'| <= 4.5 < 3 pi/2: the normal side is d - e' in [-pi/2, pi/2] */
     const bool flip = sh[3] < 0;
-    const double sT = flip ? -sh[0] : sh[0], cT = flip ? -sh[1] : sh[1];
     const double sD = sh[2], cD = flip ? -sh[3] : sh[3];
-    double x1 = cT * p.x + sT * p.y, y1 = cT * p.y - sT * p.x;
+    /* p turned by -(t + c' (+ pi)): pf (forward_framed), negated beyond
+    ** the pole */
+    const double x1 = flip ? -pf.x : pf.x, y1 = flip ? -pf.y : pf.y;
+    const V3<double> &p = pf;
     double rho = m_sqrt(x1 * x1 + y1 * y1);
     /* sin(D - D0) = p_z cos D0 - rho sin D0 (|p| = 1 to rounding: asin, no
     ** division after the square root) */
     double zn = p.z * cD - rho * sD, zd = rho * cD + p.z * sD;
     if (!(m_fabs(y1) <= 0.01 * x1) || !(m_fabs(zn) <= 0.01) || !(zd > 0))
         return false;
-    double dT = atan_small(y1 / x1), dD = asin_small(zn);
-    /* T = t + c' + dT (+ pi), in (-pi, pi] */
-    *T = turn_sum(t, c + dT, flip);
-    /* D = d - e' + dD, or beyond the pole +-pi - (d - e') + dD */
+    /* T = t + c' + atan(y1/x1) (+ pi), in (-pi, pi] */
+    *T = turn_sum_atan(t, c, y1 / x1, flip);
+    /* D = d - e' + asin(zn), or beyond the pole +-pi - (d - e') +
+    ** asin(zn) (pi_minus's sums, the small parts first) */
     double da;
     if (!flip)
-        da = d + (dD - e);
+        da = d + asin_plus(-e, zn);
     else if (d - e > 0)
-        da = pi_minus(d, e + dD);
-    else /* -pi - (d - e') + dD */
-        da = -pi_minus(-d, -(e + dD));
+        da = (2 * PIO2_1 - d) + asin_plus((e + 2 * PIO2_2) + 2 * PIO2_3, zn);
+    else /* -pi - (d - e') + asin(zn) */
+        da = -((2 * PIO2_1 + d) + asin_plus((2 * PIO2_2 - e) + 2 * PIO2_3, -zn));
     /* the exact angle is in [-pi/2, pi/2]: rounding only can leave it */
     *D = abs_beyond(da, PI / 2) ? (below0(da) ? -PI / 2 : PI / 2) : da;
     return true;
@@ -2031,10 +2052,26 @@ pm_status pm_term_name(const pm_model *m, int index, char *buf, size_t len)
     return PM_OK;
 }
 
-pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
+PM_NO_SLP pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
                          double enc_ha, double enc_dec, double *app_ha,
                          double *app_dec)
 {
+#if PM_COMPOSED_FORWARD
+    /* eval_ready's checks and the arguments', the same statuses in the same
+    ** order, but the comparison of the coefficients with pm_model_prepare's
+    ** copy inside the evaluation (forward_framed's stale), unless an
+    ** argument is refused */
+    pm_status st = model_shape(m);
+    if (st != PM_OK)
+        return st;
+    st = context_ok(m, ctx);
+    if (st == PM_OK && (!app_ha || !app_dec))
+        st = PM_ERR_ARG;
+    if (st == PM_OK && (!finite(enc_ha) || !finite(enc_dec)))
+        st = PM_ERR_NONFINITE;
+    if (st != PM_OK)
+        return coef_changed(m) ? PM_ERR_STATE : st;
+#else
     pm_status st = eval_ready(m, ctx);
     if (st != PM_OK)
         return st;
@@ -2042,10 +2079,34 @@ pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
         return PM_ERR_ARG;
     if (!finite(enc_ha) || !finite(enc_dec))
         return PM_ERR_NONFINITE;
+#endif
     const Iso<double> &k = iso_of(m);
     double sh[4], t, d;
-    V3<double> p = forward_vec<double>(m, k, trig_of(enc_ha, enc_dec), ctx, sh);
-    if (!frame_angles(m, enc_ha, enc_dec, sh, p, &t, &d)) {
+#if PM_COMPOSED_FORWARD
+    const Trig<double> g = trig_of(enc_ha, enc_dec);
+    /* the comparison after the sines and cosines in the code (the barrier
+    ** keeps the compiler from hoisting it to the top): the evaluation is
+    ** safe to run once model_shape passed, and its ~150 instructions (L =
+    ** 2) then enter the core while the sines and cosines are computed, not
+    ** before them, where they took the place of the next call's start in
+    ** the core's window */
+    const pm_model *mc = m;
+#if defined(__GNUC__)
+    __asm__ volatile("" : "+r"(mc) : "m"(g));
+#endif
+    if (coef_changed(mc))
+        return PM_ERR_STATE;
+    const V3<double> pf = forward_framed<double>(m, k, g, ctx, sh);
+#else
+    const V3<double> p0 = forward_vec<double>(m, k, trig_of(enc_ha, enc_dec), ctx, sh);
+    const V3<double> pf = rot_zt<double>(sh[0], sh[1], p0);
+#endif
+    if (!frame_angles(m, enc_ha, enc_dec, sh, pf, &t, &d)) {
+#if PM_COMPOSED_FORWARD
+        const V3<double> p = rot_z<double>(sh[0], sh[1], pf);
+#else
+        const V3<double> &p = p0;
+#endif
         t = m_atan2(p.y, p.x);
         d = m_atan2(p.z, m_sqrt(p.x * p.x + p.y * p.y));
     }

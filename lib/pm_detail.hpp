@@ -121,6 +121,23 @@ const double PIO2_1 = 1.5707963267341256, PIO2_2 = 6.077100506303966e-11,
 /* (x + RND_INT) - RND_INT is x rounded to an integer, |x| < 2^51 (1.5 2^52) */
 const double RND_INT = 6755399441055744.0;
 
+/* x0 + atan(r) and x0 + asin(r) for |r| <= 0.01 by their series to r^9
+** (the terms left out are below 1e-23): (x0 + r) and the series' tail,
+** whose terms are formed side by side, six operations deep from r (the
+** forward model's frame_angles, where the small x0 is added beside r
+** instead of after the series).  Any arithmetic type (the Python lanes). */
+template <typename T> inline T atan_plus(T x0, T r)
+{
+    const T r2 = r * r, r3 = r * r2, r4 = r2 * r2, r7 = r3 * r4;
+    return (x0 + r) + (r3 * (-1.0 / 3 + r2 * (1.0 / 5)) + r7 * (-1.0 / 7 + r2 * (1.0 / 9)));
+}
+template <typename T> inline T asin_plus(T x0, T r)
+{
+    const T r2 = r * r, r3 = r * r2, r4 = r2 * r2, r7 = r3 * r4;
+    return (x0 + r) +
+           (r3 * (1.0 / 6 + r2 * (3.0 / 40)) + r7 * (5.0 / 112 + r2 * (35.0 / 1152)));
+}
+
 /* A double from its bit pattern. */
 inline double of_bits(unsigned long long u)
 {
@@ -502,22 +519,28 @@ inline void base_uv_at(int k, const Trig<T> &g, const Trig<T> &gs, T *u, T *v)
 
 /* Unit vector displaced from (1,0,0) by the tangent offset (a, b) along y
 ** and z: the exponential map.  Series below 1e-2 (error < 1e-15). */
-template <typename T> inline V3<T> expmap(T a, T b)
+/* expmap(a, b) = (c, a s, b s): c = cos r and s = sin(r)/r, r^2 = a^2 +
+** b^2. */
+template <typename T> __attribute__((always_inline)) inline void expmap_cs(T a, T b, T *c, T *s)
 {
     T r2 = a * a + b * b;
-    T c, s;
     if (r2 < (T)1e-4) {
         /* (by the reciprocals: no division; the r^4 part beside the
         ** leading terms, so that the chain is short: it is on the
         ** inverse's iteration path) */
         T r4 = r2 * r2;
-        c = (1 - (T)0.5 * r2) + r4 * ((T)(1.0 / 24) - r2 * (T)(1.0 / 720));
-        s = (1 - (T)(1.0 / 6) * r2) + r4 * ((T)(1.0 / 120) - r2 * (T)(1.0 / 5040));
+        *c = (1 - (T)0.5 * r2) + r4 * ((T)(1.0 / 24) - r2 * (T)(1.0 / 720));
+        *s = (1 - (T)(1.0 / 6) * r2) + r4 * ((T)(1.0 / 120) - r2 * (T)(1.0 / 5040));
     } else {
         T r = m_sqrt(r2);
-        c = m_cos(r);
-        s = m_sin(r) / r;
+        *c = m_cos(r);
+        *s = m_sin(r) / r;
     }
+}
+template <typename T> inline V3<T> expmap(T a, T b)
+{
+    T c, s;
+    expmap_cs<T>(a, b, &c, &s);
     return v3(c, a * s, b * s);
 }
 
@@ -607,14 +630,21 @@ inline void finish_angles(const double ref[2], double *t, double *d)
 }
 
 
-/* Is the model ready for evaluation: prepared, and no coefficient changed
-** since (a stale model would be silently wrong). */
-inline pm_status model_ready(const pm_model *m)
+/* Is the model prepared, with a term count it can evaluate (model_ready's
+** first part: what makes an evaluation safe to run). */
+__attribute__((always_inline)) inline pm_status model_shape(const pm_model *m)
 {
     if (!m)
         return PM_ERR_ARG;
     if (m->prepared != 1 || m->n_terms < 6 || m->n_terms > PM_MAX_TERMS)
         return PM_ERR_STATE;
+    return PM_OK;
+}
+
+/* Has a coefficient of a model that passed model_shape changed since
+** pm_model_prepare (model_ready's second part)? */
+__attribute__((always_inline)) inline bool coef_changed(const pm_model *m)
+{
     /* Bit patterns XOR-ed and OR-ed together in the machine's words (two
     ** per double on a 32-bit core; two doubles per SSE2 register), four at
     ** a time, no early exit.  (Bitwise, so writing -0.0 over 0.0 also asks
@@ -645,7 +675,17 @@ inline pm_status model_ready(const pm_model *m)
 #else
     word any = acc0;
 #endif
-    return any ? PM_ERR_STATE : PM_OK;
+    return any != 0;
+}
+
+/* Is the model ready for evaluation: prepared, and no coefficient changed
+** since (a stale model would be silently wrong). */
+inline pm_status model_ready(const pm_model *m)
+{
+    const pm_status st = model_shape(m);
+    if (st != PM_OK)
+        return st;
+    return coef_changed(m) ? PM_ERR_STATE : PM_OK;
 }
 
 /* Model constants in working precision. */
@@ -1121,6 +1161,107 @@ inline V3<T> forward_vec(const pm_model *m, const Iso<T> &k, const Trig<T> &g,
     w = rot_x<T>(k.sd, k.cd, w);
     w = rot_z<T>(stp, ctp, w);
     return mat_mul<T>(k.h, w);
+}
+
+/* pm_model_apply's rotations: composed beside the displacement
+** (framed_rotations) where the core runs several instructions per cycle
+** out of order and a shorter chain pays for ~80 more instructions; one
+** after the other (forward_vec's five, as before) on 32-bit ARM (Cortex-M:
+** in order, and counted in instructions).  Either way within about an ulp
+** of each other.  With the composed rotations pm_model_apply also
+** compares the coefficients with pm_model_prepare's copy after the sines
+** and cosines instead of first (lib/model.cpp). */
+#ifndef PM_COMPOSED_FORWARD
+#if defined(__arm__)
+#define PM_COMPOSED_FORWARD 0
+#else
+#define PM_COMPOSED_FORWARD 1
+#endif
+#endif
+/* For pm_model_apply with the composed rotations: gcc's pairing of their
+** scalar products into SSE2 registers costs more shuffles than it saves
+** (1,021 host instructions per call at L = 2 with it, 981 without; the
+** same operations, the same results). */
+#if PM_COMPOSED_FORWARD && defined(__GNUC__) && !defined(__clang__)
+#define PM_NO_SLP __attribute__((optimize("no-tree-slp-vectorize")))
+#else
+#define PM_NO_SLP
+#endif
+
+/* The forward model's rotations composed, seen from the shifted hour angle
+** t' = t + c': F = Pt(t')^T H Pt(t') X(d) Pd(d') T(i) (row-major), so that
+** Pt(t')^T p = F expmap(D).  F depends only on the shifted position's trig
+** (stp, ctp, sdp, cdp) and the model's constants: it is formed beside the
+** displacement, and one product with expmap(D) follows it (a short chain)
+** instead of five rotations in a row. */
+template <typename T>
+__attribute__((always_inline)) inline void framed_rotations(const Iso<T> &k, T stp, T ctp,
+                                                            T sdp, T cdp, T *F)
+{
+    /* B = X(d) Pd(d') T(i), written out (its columns: the three axes
+    ** through T(i), Pd(d'), X(d)); nb1, nb2 = sdp, nb5: the negated
+    ** entries, whose signs the sums below take */
+    const T a0 = sdp * k.ci, a1 = sdp * k.si;
+    const T b0 = cdp * k.ci, nb1 = cdp * k.si;
+    const T b3 = k.cd * k.si - k.sd * a0, b4 = k.cd * k.ci + k.sd * a1, nb5 = k.sd * cdp;
+    const T b6 = k.sd * k.si + k.cd * a0, b7 = k.sd * k.ci - k.cd * a1, b8 = k.cd * cdp;
+    /* G = Pt(t')^T H Pt(t'): H's upper 2 x 2 block P turned, Q^T P Q =
+    ** P + s E with c^2 = 1 - s^2 (E from P's difference and sum across),
+    ** its third column and row turned once */
+    const T *h = k.h;
+    const T d04 = h[0] - h[4], s13 = h[1] + h[3];
+    const T e0 = stp * (stp * d04 - ctp * s13), e1 = stp * (stp * s13 + ctp * d04);
+    const T g0 = h[0] - e0, g4 = h[4] + e0, g1 = h[1] - e1, g3 = h[3] - e1;
+    const T g2 = ctp * h[2] + stp * h[5], g5 = ctp * h[5] - stp * h[2];
+    const T g6 = ctp * h[6] + stp * h[7], g7 = ctp * h[7] - stp * h[6], g8 = h[8];
+    /* F = G B (row r: (g_r0 b_0c + g_r1 b_1c) + g_r2 b_2c) */
+    F[0] = (g0 * b0 + g1 * b3) + g2 * b6;
+    F[1] = (g1 * b4 - g0 * nb1) + g2 * b7;
+    F[2] = g2 * b8 - (g0 * sdp + g1 * nb5);
+    F[3] = (g3 * b0 + g4 * b3) + g5 * b6;
+    F[4] = (g4 * b4 - g3 * nb1) + g5 * b7;
+    F[5] = g5 * b8 - (g3 * sdp + g4 * nb5);
+    F[6] = (g6 * b0 + g7 * b3) + g8 * b6;
+    F[7] = (g7 * b4 - g6 * nb1) + g8 * b7;
+    F[8] = g8 * b8 - (g6 * sdp + g7 * nb5);
+}
+
+/* F expmap(a, b) = c F0 + s (a F1 + b F2) (Fj: F's columns): a F1 + b F2
+** is formed beside expmap's series, two operations follow it. */
+template <typename T>
+__attribute__((always_inline)) inline V3<T> framed_product(const T *F, T a, T b, T c, T s)
+{
+    const T u0 = F[1] * a + F[2] * b, u1 = F[4] * a + F[5] * b, u2 = F[7] * a + F[8] * b;
+    return v3(c * F[0] + s * u0, c * F[3] + s * u1, c * F[6] + s * u2);
+}
+template <typename T>
+__attribute__((always_inline)) inline V3<T> framed_apply(const T *F, T a, T b)
+{
+    T c, s;
+    expmap_cs<T>(a, b, &c, &s);
+    return framed_product<T>(F, a, b, c, s);
+}
+
+/* The forward model's unit vector seen from the shifted hour angle:
+** Pt(t')^T p (p of forward_vec, the same model; the rotations composed by
+** framed_rotations); sh receives the shifted position's trig as in
+** forward_vec.  pm_model_apply's path (frame_angles), inlined there. */
+template <typename T>
+__attribute__((always_inline)) inline V3<T> forward_framed(const pm_model *m, const Iso<T> &k,
+                                                           const Trig<T> &g,
+                                                           const pm_context *ctx, T *sh)
+{
+    T dt, dd, stp, ctp, sdp, cdp, F[9];
+    shifted<T>(k, g, &stp, &ctp, &sdp, &cdp);
+    const T sg[4] = {stp, ctp, sdp, cdp};
+    aniso<T>(m, k, g, ctx, &dt, &dd, sg);
+    /* (after the call in the code, beside its chain in the core) */
+    framed_rotations<T>(k, stp, ctp, sdp, cdp, F);
+    sh[0] = stp;
+    sh[1] = ctp;
+    sh[2] = sdp;
+    sh[3] = cdp;
+    return framed_apply<T>(F, dt, dd);
 }
 
 /* The derivatives (ft, fd) along the axes of an added term's factor f at g

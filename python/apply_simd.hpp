@@ -8,9 +8,10 @@
 **  core's scalar pm_model_apply (lib/model.cpp, lib/pm_detail.hpp), so that
 **  every lane gives the scalar call's doubles bit for bit.  The templates of
 **  lib/pm_detail.hpp that are written for any arithmetic type (sincos_core,
-**  quadrant, harmonics_n, shifted, the rotations, mat_mul) are instantiated
+**  quadrant, harmonics_n, shifted, framed_rotations, framed_product,
+**  atan_plus, asin_plus) are instantiated
 **  on the vector type; the parts of the forward that branch per point
-**  (expmap, frame_angles, turn_sum) are written here once more with lane
+**  (expmap, frame_angles, turn_sum_atan) are written here once more with lane
 **  masks, taking only their common branch.  A point whose lane leaves that
 **  branch (|ha| > 64, |dec| > 4, a NaN or infinity, a displacement beyond
 **  the series of expmap, the pole's neighbourhood where frame_angles gives
@@ -205,18 +206,6 @@ inline void harm_sums(const Consts<W, LC> &K, const VD<W> *Y, VD<W> *S)
     }
 }
 
-/* atan_small, asin_small of lib/model.cpp. */
-template <int W> inline VD<W> atan_small_v(VD<W> r)
-{
-    VD<W> r2 = r * r, r4 = r2 * r2;
-    return r * ((1 - r2 * (1.0 / 3)) + r4 * ((1.0 / 5 - r2 * (1.0 / 7)) + r4 * (1.0 / 9)));
-}
-template <int W> inline VD<W> asin_small_v(VD<W> r)
-{
-    VD<W> r2 = r * r, r4 = r2 * r2;
-    return r * ((1 + r2 * (1.0 / 6)) + r4 * ((3.0 / 40 + r2 * (5.0 / 112)) + r4 * (35.0 / 1152)));
-}
-
 /* W points from index i: the results into a[i..], b[i..]; returns the lanes
 ** (bit j for point i + j) whose point left the common branch (to be
 ** evaluated by pm_model_apply). */
@@ -239,8 +228,8 @@ inline unsigned apply_block(const Consts<W, LC> &K, const double *ha, const doub
     g.t = V(t);
     g.d = V(d);
     g.have_angles = true;
-    /* forward_vec: the shifted position, aniso (sh_sums, aniso_of_sums
-    ** without added terms), expmap, the rotations */
+    /* forward_framed: the shifted position, aniso (sh_sums, aniso_of_sums
+    ** without added terms), expmap, the composed rotations */
     V stp, ctp, sdp, cdp;
     shifted<V>(k, g, &stp, &ctp, &sdp, &cdp);
     V S[6];
@@ -258,38 +247,75 @@ inline unsigned apply_block(const Consts<W, LC> &K, const double *ha, const doub
     const V r4 = r2 * r2;
     const V c = (1 - 0.5 * r2) + r4 * ((1.0 / 24) - r2 * (1.0 / 720));
     const V s = (1 - (1.0 / 6) * r2) + r4 * ((1.0 / 120) - r2 * (1.0 / 5040));
+#if PM_COMPOSED_FORWARD
+    /* framed_rotations and framed_product: for AVX2 and AVX-512 row by
+    ** row (the same operations, fewer values live at once: avx2x2 spilled
+    ** at order 2, ~25 ns a point against ~20), for SSE2 as the core writes
+    ** them (row by row, sse2x2 took ~83 ns a point at order 2) */
+    V3<V> p;
+    if constexpr (NATIVE_W < 4) {
+        V F[9];
+        framed_rotations<V>(k, stp, ctp, sdp, cdp, F);
+        p = framed_product<V>(F, dt, dd, c, s);
+    } else {
+        const V a0 = sdp * k.ci, a1 = sdp * k.si;
+        const V b0 = cdp * k.ci, nb1 = cdp * k.si;
+        const V b3 = k.cd * k.si - k.sd * a0, b4 = k.cd * k.ci + k.sd * a1, nb5 = k.sd * cdp;
+        const V b6 = k.sd * k.si + k.cd * a0, b7 = k.sd * k.ci - k.cd * a1, b8 = k.cd * cdp;
+        const V *h = k.h;
+        const V d04 = h[0] - h[4], s13 = h[1] + h[3];
+        const V e0 = stp * (stp * d04 - ctp * s13), e1 = stp * (stp * s13 + ctp * d04);
+        {
+            const V g0 = h[0] - e0, g1 = h[1] - e1, g2 = ctp * h[2] + stp * h[5];
+            const V F0 = (g0 * b0 + g1 * b3) + g2 * b6, F1 = (g1 * b4 - g0 * nb1) + g2 * b7,
+                    F2 = g2 * b8 - (g0 * sdp + g1 * nb5);
+            p.x = c * F0 + s * (F1 * dt + F2 * dd);
+        }
+        {
+            const V g3 = h[3] - e1, g4 = h[4] + e0, g5 = ctp * h[5] - stp * h[2];
+            const V F3 = (g3 * b0 + g4 * b3) + g5 * b6, F4 = (g4 * b4 - g3 * nb1) + g5 * b7,
+                    F5 = g5 * b8 - (g3 * sdp + g4 * nb5);
+            p.y = c * F3 + s * (F4 * dt + F5 * dd);
+        }
+        {
+            const V g6 = ctp * h[6] + stp * h[7], g7 = ctp * h[7] - stp * h[6], g8 = h[8];
+            const V F6 = (g6 * b0 + g7 * b3) + g8 * b6, F7 = (g7 * b4 - g6 * nb1) + g8 * b7,
+                    F8 = g8 * b8 - (g6 * sdp + g7 * nb5);
+            p.z = c * F6 + s * (F7 * dt + F8 * dd);
+        }
+    }
+#else
     V3<V> w = v3<V>(c, dt * s, dd * s);
     w = rot_z<V>(k.si, k.ci, w);
     w = rot_d<V>(sdp, cdp, w);
     w = rot_x<V>(k.sd, k.cd, w);
     w = rot_z<V>(stp, ctp, w);
-    const V3<V> p = mat_mul<V>(k.h, w);
+    const V3<V> p = rot_zt<V>(stp, ctp, mat_mul<V>(k.h, w));
+#endif
     /* frame_angles (the model's |c'|, |e'| <= 0.5: apply_simd_ok) */
     const mask flip = Ln::lt(cdp.v, Ln::all(0.0));
-    const V sT(Ln::sel(flip, -stp.v, stp.v)), cT(Ln::sel(flip, -ctp.v, ctp.v));
     const V sD = sdp, cD(Ln::sel(flip, -cdp.v, cdp.v));
-    const V x1 = cT * p.x + sT * p.y, y1 = cT * p.y - sT * p.x;
+    const V x1(Ln::sel(flip, -p.x.v, p.x.v)), y1(Ln::sel(flip, -p.y.v, p.y.v));
     const V rho(Ln::sqrt((x1 * x1 + y1 * y1).v));
     const V zn = p.z * cD - rho * sD, zd = rho * cD + p.z * sD;
     ok &= Ln::le(Ln::fabs(y1.v), (0.01 * x1).v) & Ln::le(Ln::fabs(zn.v), Ln::all(0.01)) &
           Ln::lt(Ln::all(0.0), zd.v);
-    const V dT = atan_small_v<W>(y1 / x1), dD = asin_small_v<W>(zn);
-    /* turn_sum(t, c' + dT, flip), its first try (the second: the scalar
-    ** call) */
+    /* turn_sum_atan(t, c', y1 / x1, flip), its first try (the second: the
+    ** scalar call) */
     const V half(Ln::sel(flip, Ln::all(0.5), Ln::all(0.0)));
     const V two(Ln::sel(flip, Ln::all(2.0), Ln::all(0.0)));
-    const V tv(t), sv = K.c + dT;
+    const V tv(t), r = y1 / x1;
     const V n = ((tv * 0.15915494309189535 + half) + RND_INT) - RND_INT;
     const V q = 4 * n - two;
-    const V a = (tv - q * PIO2_1) + ((sv - q * PIO2_2) - q * PIO2_3);
+    const V a = (tv - q * PIO2_1) + atan_plus<V>((K.c - q * PIO2_2) - q * PIO2_3, r);
     ok &= Ln::le(Ln::fabs(a.v), Ln::all(PI));
     raw T = Ln::sel(Ln::eq(a.v, Ln::all(-PI)), Ln::all(PI), a.v);
-    /* the declination: d + (dD - e'), or beyond the pole pi_minus */
+    /* the declination: d + asin_plus(-e', zn), or beyond the pole (the
+    ** sums of frame_angles) */
     const V dv(d), ev(K.e);
-    const V d0 = dv + (dD - ev);
-    const V ed = ev + dD;
-    const V dp = (2 * PIO2_1 - dv) + ((ed + 2 * PIO2_2) + 2 * PIO2_3);
-    const V dm = -((2 * PIO2_1 - (-dv)) + (((-ed) + 2 * PIO2_2) + 2 * PIO2_3));
+    const V d0 = dv + asin_plus<V>(-ev, zn);
+    const V dp = (2 * PIO2_1 - dv) + asin_plus<V>((ev + 2 * PIO2_2) + 2 * PIO2_3, zn);
+    const V dm = -((2 * PIO2_1 + dv) + asin_plus<V>((2 * PIO2_2 - ev) + 2 * PIO2_3, -zn));
     const raw da = Ln::sel(flip, Ln::sel(Ln::lt(Ln::all(0.0), (dv - ev).v), dp.v, dm.v), d0.v);
     const mask out = ~Ln::le(Ln::fabs(da), Ln::all(PI / 2));
     const raw D = Ln::sel(out, Ln::sel(Ln::lt(da, Ln::all(0.0)), Ln::all(-PI / 2), Ln::all(PI / 2)), da);

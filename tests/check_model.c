@@ -515,6 +515,54 @@ START_TEST(test_pm_model_stale_each_coef)
 }
 END_TEST
 
+/* A stale model is PM_ERR_STATE before any other refusal of the call, as
+** eval_ready orders them (pm_model_apply compares the coefficients inside
+** the evaluation, after the sines and cosines: lib/model.cpp), also where
+** the new coefficients would overflow the evaluation or are NaN; the
+** outputs untouched.  On the good model the same calls give their own
+** statuses. */
+START_TEST(test_pm_model_apply_stale_first)
+{
+    static pm_model good, stale, aux;
+    double T = SENTINEL, D = SENTINEL;
+    pm_context ctx;
+    pm_term x;
+    good_and_stale(&good, &stale);
+    ck_assert_int_eq(pm_model_apply(&stale, NULL, 0.1, 0.2, NULL, &D), PM_ERR_STATE);
+    ck_assert_int_eq(pm_model_apply(&stale, NULL, 0.1, 0.2, &T, NULL), PM_ERR_STATE);
+    ck_assert_int_eq(pm_model_apply(&stale, NULL, NAN, 0.2, &T, &D), PM_ERR_STATE);
+    ck_assert_int_eq(pm_model_apply(&stale, NULL, 0.1, -INFINITY, &T, &D), PM_ERR_STATE);
+    stale.coef[7] = 1e300; /* the terms overflow */
+    ck_assert_int_eq(pm_model_apply(&stale, NULL, 0.1, 0.2, &T, &D), PM_ERR_STATE);
+    stale.coef[7] = good.coef[7];
+    stale.coef[2] = NAN; /* c' */
+    ck_assert_int_eq(pm_model_apply(&stale, NULL, 0.1, 0.2, &T, &D), PM_ERR_STATE);
+    stale.coef[2] = good.coef[2];
+    ck_assert_int_eq(pm_model_apply(&stale, NULL, 0.1, 0.2, &T, &D), PM_OK); /* as prepared */
+    T = D = SENTINEL;
+    ck_assert_int_eq(pm_model_apply(&good, NULL, 0.1, 0.2, NULL, &D), PM_ERR_ARG);
+    ck_assert_int_eq(pm_model_apply(&good, NULL, NAN, 0.2, &T, &D), PM_ERR_NONFINITE);
+    /* a model that reads the context: stale before the missing context or
+    ** its non-finite input */
+    roundtrip_model(&aux, 1, 1);
+    memset(&x, 0, sizeof x);
+    x.kind = PM_TERM_AUX;
+    x.k = PM_BASE_C;
+    x.aux = PM_AUX_TEMP;
+    x.param = 10.0;
+    ck_assert_int_eq(pm_model_add_term(&aux, &x, 1e-6, NULL), PM_OK);
+    ck_assert_int_eq(pm_model_prepare(&aux), PM_OK);
+    memset(&ctx, 0, sizeof ctx);
+    ctx.temp_c = NAN;
+    ck_assert_int_eq(pm_model_apply(&aux, NULL, 0.1, 0.2, &T, &D), PM_ERR_ARG);
+    ck_assert_int_eq(pm_model_apply(&aux, &ctx, 0.1, 0.2, &T, &D), PM_ERR_NONFINITE);
+    aux.coef[aux.n_terms - 1] *= 2;
+    ck_assert_int_eq(pm_model_apply(&aux, NULL, 0.1, 0.2, &T, &D), PM_ERR_STATE);
+    ck_assert_int_eq(pm_model_apply(&aux, &ctx, 0.1, 0.2, &T, &D), PM_ERR_STATE);
+    ck_assert(T == SENTINEL && D == SENTINEL);
+}
+END_TEST
+
 START_TEST(test_pm_model_invert_stale)
 {
     static pm_model good, stale;
@@ -1800,6 +1848,7 @@ static Suite *model_suite(void)
     tcase_add_test(tc, test_pm_model_apply_null);
     tcase_add_test(tc, test_pm_model_apply_nonfinite);
     tcase_add_test(tc, test_pm_model_apply_stale);
+    tcase_add_test(tc, test_pm_model_apply_stale_first);
     tcase_add_test(tc, test_pm_model_invert_null);
     tcase_add_test(tc, test_pm_model_invert_nonfinite);
     tcase_add_test(tc, test_pm_model_invert_dec_out_of_range);
