@@ -2229,6 +2229,7 @@ pm_status pm_model_track(const pm_model *m, const pm_context *ctx, pm_track *t,
     }
     c.reach = PM_TRACK_J_REACH;
     c.fresh = c.out_ni = c.out_trig = false;
+    c.rtrig[0] = c.rtrig[1] = c.rtrig[2] = c.rtrig[3] = 0; /* (written where out_trig) */
     c.used = 0;
     double eh = 0, ed = 0;
     pm_status st = invert<true>(m, ctx, app_ha, app_dec, 1, start, &c, &eh, &ed);
