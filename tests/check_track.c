@@ -166,6 +166,54 @@ START_TEST(test_track_realistic)
 }
 END_TEST
 
+/* Long loops: 3,000 ticks of 1 ms and of 0.1 s from each of three
+** positions.  Where the start is the solution already it is returned as
+** it is, with the sines and cosines the state predicted: their lengths
+** must stay 1 (they would drift tick by tick, and the measured stop at
+** such a point miss by as much), every tick round-tripping. */
+START_TEST(test_track_long)
+{
+    static const double dts[2] = {0.001, 0.1};
+    tu_rng r;
+    pm_model m;
+    int i, j, k;
+    double worst = 0, worst_len = 0;
+    tu_seed(&r, 83);
+    real_model(&m, &r, 2, 0);
+    for (j = 0; j < 2; j++)
+        for (i = 0; i < 3; i++) {
+            const double eh = (2 * tu_uniform(&r) - 1) * M_PI;
+            const double ed = m.coef[4] + (2 * tu_uniform(&r) - 1) * 60 * DEG;
+            double ha0, dec, th, td, bh, bd;
+            pm_track t;
+            ck_assert_int_eq(pm_model_apply(&m, NULL, eh, ed, &ha0, &dec), PM_OK);
+            ck_assert_int_eq(pm_track_start(&t, eh, ed), PM_OK);
+            for (k = 1; k <= 3000; k++) {
+                double ah = ha0 + k * dts[j] * SIDEREAL, rt;
+                ck_assert_int_eq(pm_model_track(&m, NULL, &t, ah, dec, &th, &td), PM_OK);
+                ck_assert_int_eq(pm_model_apply(&m, NULL, th, td, &bh, &bd), PM_OK);
+                rt = tu_angle(bh, bd, ah, dec);
+                if (rt > worst)
+                    worst = rt;
+                ck_assert_msg(rt <= PM_INVERT_TOL + ROUND_TRIP_SLACK,
+                              "tick %d of %g s: round trip %.3g", k, dts[j], rt);
+                if (t.flags & PM_TRACK_HAVE_TRIG) {
+                    double l1 = fabs(t.trig[0] * t.trig[0] + t.trig[1] * t.trig[1] - 1);
+                    double l2 = fabs(t.trig[2] * t.trig[2] + t.trig[3] * t.trig[3] - 1);
+                    if (l1 > worst_len)
+                        worst_len = l1;
+                    if (l2 > worst_len)
+                        worst_len = l2;
+                }
+            }
+        }
+    printf("track, 18,000 ticks: worst round trip %.3g rad, sin^2 + cos^2 - 1 at most %.3g\n",
+           worst, worst_len);
+    /* (the renormalisation's own roundings: a few units of 2.2e-16) */
+    ck_assert_double_le(worst_len, 2e-15);
+}
+END_TEST
+
 /* A loop whose target does not move uniformly: ticks of random length, a
 ** pause (the same target again: the predicted start overshoots), a
 ** reversal, a jump of a degree; every result the solution
@@ -432,6 +480,7 @@ int main(void)
     TCase *tc = tcase_create("track");
     tcase_set_timeout(tc, 120);
     tcase_add_test(tc, test_track_realistic);
+    tcase_add_test(tc, test_track_long);
     tcase_add_test(tc, test_track_irregular);
     tcase_add_test(tc, test_track_model_change);
     tcase_add_test(tc, test_track_aux_inputs);
