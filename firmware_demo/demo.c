@@ -14,7 +14,11 @@
 **     previous tick's target (checked to 1e-12 rad; 0.01" for float).  Three targets, one
 **     of them close to the pole, one crossing the meridian; one tick is
 **     FW_TICK_S seconds of sidereal motion (compressed time: a real loop
-**     runs at 10-100 Hz, the arithmetic per tick is the same).
+**     runs at 10-100 Hz, the arithmetic per tick is the same).  Beside it
+**     the loop a controller that keeps its own setpoints would run:
+**     pm_model_track (pm_model_track_f) with its state carried from tick
+**     to tick, checked against pm_model_invert_near's result (1e-12 rad;
+**     the float build 2 PM_INVERT_F_TOL) and its cost printed beside it.
 **  2) Refit on the controller.  A pointing run: slew to FW_NOBS stars with
 **     the current model, "measure" where the telescope really points (a
 **     simulated true mount: the model with every coefficient changed by up
@@ -168,6 +172,33 @@ static pm_status ctl_invert_near(double ah, double ad, double sh, double sd, dou
 #endif
 }
 
+/* The tracking loop's state (pm_model_track): one per axis pair. */
+#if defined(FW_FLOAT)
+static pm_track_f trk;
+#define FW_TRACK_SAME (2 * PM_INVERT_F_TOL)
+#else
+static pm_track trk;
+#define FW_TRACK_SAME 1e-12
+#endif
+
+static pm_status ctl_track_start(double eh, double ed)
+{
+#if defined(FW_FLOAT)
+    return pm_track_f_start(&trk, eh, ed);
+#else
+    return pm_track_start(&trk, eh, ed);
+#endif
+}
+
+static pm_status ctl_track(double ah, double ad, double *eh, double *ed)
+{
+#if defined(FW_FLOAT)
+    return pm_model_track_f(&model_f, NULL, &trk, ah, ad, eh, ed);
+#else
+    return pm_model_track(&model, NULL, &trk, ah, ad, eh, ed);
+#endif
+}
+
 /* ---------------------------------------------------------------------- */
 /* Phase 1: tracking.                                                     */
 
@@ -178,8 +209,8 @@ static void tracking(void)
         {-0.25, 1.45},  /* 83 deg, crosses the meridian */
         {-2.00, -0.45}  /* low in the south-east */
     };
-    cost c_apply = {0, 0, 0}, c_inv = {0, 0, 0};
-    double worst = 0;
+    cost c_apply = {0, 0, 0}, c_inv = {0, 0, 0}, c_trk = {0, 0, 0};
+    double worst = 0, worst_trk = 0;
     int t, k, n = 0;
     for (t = 0; t < FW_TARGETS; t++) {
         double ha = start[t][0], dec = start[t][1];
@@ -188,9 +219,11 @@ static void tracking(void)
         pm_status st = ctl_invert(ha, dec, &enc_ha, &enc_dec);
         if (st != PM_OK)
             fail("pm_model_invert status", (double)st, 0);
+        if (ctl_track_start(enc_ha, enc_dec) != PM_OK)
+            fail("pm_track_start status", 0, 0);
         for (k = 1; k <= FW_TICKS; k++) {
-            double rep_ha, rep_dec, cmd_ha, cmd_dec, err;
-            unsigned long c0, c1, c2;
+            double rep_ha, rep_dec, cmd_ha, cmd_dec, trk_ha, trk_dec, err;
+            unsigned long c0, c1, c2, c3;
             ha = start[t][0] + SIDEREAL_RATE * FW_TICK_S * k;
             c0 = fw_counter();
             st = ctl_apply(enc_ha, enc_dec, &rep_ha, &rep_dec);
@@ -198,12 +231,20 @@ static void tracking(void)
             if (st == PM_OK)
                 st = ctl_invert_near(ha, dec, enc_ha, enc_dec, &cmd_ha, &cmd_dec);
             c2 = fw_counter();
+            if (st == PM_OK)
+                st = ctl_track(ha, dec, &trk_ha, &trk_dec);
+            c3 = fw_counter();
             cost_add(&c_apply, c0, c1);
             cost_add(&c_inv, c1, c2);
+            cost_add(&c_trk, c2, c3);
             if (st != PM_OK) {
                 fail("tracking status", (double)st, 0);
                 return;
             }
+            err = fabs(trk_ha - cmd_ha) > fabs(trk_dec - cmd_dec) ? fabs(trk_ha - cmd_ha)
+                                                                  : fabs(trk_dec - cmd_dec);
+            if (!(err <= worst_trk))
+                worst_trk = err;
             err = angle(rep_ha, rep_dec, prev_ha, prev_dec);
             if (err > worst)
                 worst = err;
@@ -224,12 +265,17 @@ static void tracking(void)
            "target: worst %.2e rad\n", FW_TARGETS, FW_TICKS, worst);
     if (worst > FW_TRACK_TOL)
         fail("tracking: report vs. target (rad)", worst, FW_TRACK_TOL);
+    printf("tracking with a state: vs. invert_near worst %.2e rad\n", worst_trk);
+    if (!(worst_trk <= FW_TRACK_SAME))
+        fail("tracking: pm_model_track vs. invert_near (rad)", worst_trk, FW_TRACK_SAME);
 #if defined(FW_FLOAT)
     cost_print("pm_model_apply_f", &c_apply);
     cost_print("pm_model_invert_near_f", &c_inv);
+    cost_print("pm_model_track_f", &c_trk);
 #else
     cost_print("pm_model_apply", &c_apply);
     cost_print("pm_model_invert_near", &c_inv);
+    cost_print("pm_model_track", &c_trk);
 #endif
 }
 

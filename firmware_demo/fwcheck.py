@@ -22,8 +22,8 @@ import subprocess
 import sys
 
 # Entry points whose worst stack depth is reported.
-ROOTS = ["pm_model_apply", "pm_model_invert", "pm_model_invert_near",
-         "pm_model_apply_f", "pm_model_invert_f", "pm_model_invert_near_f",
+ROOTS = ["pm_model_apply", "pm_model_invert", "pm_model_invert_near", "pm_model_track",
+         "pm_model_apply_f", "pm_model_invert_f", "pm_model_invert_near_f", "pm_model_track_f",
          "pm_fit_add", "pm_fit_solve", "pm_fit_run", "main"]
 
 
@@ -225,8 +225,9 @@ def main():
         if m:
             info["sizeof"] = {k: int(v) for k, v in
                               re.findall(r"(pm_\w+) (\d+)", m.group(1))}
-        for name in ("pm_model_apply", "pm_model_invert_near", "pm_model_apply_f",
-                     "pm_model_invert_near_f", "pm_fit_add", "pm_fit_solve",
+        for name in ("pm_model_apply", "pm_model_invert_near", "pm_model_track",
+                     "pm_model_apply_f", "pm_model_invert_near_f", "pm_model_track_f",
+                     "pm_fit_add", "pm_fit_solve",
                      r"pm_fit_run \(whole\)"):
             m = re.search(name + r"\s+(\d+) instructions mean,\s+(\d+) max", text)
             if m:

@@ -1750,7 +1750,7 @@ pm_status invert(const pm_model *m, const pm_context *ctx, double app_ha,
         TRACK ? solve_branch<true>(m, k, ctx, a, side, 0, start, carry, turn, &t, &d, &err)
               : solve_branch<false>(m, k, ctx, a, side, start ? 0 : side, start, 0, turn, &t,
                                     &d, &err);
-    if (!start && (result != PM_OK || side_of(m, d) != side)) {
+    if (!TRACK && !start && (result != PM_OK || side_of(m, d) != side)) {
         /* Within the anisotropic amplitude of the mount's pole the closed
         ** form's branches (sign of cos(dec - e' + displacement angle)) and
         ** the sides of the pole (sign of cos(dec - e')) differ: the other
@@ -2223,20 +2223,6 @@ pm_status pm_model_track(const pm_model *m, const pm_context *ctx, pm_track *t,
     if (!m || !t || t->magic != PM_TRACK_MAGIC || !enc_ha || !enc_dec)
         return PM_ERR_ARG;
     /* (invert checks the model and the context before either is used) */
-    if (iso_only(m)) { /* the closed form: nothing to carry */
-        double eh = 0, ed = 0;
-        pm_status st = invert<false>(m, ctx, app_ha, app_dec, 1, t->enc, 0, &eh, &ed);
-        if (st == PM_OK) {
-            t->enc[0] = eh;
-            t->enc[1] = ed;
-            t->flags &= ~(PM_TRACK_HAVE_TRIG | PM_TRACK_HAVE_STEP);
-        }
-        if (st >= 0) {
-            *enc_ha = eh;
-            *enc_dec = ed;
-        }
-        return st;
-    }
     const Digest in = inputs_digest(m, ctx);
     Carry c;
     c.t = t;
