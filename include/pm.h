@@ -621,8 +621,8 @@ pm_status pm_model_invert_near(const pm_model *m, const pm_context *ctx,
 **     evaluations holds as for pm_model_invert_near.  The results differ
 **     from pm_model_invert_near's in the last bits (other iterates):
 **     tests/check_track.c finds them within 1e-12 rad of it beyond 5 deg
-**     of the mount's pole.  A model without anisotropic terms has nothing
-**     to carry: pm_model_invert_near from t->enc.
+**     of the mount's pole.  A model without anisotropic terms needs no
+**     evaluation: the closed form, on the branch of the start.
 **  2) On PM_OK the state's position becomes the result; on a warning or
 **     an error it stays (the next tick starts from the last good one),
 **     and a J taken in the call is kept (it is right wherever it was
