@@ -2138,16 +2138,7 @@ pm_status pm_model_invert_near(const pm_model *m, const pm_context *ctx,
 
 pm_status pm_track_start(pm_track *t, double enc_ha, double enc_dec)
 {
-    if (!t)
-        return PM_ERR_ARG;
-    pm_status st = start_status(enc_ha, enc_dec);
-    if (st != PM_OK)
-        return st;
-    __builtin_memset(t, 0, sizeof *t);
-    t->enc[0] = enc_ha;
-    t->enc[1] = enc_dec;
-    t->magic = PM_TRACK_MAGIC;
-    return PM_OK;
+    return start_state(t, enc_ha, enc_dec, PM_TRACK_MAGIC);
 }
 
 /* The sines and cosines of a + b (each axis) from a's and b's. */

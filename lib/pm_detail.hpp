@@ -70,14 +70,21 @@ inline bool abs_beyond(double a, double b)
 #endif
 }
 
-/* A tracking state's start position (pm_track_start, pm_track_f_start):
-** PM_OK, PM_ERR_NONFINITE or PM_ERR_ARG (beyond PM_START_MAX). */
-inline pm_status start_status(double h, double d)
+/* A tracking state (pm_track, pm_track_f) started at (h, d) with its
+** magic number: PM_OK, PM_ERR_ARG (no state, or beyond PM_START_MAX) or
+** PM_ERR_NONFINITE; the state untouched on error. */
+template <typename S> inline pm_status start_state(S *t, double h, double d, int magic)
 {
+    if (!t)
+        return PM_ERR_ARG;
     if (!finite(h) || !finite(d))
         return PM_ERR_NONFINITE;
     if (abs_beyond(h, PM_START_MAX) || abs_beyond(d, PM_START_MAX))
         return PM_ERR_ARG;
+    __builtin_memset(t, 0, sizeof *t);
+    t->enc[0] = h;
+    t->enc[1] = d;
+    t->magic = magic;
     return PM_OK;
 }
 
