@@ -1725,7 +1725,9 @@ pm_status invert(const pm_model *m, const pm_context *ctx, double app_ha,
                  double app_dec, int side, const double *start, Carry *carry,
                  double *enc_ha, double *enc_dec)
 {
-    pm_status st = eval_ready(m, ctx);
+    /* (pm_model_track checked the model and the context itself, before it
+    ** read them) */
+    pm_status st = TRACK ? PM_OK : eval_ready(m, ctx);
     if (st != PM_OK)
         return st;
     if (!enc_ha || !enc_dec)
@@ -2211,9 +2213,11 @@ static int track_step(pm_track *t, double eh, double ed, const double r[4])
 pm_status pm_model_track(const pm_model *m, const pm_context *ctx, pm_track *t,
                          double app_ha, double app_dec, double *enc_ha, double *enc_dec)
 {
-    if (!m || !t || t->magic != PM_TRACK_MAGIC || !enc_ha || !enc_dec)
+    if (!t || t->magic != PM_TRACK_MAGIC || !enc_ha || !enc_dec)
         return PM_ERR_ARG;
-    /* (invert checks the model and the context before either is used) */
+    pm_status st = eval_ready(m, ctx); /* (before the digest reads them) */
+    if (st != PM_OK)
+        return st;
     const Digest in = inputs_digest(m, ctx);
     Carry c;
     c.t = t;
@@ -2235,7 +2239,7 @@ pm_status pm_model_track(const pm_model *m, const pm_context *ctx, pm_track *t,
     c.rtrig[0] = c.rtrig[1] = c.rtrig[2] = c.rtrig[3] = 0; /* (written where out_trig) */
     c.used = 0;
     double eh = 0, ed = 0;
-    pm_status st = invert<true>(m, ctx, app_ha, app_dec, 1, start, &c, &eh, &ed);
+    st = invert<true>(m, ctx, app_ha, app_dec, 1, start, &c, &eh, &ed);
     if (st < 0 && !c.fresh)
         return st; /* (the state as it was) */
     int f = t->flags & ~PM_TRACK_REFRESH;
