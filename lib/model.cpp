@@ -174,14 +174,9 @@ int side_of(const pm_model *m, double d)
     return m_cos(x) >= 0 ? 1 : -1;
 }
 
-/* atan(r) and asin(r) for |r| <= 0.01 by their series (the terms left out
-** are below 1e-23), by Estrin's scheme (a short dependency chain: these
-** end the forward model's). */
-inline double atan_small(double r)
-{
-    double r2 = r * r, r4 = r2 * r2;
-    return r * ((1 - r2 * (1.0 / 3)) + r4 * ((1.0 / 5 - r2 * (1.0 / 7)) + r4 * (1.0 / 9)));
-}
+/* asin(r) for |r| <= 0.01 by its series (the terms left out are below
+** 1e-23), by Estrin's scheme (the inverse's returned angles; the forward's
+** atan and asin tails are atan_plus and asin_plus, below). */
 inline double asin_small(double r)
 {
     double r2 = r * r, r4 = r2 * r2;
