@@ -176,7 +176,7 @@ int side_of(const pm_model *m, double d)
 
 /* asin(r) for |r| <= 0.01 by its series (the terms left out are below
 ** 1e-23), by Estrin's scheme (the inverse's returned angles; the forward's
-** atan and asin tails are atan_plus and asin_plus, below). */
+** atan and asin tails are atan_plus and asin_plus, lib/pm_detail.hpp). */
 inline double asin_small(double r)
 {
     double r2 = r * r, r4 = r2 * r2;
