@@ -803,12 +803,13 @@ pm_status pm_model_invert_near_f(const pm_model_f *m, const pm_context *ctx,
 **  Notes:
 **  1) The correction changes by |dC/dx| times a tick's motion (1e-9 rad
 **     at 10 Hz with arcminute terms), and that change by far less, so the
-**     first step's change already predicts a point within PM_INVERT_F_TOL,
-**     and the
-**     forward model's check (Note 2 above) certifies it: two evaluations
-**     a tick where pm_model_invert_near_f makes three.  The check is
-**     what makes the result right, whatever the state holds (a state
-**     from another model only costs steps).
+**     point the predicted correction gives is within PM_INVERT_F_TOL
+**     already: it is checked with the forward model (Note 2 above, the
+**     check that certifies every float result) and returned, one
+**     evaluation a tick; where the check fails the fixed point goes on
+**     from there, as pm_model_invert_near_f's.  The check is what makes
+**     the result right, whatever the state holds (a state from another
+**     model only costs steps).
 **  2) Arguments, statuses and the state's updates as pm_model_track
 **     (PM_ERR_ARG for a state pm_track_f_start did not fill); the state
 **     is plain data of the caller's.

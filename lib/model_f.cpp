@@ -320,6 +320,43 @@ void encoder_of(const pm_model_f *m, double T0, double D, float dT, float dD, bo
     *d = dd;
 }
 
+/* The fixed point's check: the encoder position of the frame position
+** (T0 - dT, D - dD) evaluated with the forward model itself; true where
+** it points within PM_INVERT_F_TOL of the target (T0, D), the position in
+** (t_out, d_out) and the correction the forward model found there in
+** corr (where given: the next tick's start, pm_model_track_f). */
+__attribute__((always_inline)) inline bool
+point_ok_f(const pm_model_f *m, const pm_context *ctx, double T0, double D, float sD, float cD,
+           float dT, float dD, bool flip, const double ref[2], float *corr, double *t_out,
+           double *d_out)
+{
+    const float tol = (float)PM_INVERT_F_TOL;
+    double t, d, tr, dr;
+    float kT, kD; /* the correction there */
+    encoder_of(m, T0, D, dT, dD, flip, ref, &t, &d);
+    forward_parts_f(m, ctx, t, d, &tr, &dr, &kT, &kD);
+    /* The forward model gives (T1, D1) = (t_r + kT, d_r + kD), to the
+    ** rounding of those sums (1e-16), so its offset from the target is
+    ** (eT, eD) below.  The separation (haversine):
+    ** chord^2 = (2 sin(eD/2))^2 + cos D1 cos D (2 sin(eT/2))^2
+    **         <= eD^2 + cos D1 cos D eT^2,
+    ** with cos D1 <= cos D - sin D eD + eD^2 (|eD| < 1); the angle exceeds
+    ** the chord by a part in chord^2 / 24, and the float sums by a few
+    ** parts in 1e7: 1% of tol^2 covers both. */
+    float eT = (float)wrap_pi(wrap_pi(tr) - T0) + kT, eD = (float)(dr - D) + kD;
+    float cD1 = cD - sD * eD + eD * eD;
+    float cc = cD1 > 0 ? cD1 * cD : 0.0f;
+    if (!(m_fabs(eD) < 1 && eD * eD + cc * eT * eT <= 0.99f * tol * tol))
+        return false;
+    *t_out = t;
+    *d_out = d;
+    if (corr) {
+        corr[0] = kT;
+        corr[1] = kD;
+    }
+    return true;
+}
+
 /* The fixed point of the float inverse: the frame position is the target
 ** minus the correction there, x_{n+1} = target - C(x_n), iterated from
 ** the target itself.  The frame trig comes from the target's, turned by
@@ -334,15 +371,21 @@ pm_status fixed_f(const pm_model_f *m, const pm_context *ctx, double T, double D
                   double *d_out)
 {
     const double T0 = wrap_pi(T);
-    float sT, cT;
-    sincos_f((float)T0, &sT, &cT);
     float sD, cD;
     dec_trig_f(D, &sD, &cD);
-    const bool raw = reads_angles_f(m);
-    const float tol = (float)PM_INVERT_F_TOL;
     /* (from the correction of the tick before where pm_model_track_f has
     ** one: it then changes by far less than the tolerance per step) */
     float dT = warm ? warm[0] : 0.0f, dD = warm ? warm[1] : 0.0f, last = 0;
+    /* A tracking loop's start (pm_model_track_f) is the correction of the
+    ** ticks before, moved on by its last change: checked as it is first,
+    ** one evaluation where it is within the tolerance already */
+    if (warm && m_fabs(dT) <= 0.01f && m_fabs(dD) <= 0.01f &&
+        point_ok_f(m, ctx, T0, D, sD, cD, dT, dD, flip, ref, corr, t_out, d_out))
+        return PM_OK;
+    float sT, cT;
+    sincos_f((float)T0, &sT, &cT);
+    const bool raw = reads_angles_f(m);
+    const float tol = (float)PM_INVERT_F_TOL;
     for (int it = 0; it < PM_INVERT_F_FIXED; it++) {
         float s1, c1, s2, c2;
         sincos_small(dT, &s1, &c1);
@@ -383,30 +426,9 @@ pm_status fixed_f(const pm_model_f *m, const pm_context *ctx, double T, double D
         ** (one more evaluation); Newton takes over if it misses. */
         float rho = last > 0 ? change / last : change == 0 ? 0.0f : 1.0f;
         if ((it > 0 || warm) && change * rho <= 0.25f * tol) {
-            double t, d, tr, dr;
-            float kT, kD; /* the correction there */
-            encoder_of(m, T0, D, dT, dD, flip, ref, &t, &d);
-            forward_parts_f(m, ctx, t, d, &tr, &dr, &kT, &kD);
-            /* The forward model gives (T1, D1) = (t_r + kT, d_r + kD), to
-            ** the rounding of those sums (1e-16), so its offset from the
-            ** target is (eT, eD) below.  The separation (haversine):
-            ** chord^2 = (2 sin(eD/2))^2 + cos D1 cos D (2 sin(eT/2))^2
-            **         <= eD^2 + cos D1 cos D eT^2,
-            ** with cos D1 <= cos D - sin D eD + eD^2 (|eD| < 1); the angle
-            ** exceeds the chord by a part in chord^2 / 24, and the float
-            ** sums by a few parts in 1e7: 1% of tol^2 covers both. */
-            float eT = (float)wrap_pi(wrap_pi(tr) - T0) + kT, eD = (float)(dr - D) + kD;
-            float cD1 = cD - sD * eD + eD * eD;
-            float cc = cD1 > 0 ? cD1 * cD : 0.0f;
-            if (!(m_fabs(eD) < 1 && eD * eD + cc * eT * eT <= 0.99f * tol * tol))
-                return PM_WARN_NOT_CONVERGED;
-            *t_out = t;
-            *d_out = d;
-            if (corr) {
-                corr[0] = dT;
-                corr[1] = dD;
-            }
-            return PM_OK;
+            return point_ok_f(m, ctx, T0, D, sD, cD, dT, dD, flip, ref, corr, t_out, d_out)
+                       ? PM_OK
+                       : PM_WARN_NOT_CONVERGED;
         }
         last = change;
     }
