@@ -5,7 +5,8 @@
 **  double (NaN, Inf, 1e300, subnormals), terms added (valid and invalid),
 **  fields of the struct overwritten, prepare, apply, invert, invert_near,
 **  pm_model_track (a state carried across the operations, the model
-**  changing under it), residual, the float build, pm_terms_eval,
+**  changing under it), residual, the float build (pm_model_track_f too),
+**  pm_terms_eval,
 **  pm_term_name, pm_model_find.
 **
 **  Invariants (README.md): every call returns one of its documented
@@ -52,6 +53,7 @@ typedef struct ca_state {
     int prepared;                /* a prepare (init, add_term) succeeded */
     double pcoef[PM_MAX_TERMS];  /* the coefficients it prepared */
     pm_track tk;                 /* pm_model_track's state (zero: not started) */
+    pm_track_f tkf;              /* pm_model_track_f's */
 } ca_state;
 
 static void ca_mark(ca_state *s)
@@ -412,6 +414,39 @@ static int ca_op_terms_eval(pmfz_in *in)
     return 0;
 }
 
+/* The float build's tracking loop on the target (t, d) that (eh, ed)
+** points at: its state started there first (start), else carried from
+** the calls before, whatever model they had; PM_OK round-trips. */
+static int ca_op_track_f(const pm_model_f *mf, const pm_context *ctx, pm_track_f *tk,
+                         double t, double d, double eh, double ed, int start)
+{
+    double et = CA_SENTINEL, edc = CA_SENTINEL;
+    pm_status st;
+    if ((start || tk->magic != PM_TRACK_F_MAGIC) && pm_track_f_start(tk, eh, ed) != PM_OK)
+        return 0; /* (a start beyond PM_START_MAX: refused) */
+    st = pm_model_track_f(mf, ctx, tk, t, d, &et, &edc);
+    if (!pmfz_status_in(st, ca_invert_st))
+        return pmfz_fail("track_f: status %d", st);
+    if (st < 0) {
+        if (et != CA_SENTINEL || edc != CA_SENTINEL)
+            return pmfz_fail("track_f: outputs changed on error %d", st);
+        return 0;
+    }
+    if (!pmfz_finite(et) || !pmfz_finite(edc))
+        return pmfz_fail("track_f: status %d with (%g, %g)", st, et, edc);
+    if (st == PM_OK) {
+        double rt, rd, miss;
+        if (pm_model_apply_f(mf, ctx, et, edc, &rt, &rd) != PM_OK)
+            return pmfz_fail("track_f: apply_f of the result failed");
+        miss = pmfz_sep(rt, rd, t, d);
+        if (!(miss <= CA_TOL_ROUNDTRIP_F))
+            return pmfz_fail("track_f: PM_OK but the round trip misses by %g rad", miss);
+        if (tk->enc[0] != et || tk->enc[1] != edc)
+            return pmfz_fail("track_f: PM_OK without the state's position moved");
+    }
+    return 0;
+}
+
 static int ca_op_float(pmfz_in *in, ca_state *s)
 {
     static pm_model_f mf;
@@ -488,6 +523,8 @@ static int ca_op_float(pmfz_in *in, ca_state *s)
                 return pmfz_fail("invert_f: PM_OK but the round trip misses by %g rad "
                                  "(target %.17g %.17g)", miss, t, d);
         }
+        if (near && ca_op_track_f(&mf, ctx, &s->tkf, t, d, eh, ed, k == 0))
+            return 1;
     }
     return 0;
 }
