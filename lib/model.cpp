@@ -848,7 +848,6 @@ struct Carry {
     pm_track *t;
     bool have_j, have_ni;         /* in */
     const double *strig;          /* in: the start's sines and cosines, or 0 */
-    double reach;                 /* in: J is carried within this distance */
     bool fresh, out_ni, out_trig; /* out */
     double rtrig[4];              /* out: the result's sines and cosines */
     int used;                     /* out: evaluations made */
@@ -943,7 +942,7 @@ PM_HOT bool carried_j(Branch *s, const Trig<double> &g)
     if (!small_step(g, gj, &ht, &hd))
         return false;
     const double hn = step_len(ht, hd);
-    if (!(hn <= c->reach))
+    if (!(hn <= PM_TRACK_J_REACH))
         return false;
     for (int i = 0; i < 4; i++)
         s->J[i] = t->jac[i];
@@ -2229,7 +2228,6 @@ pm_status pm_model_track(const pm_model *m, const pm_context *ctx, pm_track *t,
         start[1] = t->enc[1];
         c.strig = 0;
     }
-    c.reach = PM_TRACK_J_REACH;
     c.fresh = c.out_ni = c.out_trig = false;
     c.rtrig[0] = c.rtrig[1] = c.rtrig[2] = c.rtrig[3] = 0; /* (written where out_trig) */
     c.used = 0;
