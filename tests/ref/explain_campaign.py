@@ -242,6 +242,11 @@ def score_single(effect, d, truth, cfg):
     if mine:
         f = mine[0]
         amp = f["amplitude_arcsec"]
+        # the reported uncertainty: is the true amplitude within 2 of its
+        # sigmas (the fit's covariance) of the one found?
+        if effect not in ("outlier", "higher_order") and f.get("amplitude_error_arcsec"):
+            info["amp_pull"] = (amp - te["explain_amplitude_arcsec"]) / f["amplitude_error_arcsec"]
+            info["amp_in_2sigma"] = bool(abs(info["amp_pull"]) <= 2)
         if effect in ("ha_periodic", "dec_periodic"):
             G = te["G"]
             g_ok = abs(f.get("cycles_per_rev", -1) - G) < 1e-6
@@ -491,6 +496,14 @@ def main():
                   if "phase_diff_deg" in x["score"] and x["score"]["named"]]
             if ph:
                 notes.append("phase within 30 deg %d/%d" % (sum(p <= 30 for p in ph), len(ph)))
+            a2 = [x for x in good if "amp_in_2sigma" in x["score"]]
+            if a2:
+                notes.append("amp within 2 sigma %d/%d" % (
+                    sum(x["score"]["amp_in_2sigma"] for x in a2), len(a2)))
+                miss = [x for x in a2 if x["score"]["named"] and not x["score"]["params_ok"]]
+                if miss:
+                    notes.append("of the params misses %d/%d" % (
+                        sum(x["score"]["amp_in_2sigma"] for x in miss), len(miss)))
             fa = sum(x["score"].get("first_or_alt", False) for x in good)
             if fa != nf:
                 notes.append("first or its close alternative %d/%d" % (fa, len(good)))
@@ -504,6 +517,14 @@ def main():
             print("%-13s %-6s %4d  %-11s %-9s %-7s %-11s %-8s %s" % (
                 e, m, len(good), pct(nf, len(good)), pct(po, len(good)), pct(ex, len(good)),
                 "%.2f-%.2f" % (min(infl), max(infl)) if infl else "-", len(fail), "; ".join(notes)))
+
+    pulls = [x["score"]["amp_pull"] for x in recs if x["kind"] == "single" and "score" in x
+             and "amp_pull" in x["score"]]
+    if pulls:
+        pa = np.array(pulls)
+        print("amplitudes found, (found - true) / the sigma reported beside them, %d findings: "
+              "mean %.2f, std %.2f, within 2 sigma %s" % (
+                  len(pa), pa.mean(), pa.std(), pct(int((abs(pa) <= 2).sum()), len(pa))))
 
     print("\nnothing hidden")
     print("%-32s %-6s %5s  %s" % ("runs", "mount", "n", "no finding  (found instead)"))
