@@ -518,13 +518,15 @@ def main():
                 e, m, len(good), pct(nf, len(good)), pct(po, len(good)), pct(ex, len(good)),
                 "%.2f-%.2f" % (min(infl), max(infl)) if infl else "-", len(fail), "; ".join(notes)))
 
-    pulls = [x["score"]["amp_pull"] for x in recs if x["kind"] == "single" and "score" in x
-             and "amp_pull" in x["score"]]
-    if pulls:
-        pa = np.array(pulls)
+    pulled = [x for x in recs if x["kind"] == "single" and "score" in x
+              and "amp_pull" in x["score"]]
+    if pulled:
+        pa = np.array([x["score"]["amp_pull"] for x in pulled])
+        worst = pulled[int(np.argmax(abs(pa)))]
         print("amplitudes found, (found - true) / the sigma reported beside them, %d findings: "
-              "mean %.2f, std %.2f, within 2 sigma %s" % (
-                  len(pa), pa.mean(), pa.std(), pct(int((abs(pa) <= 2).sum()), len(pa))))
+              "mean %.2f, std %.2f, within 2 sigma %s; largest %.1f (%s)" % (
+                  len(pa), pa.mean(), pa.std(), pct(int((abs(pa) <= 2).sum()), len(pa)),
+                  worst["score"]["amp_pull"], worst["tag"]))
 
     print("\nnothing hidden")
     print("%-32s %-6s %5s  %s" % ("runs", "mount", "n", "no finding  (found instead)"))
