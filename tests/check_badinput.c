@@ -1440,6 +1440,35 @@ START_TEST(test_badinput_cli_unwritable_output)
 }
 END_TEST
 
+/* A run with a point 37 deg off (fuzz/regress/explain/cv_fold_does_not_fit,
+** found by fuzz_explain): a fold of the baseline's cross-validation does
+** not fit.  explain says the CV RMS is not available (no "nan"), the JSON
+** writes null, and the gross error is still found and the rest explained. */
+START_TEST(test_badinput_explain_cv_not_available)
+{
+    char src[1024], path[1024];
+    const char *top = getenv("PM_TOP");
+    size_t n = 0;
+    char *bytes;
+    make_tmpdir();
+    snprintf(src, sizeof src, "%s/fuzz/regress/explain/cv_fold_does_not_fit",
+             top && *top ? top : ".");
+    bytes = read_all(src, &n);
+    ck_assert_msg(bytes != NULL && n > 1, "cannot read %s", src);
+    tmp_path(path, sizeof path, "gross.dat");
+    write_bytes(path, bytes + 1, n - 1); /* (byte 0: the harness's options) */
+    free(bytes);
+    ck_assert_int_eq(pmfit("explain '%s'", path), 0);
+    ck_assert_msg(strstr(out, "cross-validated RMS not available (a fold of the "
+                              "cross-validation did not fit)") != NULL, "%.2000s", out);
+    ck_assert_msg(strstr(out, "nan") == NULL, "%.2000s", out);
+    ck_assert_msg(strstr(out, "1. outlier:") != NULL && strstr(out, "at line 74") != NULL,
+                  "%.2000s", out);
+    ck_assert_int_eq(pmfit("explain '%s' --json", path), 0);
+    ck_assert_msg(strstr(out, "\"cv_rms_arcsec\": null") != NULL, "%.800s", out);
+}
+END_TEST
+
 static Suite *suite(void)
 {
     Suite *s = suite_create("badinput");
@@ -1492,6 +1521,7 @@ static Suite *suite(void)
     tc = tcase_create("cli");
     tcase_add_test(tc, test_badinput_cli_order);
     tcase_add_test(tc, test_badinput_cli_unwritable_output);
+    tcase_add_test(tc, test_badinput_explain_cv_not_available);
     tcase_set_timeout(tc, 60);
     tcase_add_checked_fixture(tc, setup, teardown);
     suite_add_tcase(s, tc);

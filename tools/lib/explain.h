@@ -18,7 +18,9 @@ extern "C" {
 /* Another reading of the same residuals with close evidence. */
 typedef struct pmx_alternative {
     char effect[24];
-    double delta_bic;                /* BIC(alternative) - BIC(chosen), >= 0 */
+    double delta_bic;                /* BIC(alternative) - BIC(chosen); negative where BIC
+                                        (which does not count the periods or candidates
+                                        tried) prefers the alternative */
     double log10_lr;                 /* log10 likelihood ratio chosen : alternative */
     double log10_fap;                /* its own false-alarm probability, log10 */
     char separate_by[160];           /* the observation that would tell them apart */
@@ -49,6 +51,9 @@ typedef struct pmx_finding {
 } pmx_finding;
 
 typedef struct pmx_result {
+    /* (a cross-validated RMS is NaN where a fold of the cross-validation
+    ** did not fit, e.g. beside a gross error of tens of degrees; the
+    ** finding that removes such a point is an outlier, which needs none) */
     double base_sigma_arcsec, base_cv_rms_arcsec;
     int base_n_params;
     int n_findings;

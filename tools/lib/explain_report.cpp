@@ -2,6 +2,7 @@
 // one JSON object (keys in docs/formats.md, "pmfit explain --json") or as
 // text.
 #include "explain_internal.hpp"
+#include "hostutil.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -137,6 +138,20 @@ void print_located(const Explanation &ex, double alpha, bool gears_ha, bool gear
                     pg.peak_power, alpha, pg.threshold);
 }
 
+// A cross-validated RMS for the text: NaN where a fold of the
+// cross-validation did not fit (cv_rms; null in the JSON).
+std::string cv_text(double x)
+{
+    return std::isfinite(x) ? fmt("%.3f\"", x)
+                            : std::string("not available (a fold of the cross-validation did "
+                                          "not fit)");
+}
+
+std::string cv_cell(double x)
+{
+    return std::isfinite(x) ? fmt("%10.3f", x) : fmt("%10s", "n/a");
+}
+
 void print_findings(const Explanation &ex, double alpha)
 {
     std::printf("\nfindings:\n");
@@ -151,9 +166,9 @@ void print_findings(const Explanation &ex, double alpha)
             std::printf("     found together with %s: neither alone passed, the pair does\n",
                         f.with.c_str());
         std::printf("     where: %s\n     false-alarm probability %.2g (10^%.1f); with it sigma "
-                    "%.3f\", CV RMS %.3f\", P = %d\n",
+                    "%.3f\", CV RMS %s, P = %d\n",
                     f.where.c_str(), f.false_alarm_probability, f.log10_p, f.sigma_after_arcsec,
-                    f.cv_rms_after_arcsec, f.n_params_after);
+                    cv_text(f.cv_rms_after_arcsec).c_str(), f.n_params_after);
         for (const Alternative &a : f.alternatives) {
             if (a.smooth)
                 std::printf("     or a smooth shape: %s (false-alarm 10^%.1f) holds all that the "
@@ -183,9 +198,9 @@ void print_findings(const Explanation &ex, double alpha)
 void print_explain_text(const Run &run, const Explanation &ex, int order, bool added,
                         double alpha, bool gears_ha, bool gears_dec)
 {
-    std::printf("baseline: order %d%s, P = %d, unbiased sigma %.3f\", cross-validated RMS %.3f\"\n",
+    std::printf("baseline: order %d%s, P = %d, unbiased sigma %.3f\", cross-validated RMS %s\n",
                 order, added ? " + added terms" : "", ex.base_n_params, ex.base_sigma_arcsec,
-                ex.base_cv_rms_arcsec);
+                cv_text(ex.base_cv_rms_arcsec).c_str());
     if (!ex.interpretation.empty()) {
         std::printf("\nwhat the baseline holds (its physical reading):\n");
         for (const Interpretation &it : ex.interpretation)
@@ -196,11 +211,11 @@ void print_explain_text(const Run &run, const Explanation &ex, int order, bool a
     print_located(ex, alpha, gears_ha, gears_dec, run.mount == PM_MOUNT_ALTAZ);
     print_findings(ex, alpha);
     std::printf("\n  %-22s %5s %10s %10s\n", "step", "P", "sigma(\")", "CV RMS(\")");
-    std::printf("  %-22s %5d %10.3f %10.3f\n", "baseline", ex.base_n_params, ex.base_sigma_arcsec,
-                ex.base_cv_rms_arcsec);
+    std::printf("  %-22s %5d %10.3f %s\n", "baseline", ex.base_n_params, ex.base_sigma_arcsec,
+                cv_cell(ex.base_cv_rms_arcsec).c_str());
     for (const Finding &f : ex.findings)
-        std::printf("  %-22s %5d %10.3f %10.3f\n", ("+ " + f.effect).c_str(), f.n_params_after,
-                    f.sigma_after_arcsec, f.cv_rms_after_arcsec);
+        std::printf("  %-22s %5d %10.3f %s\n", ("+ " + f.effect).c_str(), f.n_params_after,
+                    f.sigma_after_arcsec, cv_cell(f.cv_rms_after_arcsec).c_str());
     std::printf("\n  pmfit fit %s --order %d", run.path.c_str(), ex.final_order);
     for (const std::string &a : ex.final_adds)
         std::printf(a.find('\'') == std::string::npos ? " --add '%s'" : " --add \"%s\"", a.c_str());
