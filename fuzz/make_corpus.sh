@@ -9,7 +9,7 @@ set -e
 B=${1:-build}
 C=fuzz/corpus
 rm -rf $C
-mkdir -p $C/runfile $C/modelfile $C/capi $C/fit
+mkdir -p $C/runfile $C/modelfile $C/capi $C/fit $C/explain
 
 # ---- run files: one option byte (fuzz/harness_runfile.c), then the file.
 opt() { # opt BYTE SRC NAME
@@ -43,6 +43,21 @@ opt 16 tests/data/bad_first_line.dat err_null
 printf '\101# tau delta T D\n1 2 3 4\n5 6 \001 8\n' > $C/runfile/long_line_skip   # 0x41: 70000-digit field
 printf '\201# tau delta T D\n1 2 x 4\n' > $C/runfile/repeat_skip_messages          # 0x81: 1001 copies
 printf '\000\357\273\277# tau delta T D\r\n1 2 3 4\r\n5 6 7 8\r\n' > $C/runfile/bom_crlf
+
+# ---- explain: one option byte (fuzz/harness_explain.c: bit 0 order 1, bit 1
+# pairs off, bits 2-3 folds, bits 4-5 alpha, bit 6 gears), then a run file.
+xopt() { # xopt BYTE SRC NAME
+    { printf "\\$(printf '%03o' "$1")"; cat "$2"; } > $C/explain/$3
+}
+xopt 1 tests/data/flip_gem_pm180.dat flip_gem_order1
+xopt 0 tests/data/indep_temp_sag_fork.dat fork_order0
+xopt 1 tests/data/indep_ho_altaz.dat altaz_order1
+xopt 5 tests/data/tpoint_equat.dat tpoint_folds2
+xopt 65 tests/data/named_altaz_el_modular.dat altaz_gears
+xopt 49 tests/data/four_column.dat four_column_alpha
+xopt 1 tests/data/rts2_altaz.dat rts2_altaz
+head -n 90 examples/sim_gem.dat > $B/sim_gem_head90.dat
+xopt 3 $B/sim_gem_head90.dat sim_gem_pairs_off
 
 # ---- model files: written by pmfit, and by hand.
 $B/pmfit fit examples/sim_gem.dat --order 0 --save $C/modelfile/order0.pm > /dev/null
