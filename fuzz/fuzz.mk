@@ -14,7 +14,7 @@ FUZZ_CC      ?= clang-14
 FUZZ_CXX     ?= clang++-14
 FUZZ_SECONDS ?= 60
 FUZZ_FLAGS   ?= -rss_limit_mb=2048 -timeout=10
-FUZZ_TARGETS := runfile modelfile capi fit explain
+FUZZ_TARGETS := runfile modelfile capi fit explain plan
 FUZZ_DIR     := $(B)/fuzz
 # Instrumentation for every object; the libFuzzer main at the link.
 FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer

@@ -15,5 +15,6 @@ int pmfz_modelfile(const unsigned char *data, size_t size);
 int pmfz_capi(const unsigned char *data, size_t size);
 int pmfz_fit(const unsigned char *data, size_t size);
 int pmfz_explain(const unsigned char *data, size_t size);
+int pmfz_plan(const unsigned char *data, size_t size);
 
 #endif

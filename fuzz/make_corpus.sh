@@ -9,7 +9,7 @@ set -e
 B=${1:-build}
 C=fuzz/corpus
 rm -rf $C
-mkdir -p $C/runfile $C/modelfile $C/capi $C/fit $C/explain
+mkdir -p $C/runfile $C/modelfile $C/capi $C/fit $C/explain $C/plan
 
 # ---- run files: one option byte (fuzz/harness_runfile.c), then the file.
 opt() { # opt BYTE SRC NAME
@@ -58,6 +58,22 @@ xopt 49 tests/data/four_column.dat four_column_alpha
 xopt 1 tests/data/rts2_altaz.dat rts2_altaz
 head -n 90 examples/sim_gem.dat > $B/sim_gem_head90.dat
 xopt 3 $B/sim_gem_head90.dat sim_gem_pairs_off
+
+# ---- plan: two option bytes (fuzz/harness_plan.c: byte 0 mount, order,
+# criterion, sides, slew, added terms; byte 1 layout, k, latitude), then the
+# run, horizon or catalogue (layout 3: the three separated by lines "%%").
+popt() { # popt BYTE0 BYTE1 NAME FILE...  (several files: joined by "%%" lines)
+    b0=$1; b1=$2; name=$3; shift 3
+    { printf "\\$(printf '%03o' "$b0")\\$(printf '%03o' "$b1")"; first=1
+      for f in "$@"; do [ $first = 1 ] || printf '%%%%\n'; first=0; [ "$f" = - ] || cat "$f"; done
+    } > $C/plan/$name
+}
+popt 4 4 run_order1_k2 $B/sim_gem_head90.dat
+popt 0 1 horizon_only examples/horizon.hrz
+popt 8 10 catalogue_only_doptimal examples/bright_stars.txt
+popt 6 71 altaz_run_horizon_catalogue tests/data/indep_ho_altaz.dat examples/horizon.hrz examples/bright_stars.txt
+popt 85 39 fork_meridian_slew_south tests/data/indep_temp_sag_fork.dat - examples/bright_stars.txt
+popt 132 7 adds_flip_gem tests/data/flip_gem_pm180.dat examples/horizon.hrz
 
 # ---- model files: written by pmfit, and by hand.
 $B/pmfit fit examples/sim_gem.dat --order 0 --save $C/modelfile/order0.pm > /dev/null

@@ -1050,8 +1050,14 @@ std::string plan_run(const std::shared_ptr<RunData> &d, const std::string &mount
         po.mount = run.mount;
         po.latitude = run.latitude;
     }
-    if (mount != "")
-        po.mount = mount == "altaz" ? PM_MOUNT_ALTAZ : PM_MOUNT_EQUATORIAL;
+    if (mount != "") {
+        const int want = mount == "altaz" ? PM_MOUNT_ALTAZ : PM_MOUNT_EQUATORIAL;
+        if (d && want != run.mount) /* (its observations are of its mount) */
+            fail(K_ARGUMENT, "mount: '" + mount + "', but the run is of an " +
+                                 (run.mount == PM_MOUNT_ALTAZ ? "alt-az" : "equatorial") +
+                                 " mount; its mount is the plan's: leave mount= out");
+        po.mount = want;
+    }
     if (!std::isnan(lat_deg))
         po.latitude = in_range("latitude", lat_deg, -90, 90, "degrees") * PI / 180;
     if (po.mount == PM_MOUNT_EQUATORIAL && std::isnan(po.latitude))

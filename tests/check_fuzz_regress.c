@@ -20,6 +20,7 @@
 #include "../fuzz/harness_capi.c"
 #include "../fuzz/harness_fit.c"
 #include "../fuzz/harness_explain.c"
+#include "../fuzz/harness_plan.c"
 
 /* Largest input read (the corpora hold a few KB per file). */
 #define FZ_MAX_INPUT (1 << 20)
@@ -127,6 +128,12 @@ START_TEST(test_fuzz_explain_inputs_keep_invariants)
 }
 END_TEST
 
+START_TEST(test_fuzz_plan_inputs_keep_invariants)
+{
+    check_target("plan", pmfz_plan, 6);
+}
+END_TEST
+
 /* A run-file seed (option byte, then the file) read with the default
 ** options: its format, or -1 if it does not read. */
 static int seed_format(const char *name)
@@ -189,6 +196,7 @@ int main(void)
     tcase_add_test(tc, test_fuzz_capi_inputs_keep_invariants);
     tcase_add_test(tc, test_fuzz_fit_inputs_keep_invariants);
     tcase_add_test(tc, test_fuzz_explain_inputs_keep_invariants);
+    tcase_add_test(tc, test_fuzz_plan_inputs_keep_invariants);
     tcase_set_timeout(tc, 300);
     suite_add_tcase(s, tc);
     tc = tcase_create("seeds");

@@ -771,6 +771,22 @@ START_TEST(test_plan_bad_inputs)
     ck_assert_int_eq(plan_cli("--sides east"), 2);
     ck_assert_ptr_nonnull(strstr(out, "--sides: expected run, meridian or both"));
     ck_assert_int_eq(plan_cli("--utc 2024-13-01T00:00 --lon 10 --catalog x"), 1);
+    /* --mount against the run's own mount: its observations would be read
+    ** as the other mount's axes (it planned an alt-az sky from a German run
+    ** before); the same mount is accepted */
+    {
+        const char *top = getenv("PM_TOP");
+        snprintf(args, sizeof args, "'%s/examples/sim_gem.dat' --mount altaz --next 1",
+                 top && *top ? top : ".");
+        ck_assert_int_eq(plan_cli(args), 2);
+        ck_assert_msg(strstr(out, "plan: --mount altaz, but ") != NULL &&
+                          strstr(out, "is a run of an equatorial mount; its mount is the "
+                                      "plan's: drop --mount") != NULL,
+                      "%s", out);
+        snprintf(args, sizeof args, "'%s/examples/sim_gem.dat' --mount equatorial --next 1",
+                 top && *top ? top : ".");
+        ck_assert_int_eq(plan_cli(args), 0);
+    }
     /* the C access reports file errors too */
     {
         pmplan_options o;

@@ -946,6 +946,13 @@ int cmd_plan(const Options &o)
         run = load_run(o.run, o.refraction, o.skip_bad, o.format, o.equinox);
         po.mount = run.mount;
         po.latitude = run.latitude;
+        /* the run's observations are of its mount: planning another one's
+        ** sky from them would mix the axes */
+        if (o.mount_given && (o.altaz ? PM_MOUNT_ALTAZ : PM_MOUNT_EQUATORIAL) != run.mount)
+            die("plan: --mount " + std::string(o.altaz ? "altaz" : "equatorial") + ", but " +
+                o.run + " is a run of an " +
+                (run.mount == PM_MOUNT_ALTAZ ? "alt-az" : "equatorial") +
+                " mount; its mount is the plan's: drop --mount");
     }
     if (o.mount_given || o.run.empty())
         po.mount = o.altaz ? PM_MOUNT_ALTAZ : PM_MOUNT_EQUATORIAL;

@@ -67,6 +67,9 @@ def test_plan_errors(tmp_path):
             pm.plan(SIM, **kw)
     with pytest.raises(pm.ArgumentError, match="latitude"):
         pm.plan(next=2)                                  # equatorial, no run, no latitude
+    with pytest.raises(pm.ArgumentError, match="mount: 'altaz', but the run is of an equatorial"):
+        pm.plan(SIM, mount="altaz")                      # the run's own mount decides
+    assert pm.plan(SIM, mount="equatorial", next=1) == pm.plan(SIM, next=1)
     with pytest.raises(pm.FileError, match="nowhere.hrz"):
         pm.plan(SIM, horizon=tmp_path / "nowhere.hrz")
     bad = tmp_path / "bad.hrz"

@@ -28,7 +28,7 @@ typedef struct pmplan_target {
 
 typedef struct pmplan_options {
     int order;            /* the model's harmonic order */
-    int altaz;            /* 1: alt-az mount */
+    int altaz;            /* 1: alt-az mount (with a run: the run's mount, whatever this says) */
     int gem;              /* equatorial: 1 German (flips west of the meridian), 0 fork */
     double latitude_deg;
     double min_el_deg;    /* the horizon */
