@@ -23,10 +23,10 @@
 **  Invariants: pmplan_next returns -1 with a message (non-empty,
 **  terminated) or 0..k targets, each with finite angles, an elevation in
 **  [-90, 90] and at or above the horizon given (min_el_deg), the side +1 or
-**  -1 (0 for alt-az), a predicted error >= 0 or NaN, a terminated name and a
-**  slew time >= 0 or NaN; the error before them >= 0 or NaN.  Then
-**  pmplan_predicted on them returns 0 with a mean >= 0 (or NaN) or -1 with
-**  a message.
+**  -1 (0 for alt-az; with a run, the run's mount decides: plan.h), a
+**  predicted error >= 0 or NaN, a terminated name and a slew time >= 0 or
+**  NaN; the error before them >= 0 or NaN.  Then pmplan_predicted on them
+**  returns 0 with a mean >= 0 (or NaN) or -1 with a message.
 */
 #ifndef _GNU_SOURCE
 #define _GNU_SOURCE
@@ -84,7 +84,8 @@ static int pl_split(const unsigned char *p, size_t n, size_t start[PL_PARTS],
     return k + 1;
 }
 
-static int pl_targets_ok(const pmplan_options *o, const pmplan_target *t, int n, double before)
+static int pl_targets_ok(const pmplan_options *o, int have_run, const pmplan_target *t, int n,
+                         double before)
 {
     int i;
     if (!pl_nonneg_or_nan(before))
@@ -96,7 +97,9 @@ static int pl_targets_ok(const pmplan_options *o, const pmplan_target *t, int n,
             return pl_fail("a target's angles not finite, or its elevation beyond +-90");
         if (x->el_deg < o->min_el_deg - 1e-9)
             return pl_fail("a target below the horizon given");
-        if (o->altaz ? x->side != 0 : (x->side != 1 && x->side != -1))
+        /* (with a run, the run's mount: plan.h) */
+        if (have_run ? (x->side < -1 || x->side > 1)
+                     : o->altaz ? x->side != 0 : (x->side != 1 && x->side != -1))
             return pl_fail("a target's side not +1/-1 (0 for alt-az)");
         if (!pl_nonneg_or_nan(x->after_arcsec) || !pl_nonneg_or_nan(x->slew_s))
             return pl_fail("a predicted error or slew time neither >= 0 nor NaN");
@@ -169,7 +172,7 @@ int pmfz_plan(const unsigned char *data, size_t size)
     } else if (n < 0 || n > k) {
         bad = pl_fail("pmplan_next returned neither -1 nor 0..k");
     } else {
-        bad = pl_targets_ok(&o, t, n, before);
+        bad = pl_targets_ok(&o, fds[0] >= 0, t, n, before);
         if (!bad && n > 0) {
             err[0] = '\0';
             i = pmplan_predicted(&o, t, n, &mean, err, sizeof err);
