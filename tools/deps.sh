@@ -24,6 +24,7 @@ exit 0
 #pkg python3-numpy            reference scripts (tests/ref)
 #pkg python3-scipy            reference scripts
 #pkg python3-erfa             reference scripts
+#pkg python3-astropy          the independent generator tests/ref/tpoint_gen.py (its own reduction)
 #pkg gnuplot-nox              plots in docs
 #pkg gcc-arm-none-eabi        make firmware, make bench (Cortex-M)
 #pkg libnewlib-arm-none-eabi  make firmware, make bench
