@@ -54,7 +54,7 @@ using namespace pmhost;
 // Gauss-Newton passes pmfit fit allows: nearly degenerate term sets (one
 // pier side at L=2) creep along a flat valley for a thousand passes; each
 // pass is cheap, and a warning names the pair (print_table).
-const int MAX_PASSES = 2000;
+const int MAX_PASSES = FIT_MAX_PASSES;
 
 struct Options {
     std::string cmd, run, model; // model: eval's MODEL

@@ -184,6 +184,15 @@ double sampled_extent(const Run &run, const std::vector<int> &idx, int comp)
     return 2 * PI - gap;
 }
 
+// The fewest cycles per revolution searched on axis comp: one and a half
+// cycles over the sampled extent (below), and opt.g_min.
+double lowest_period(const Run &run, const std::vector<int> &idx, int comp,
+                     const ExplainOptions &opt)
+{
+    double extent = sampled_extent(run, idx, comp);
+    return std::max(opt.g_min, extent > 0 ? 3 * PI / extent : opt.g_max);
+}
+
 // The periodogram of one axis.  A period is identifiable as periodic only
 // if the run samples one and a half of its cycles (a maximum, a minimum and
 // the way back): below that a sinusoid is one smooth bump over the sampled
@@ -197,8 +206,7 @@ Periodogram periodogram(const Run &run, const FitOut &f, int comp, const Explain
     std::vector<double> r0, r1;
     frame_residuals(run, f, &r0, &r1);
     const std::vector<double> &r = comp == 0 ? r0 : r1;
-    double extent = sampled_extent(run, f.idx, comp);
-    double g_lo = std::max(opt.g_min, extent > 0 ? 3 * PI / extent : opt.g_max);
+    double g_lo = lowest_period(run, f.idx, comp, opt);
     for (double G = std::ceil(g_lo); G <= opt.g_max; G += 1)
         pg.g.push_back(G);
     scan_powers(run, f.idx, r, comp, pg.g.empty() ? 0 : pg.g[0], 1.0, pg.g.size(), pg.power);
@@ -374,6 +382,60 @@ void add_candidate(std::vector<Candidate> &cands, const State &st, const std::st
     cands.push_back(c);
 }
 
+} // namespace
+
+namespace xdetail {
+
+// (explain_internal.hpp)
+void period_range(const Run &run, const State &st, const ExplainOptions &opt,
+                  const std::vector<std::string> &adds, int comp, double G, double *lo,
+                  double *hi, double *sampled_deg)
+{
+    const double g_lo = lowest_period(run, st.use, comp, opt), g_hi = opt.g_max;
+    *lo = *hi = G;
+    *sampled_deg = sampled_extent(run, st.use, comp) * 180 / PI;
+    const std::string prefix = comp ? "dec_periodic:" : "ha_periodic:";
+    char own[64];
+    std::snprintf(own, sizeof own, "%s%.6g", prefix.c_str(), G);
+    auto at = std::find(adds.begin(), adds.end(), std::string(own));
+    if (at == adds.end())
+        return;
+    // chi^2 of the full fit with the period g in place of G
+    auto chi2_at = [&](double g) {
+        std::vector<std::string> a = adds;
+        char spec[64];
+        std::snprintf(spec, sizeof spec, "%s%.6g", prefix.c_str(), g);
+        a[(size_t)(at - adds.begin())] = spec;
+        Fit f = fit_spec(run, st.use, st.order, a);
+        return f.ok ? f.chi2 : HUGE_VAL;
+    };
+    Fit own_fit = fit_spec(run, st.use, st.order, adds);
+    if (!own_fit.ok)
+        return;
+    const double c0 = own_fit.chi2, s2 = c0 / (double)std::max(1L, 2 * own_fit.N - own_fit.P);
+    if (G == std::round(G)) { // whole numbers of cycles, up to 5 either way
+        for (int k = 1; k <= 5 && G - k >= g_lo && (chi2_at(G - k) - c0) / s2 <= PERIOD_RANGE_CHI2;
+             k++)
+            *lo = G - k;
+        for (int k = 1; k <= 5 && G + k <= g_hi && (chi2_at(G + k) - c0) / s2 <= PERIOD_RANGE_CHI2;
+             k++)
+            *hi = G + k;
+        return;
+    }
+    // a non-integer period: the parabola through G - 0.1, G, G + 0.1
+    const double d = 0.1, cm = chi2_at(G - d), cp = chi2_at(G + d);
+    const double curv = (cm + cp - 2 * c0) / (2 * d * d * s2); // per cycle^2, in sigma^2
+    if (curv > 0 && std::isfinite(curv)) {
+        const double half = std::sqrt(PERIOD_RANGE_CHI2 / curv);
+        *lo = std::max(g_lo, G - half);
+        *hi = std::min(g_hi, G + half);
+    }
+}
+
+} // namespace xdetail
+
+namespace {
+
 bool opt_is_scan(const ExplainOptions &opt, int comp)
 {
     return (comp ? opt.gears_dec : opt.gears_ha).empty();
@@ -381,25 +443,57 @@ bool opt_is_scan(const ExplainOptions &opt, int comp)
 
 // The periodogram decides integer vs non-integer G on the baseline's
 // residuals; a term correlated with the model's own terms can tip it.  The
-// full fits decide: the integer (a worm has whole teeth) unless its chi^2
-// exceeds the non-integer's by more than INTEGER_REJECT_CHI2 sigma^2.
-void prefer_integer(const Run &run, const State &st, const char *prefix, double &G)
+// full fits decide: an integer G moves to a whole-number neighbour that
+// fits better; a non-integer G becomes the better of the two integers
+// beside it (a worm has whole teeth) unless its chi^2 exceeds the
+// non-integer's by more than INTEGER_REJECT_CHI2 sigma^2.
+void prefer_integer(const Run &run, const State &st, const char *prefix, double g_lo,
+                    double g_hi, double &G)
 {
-    double gi = std::round(G);
-    if (G == gi || std::fabs(G - gi) >= 0.5 || gi < 1)
+    auto fit_at = [&](double g) {
+        char a[64];
+        std::snprintf(a, sizeof a, "%s%.6g", prefix, g);
+        std::vector<std::string> ai = st.adds;
+        ai.push_back(a);
+        return fit_spec(run, st.use, st.order, ai);
+    };
+    if (G == std::round(G)) {
+        // the whole numbers beside it too: on an axis sampled over part of
+        // its circle the baseline's periodogram can tip to a neighbour
+        // (310 for 309) that the full fit does not prefer
+        Fit here = fit_at(G);
+        for (int moves = 0; here.ok && moves < 3; moves++) {
+            Fit below = G - 1 >= g_lo ? fit_at(G - 1) : Fit();
+            Fit above = G + 1 <= g_hi ? fit_at(G + 1) : Fit();
+            double next = G;
+            Fit best = here;
+            if (below.ok && below.chi2 < best.chi2) {
+                best = below;
+                next = G - 1;
+            }
+            if (above.ok && above.chi2 < best.chi2) {
+                best = above;
+                next = G + 1;
+            }
+            if (next == G)
+                break;
+            G = next;
+            here = best;
+        }
         return;
-    char a[64], b[64];
-    std::snprintf(a, sizeof a, "%s%.6g", prefix, gi);
-    std::snprintf(b, sizeof b, "%s%.6g", prefix, G);
-    std::vector<std::string> ai = st.adds, bi = st.adds;
-    ai.push_back(a);
-    bi.push_back(b);
-    Fit fi = fit_spec(run, st.use, st.order, ai), fg = fit_spec(run, st.use, st.order, bi);
-    if (!fi.ok || !fg.ok)
+    }
+    double g0 = std::floor(G), g1 = g0 + 1;
+    // both whole numbers beside G (those searched): the nearer need not be
+    // the better
+    Fit f0 = g0 >= g_lo ? fit_at(g0) : Fit(), f1 = g1 <= g_hi ? fit_at(g1) : Fit();
+    Fit fg = fit_at(G);
+    if (!fg.ok || (!f0.ok && !f1.ok))
         return;
+    bool take1 = f1.ok && (!f0.ok || f1.chi2 < f0.chi2);
+    const Fit &fi = take1 ? f1 : f0;
     double s2 = fg.chi2 / (double)std::max(1L, 2 * fg.N - fg.P);
     if ((fi.chi2 - fg.chi2) / s2 <= INTEGER_REJECT_CHI2)
-        G = gi;
+        G = take1 ? g1 : g0;
 }
 
 void periodic_candidates(const Run &run, const State &st, const ExplainOptions &opt,
@@ -415,7 +509,8 @@ void periodic_candidates(const Run &run, const State &st, const ExplainOptions &
         if (already || !(pg.peak_g > 0))
             continue;
         if (opt_is_scan(opt, comp))
-            prefer_integer(run, st, prefix, pg.peak_g);
+            prefer_integer(run, st, prefix, lowest_period(run, st.use, comp, opt), opt.g_max,
+                           pg.peak_g);
         char spec[64];
         std::snprintf(spec, sizeof spec, "%s%.6g", prefix, pg.peak_g);
         add_candidate(cands, st, comp ? "dec_periodic" : "ha_periodic", {spec});
@@ -880,7 +975,7 @@ void record(const Run &run, State &st, const Candidate &c, const std::vector<Can
     for (double &x : d)
         x = arcsec(x);
     std::vector<Alternative> alts = alternatives(run, st, c, cands, opt);
-    for (Finding &fd : describe(run, st, c)) {
+    for (Finding &fd : describe(run, st, c, opt)) {
         fd.adds = c.new_adds;
         fd.trials = c.trials;
         fd.step = (int)(ex.findings.size() + ex.withdrawn.size()) + 1;
@@ -1174,6 +1269,8 @@ void finding_to_c(const pmhost::Finding &f, pmx_finding &g)
     using namespace pmhost;
     std::snprintf(g.effect, sizeof g.effect, "%s", f.effect.c_str());
     g.cycles_per_rev = f.cycles_per_rev;
+    g.cycles_lo = f.cycles_lo;
+    g.cycles_hi = f.cycles_hi;
     g.amplitude_arcsec = f.amplitude_arcsec;
     g.amplitude_err_arcsec = f.amplitude_err_arcsec;
     g.phase_deg = f.phase_deg;

@@ -39,6 +39,8 @@ typedef struct pmx_reading {
 typedef struct pmx_finding {
     char effect[24];                 /* ha_periodic, refraction, ... */
     double cycles_per_rev;           /* periodic effects, else 0 */
+    double cycles_lo, cycles_hi;     /* periodic: the periods that fit as well (95%),
+                                        cycles_per_rev itself where the run fixes it */
     double amplitude_arcsec, amplitude_err_arcsec, phase_deg;
     double false_alarm_probability;
     double sigma_after_arcsec, cv_rms_after_arcsec;

@@ -79,6 +79,8 @@ struct Finding {
     std::string where;        // where on the sky (or when) it matters
     std::vector<std::string> adds; // the terms added (pmfit --add syntax)
     double cycles_per_rev = 0, amplitude_arcsec = 0, amplitude_err_arcsec = 0, phase_deg = 0;
+    double cycles_lo = 0, cycles_hi = 0; // periodic: the periods that fit as well (lo..hi)
+    double sampled_deg = 0;               // periodic: the extent of the axis the run samples
     double f_stat = 0, log10_p = 0, false_alarm_probability = 1;
     double sigma_after_arcsec = 0, cv_rms_after_arcsec = 0;
     int n_params_after = 0;

@@ -202,6 +202,15 @@ void describe_periodic(const Run &run, const Candidate &c, const std::vector<int
                   head, G, 360 / G, fd.amplitude_arcsec, fd.amplitude_err_arcsec,
                   fd.phase_deg, axis_word(run, axis, true));
     fd.text = buf;
+    if (fd.cycles_lo < G || fd.cycles_hi > G) {
+        // the tooth count is not fixed by this run: say which counts fit
+        std::snprintf(buf, sizeof buf,
+                      "; %.6g to %.6g cycles fit as well (chi^2 within %.2f, 95%%): the run "
+                      "samples %.0f deg of the axis, too little to fix the count (give a known "
+                      "tooth count with --gear)",
+                      fd.cycles_lo, fd.cycles_hi, PERIOD_RANGE_CHI2, fd.sampled_deg);
+        fd.text += buf;
+    }
 }
 
 void describe_outlier(const Run &run, const State &st, const Candidate &c, Finding &fd)
@@ -313,7 +322,8 @@ void describe_family(const Run &run, const Candidate &c, const std::vector<int> 
 
 } // namespace
 
-std::vector<Finding> describe(const Run &run, const State &st, const Candidate &c)
+std::vector<Finding> describe(const Run &run, const State &st, const Candidate &c,
+                              const ExplainOptions &opt)
 {
     std::vector<Finding> out;
     int first = st.cur.f.model.n_terms;
@@ -328,9 +338,12 @@ std::vector<Finding> describe(const Run &run, const State &st, const Candidate &
         fd.effect = e;
         if (c.members.size() == 2)
             fd.with = c.members[1 - k];
-        if (e == "ha_periodic" || e == "dec_periodic")
-            describe_periodic(run, c, newi, e, k < c.member_g.size() ? c.member_g[k] : c.peak_g,
-                              fd);
+        if (e == "ha_periodic" || e == "dec_periodic") {
+            double G = k < c.member_g.size() ? c.member_g[k] : c.peak_g;
+            period_range(run, st, opt, c.adds, e == "ha_periodic" ? 0 : 1, G, &fd.cycles_lo,
+                         &fd.cycles_hi, &fd.sampled_deg);
+            describe_periodic(run, c, newi, e, G, fd);
+        }
         else if (e == "outlier")
             describe_outlier(run, st, c, fd);
         else if (e == "higher_order")

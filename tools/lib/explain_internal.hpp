@@ -75,8 +75,23 @@ std::string largest_bin(const Run &run, const std::vector<int> &use,
 // Words for an axis of this mount: "hour-angle"/"azimuth", ...
 const char *axis_word(const Run &run, int axis, bool raw);
 
+// The periods of axis comp (0, 1) that fit as well as G: the full fit of
+// adds (which holds G's term) with the period g in G's place within
+// PERIOD_RANGE_CHI2 noise variances of G's, from *lo to *hi (G itself where
+// the data fix it).  Whole numbers of cycles beside an integer G (up to 5
+// either way); beside another G, the half-width of the chi^2 parabola.  An
+// axis sampled over part of its circle (*sampled_deg) resolves G only to
+// about a turn's worth of phase over that extent: 80 deg of an axis cannot
+// always tell 309 teeth from 310.  Within the periods searched (from
+// lowest_period to opt.g_max).
+const double PERIOD_RANGE_CHI2 = 3.84; // chi^2(1) at 5%
+void period_range(const Run &run, const State &st, const ExplainOptions &opt,
+                  const std::vector<std::string> &adds, int comp, double G, double *lo,
+                  double *hi, double *sampled_deg);
+
 // The finding(s) one accepted candidate makes: one per member family.
-std::vector<Finding> describe(const Run &run, const State &st, const Candidate &c);
+std::vector<Finding> describe(const Run &run, const State &st, const Candidate &c,
+                              const ExplainOptions &opt);
 
 } // namespace xdetail
 } // namespace pmhost

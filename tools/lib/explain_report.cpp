@@ -39,7 +39,9 @@ std::string finding_json(const Finding &f)
 {
     std::string j = "{\"effect\": " + str(f.effect);
     if (f.effect == "ha_periodic" || f.effect == "dec_periodic")
-        j += ", \"cycles_per_rev\": " + num(f.cycles_per_rev) + ", \"phase_deg\": " + num(f.phase_deg);
+        j += ", \"cycles_per_rev\": " + num(f.cycles_per_rev) + ", \"cycles_per_rev_range\": [" +
+             num(f.cycles_lo) + ", " + num(f.cycles_hi) + "], \"axis_sampled_deg\": " +
+             num(f.sampled_deg) + ", \"phase_deg\": " + num(f.phase_deg);
     j += ", \"amplitude_arcsec\": " + num(f.amplitude_arcsec) +
          ", \"amplitude_error_arcsec\": " + num(f.amplitude_err_arcsec) +
          ", \"false_alarm_probability\": " + num(f.false_alarm_probability) +

@@ -53,17 +53,68 @@ Run run_from_pmrun(const pmrun *run, const std::string &path)
     return r;
 }
 
+// The sign of the move from angle a to angle b (radians) of an axis whose
+// path never crosses `cut` (cut_ok), else the short way round.
+static int move_sign(double a, double b, double cut, bool cut_ok)
+{
+    /* (remainder(x - cut - pi) jumps at x = cut only) */
+    double d = cut_ok ? std::remainder(b - cut - PI, 2 * PI) - std::remainder(a - cut - PI, 2 * PI)
+                      : std::remainder(b - a, 2 * PI);
+    return d > 0 ? 1 : (d < 0 ? -1 : 0);
+}
+
+// Where an axis's path never goes: the middle of the widest empty arc of
+// its angles over the run, when that arc is wider than a quarter turn.  A
+// mount does not turn its axis through a zone it never points into (a
+// German mount's counterweight-up half, a fork's HA beyond +-180 deg under
+// the pole, the ends of a cable wrap), so a move between the arc's two
+// sides goes the long way round, not across it.  A narrower empty arc is a
+// gap of the sampling.
+static bool axis_cut(const std::vector<double> &ang, double *cut)
+{
+    std::vector<double> a;
+    for (double x : ang)
+        if (std::isfinite(x))
+            a.push_back(std::remainder(x, 2 * PI));
+    if (a.size() < 2)
+        return false;
+    std::sort(a.begin(), a.end());
+    double best = a.front() + 2 * PI - a.back(), at = a.back() + 0.5 * best;
+    for (size_t i = 1; i < a.size(); i++)
+        if (a[i] - a[i - 1] > best) {
+            best = a[i] - a[i - 1];
+            at = a[i - 1] + 0.5 * best;
+        }
+    *cut = std::remainder(at, 2 * PI);
+    return best > 0.5 * PI;
+}
+
 void derive_directions(Run &r)
 {
+    std::vector<double> e1, e2;
+    for (const Obs &ob : r.obs) {
+        e1.push_back(ob.eh);
+        e2.push_back(ob.ed);
+    }
+    // Without such an arc: an equatorial mount's axis 1 does not pass under
+    // the pole (encoder HA +-180 deg: a fork's limit; a German mount always
+    // leaves its counterweight-up arc empty), an alt-az azimuth is taken the
+    // short way round (a cable wrap's ends are not in the file).
+    double cut1 = PI, cut2 = PI;
+    bool ok1 = axis_cut(e1, &cut1);
+    if (!ok1) {
+        cut1 = PI;
+        ok1 = r.mount == PM_MOUNT_EQUATORIAL;
+    }
+    if (!axis_cut(e2, &cut2)) /* axis 2: the encoder angle's own ends */
+        cut2 = PI;
     bool have_dir = false;
     for (const Obs &ob : r.obs)
         have_dir = have_dir || ob.ctx.dir != 0;
     if (!have_dir) {
         r.dir_derived = true;
-        for (size_t i = 1; i < r.obs.size(); i++) {
-            double dh = std::remainder(r.obs[i].eh - r.obs[i - 1].eh, 2 * PI);
-            r.obs[i].ctx.dir = dh > 0 ? 1 : (dh < 0 ? -1 : 0);
-        }
+        for (size_t i = 1; i < r.obs.size(); i++)
+            r.obs[i].ctx.dir = move_sign(r.obs[i - 1].eh, r.obs[i].eh, cut1, ok1);
     }
     // The slew direction on axis 2, likewise from the sequence, as the input
     // "dec_dir" (backlash of the declination/elevation drive), when the run
@@ -75,10 +126,8 @@ void derive_directions(Run &r)
         int j = (int)r.aux_names.size();
         r.aux_names.push_back("dec_dir");
         r.obs[0].ctx.aux[j] = 0;
-        for (size_t i = 1; i < r.obs.size(); i++) {
-            double dd = r.obs[i].ed - r.obs[i - 1].ed;
-            r.obs[i].ctx.aux[j] = dd > 0 ? 1 : (dd < 0 ? -1 : 0);
-        }
+        for (size_t i = 1; i < r.obs.size(); i++)
+            r.obs[i].ctx.aux[j] = move_sign(r.obs[i - 1].ed, r.obs[i].ed, cut2, true);
     }
 }
 

@@ -73,11 +73,17 @@ pm_model build_model(int order, const std::vector<std::string> &adds,
 // The model without its side-specific added terms.
 pm_model without_side_terms(const pm_model &m);
 
+// The Gauss-Newton passes a fit may take: pmfit fit's, and every host
+// tool's by default (explain's candidate fits too, so that explain fits
+// whatever fit fits: a sky that nearly confounds terms -- an alt-az run in a
+// narrow band of elevation -- can take hundreds of damped passes).
+const int FIT_MAX_PASSES = 2000;
+
 // Fit `start` to the observations `use` (Gauss-Newton, at most max_passes);
 // on success the residuals are filled in.  corr, corr_i, corr_j: the most
 // correlated pair of terms (also after PM_ERR_DIVERGED).
 FitOut do_fit(const std::vector<Obs> &obs, const std::vector<int> &use, const pm_model &start,
-              int max_passes = 100);
+              int max_passes = FIT_MAX_PASSES);
 // The same in a caller-owned workspace, which holds the last solve afterwards
 // (for pm_fit_pointing_sigma and pm_fit_covariance); do_fit above uses one
 // static workspace, so it is not reentrant.

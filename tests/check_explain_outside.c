@@ -1,0 +1,122 @@
+/*
+**  check_explain_outside.c - explain on runs of the independent generator
+**  tests/ref/tpoint_gen.py (astropy places, an exact TPOINT-convention
+**  gimbal, files written as mount software writes them), the cases its
+**  campaign (tests/ref/tpoint_campaign.py) found wrong, each made with the
+**  command in its file's first lines:
+**
+**  - A fork mount that never turns its HA axis under the pole: a slew from
+**    one side of HA 180 deg to the other goes the long way round, and the
+**    backlash it leaves must be read with that direction (before, the
+**    short way was assumed and 7 points after such slews were named a
+**    gross error).
+**  - An alt-az run in a narrow band of elevation, where the azimuth index,
+**    non-perpendicularity and collimation nearly confound: the baseline
+**    fit takes 176 damped passes; explain must fit what pmfit fit fits
+**    (before: "the baseline fit failed: the fit did not converge").
+**  - Gear periods on axes sampled over part of their circle: the reported
+**    range of periods that fit as well holds the true tooth count, and a
+**    whole circle fixes it.
+*/
+#define _POSIX_C_SOURCE 200809L
+#include <check.h>
+#include "tu_check.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "explain.h"
+
+static void explain_file(const char *name, pmx_result *r)
+{
+    const char *top = getenv("PM_TOP");
+    char path[512], err[512];
+    pmx_options o;
+    snprintf(path, sizeof path, "%s/tests/data/%s", top ? top : ".", name);
+    pmx_options_default(&o);
+    ck_assert_msg(pmx_explain_opts(path, &o, r, err, sizeof err) == 0, "%s: %s", name, err);
+}
+
+static int find(const pmx_result *r, const char *effect)
+{
+    int k;
+    for (k = 0; k < r->n_findings; k++)
+        if (!strcmp(r->findings[k].effect, effect))
+            return k;
+    return -1;
+}
+
+/* backlash 3.08" on the HA axis (psi 0), a drift, a 135-cycle HA error */
+START_TEST(test_long_way_round)
+{
+    pmx_result r;
+    int k, h;
+    explain_file("outside_fork_pole_backlash.dat", &r);
+    for (k = 0; k < r.n_findings; k++)
+        printf("check_explain_outside: fork under the pole: finding %d %s %.2f\"\n", k + 1,
+               r.findings[k].effect, r.findings[k].amplitude_arcsec);
+    ck_assert_int_eq(find(&r, "outlier"), -1);
+    h = find(&r, "hysteresis");
+    ck_assert_int_ge(h, 0);
+    ck_assert(fabs(r.findings[h].amplitude_arcsec - 3.07735) <= 0.25 * 3.07735);
+    ck_assert_int_ge(find(&r, "ha_periodic"), 0);
+    ck_assert_int_ge(find(&r, "time_drift"), 0);
+}
+END_TEST
+
+/* a temperature term on the elevation index, 5.18"/deg C */
+START_TEST(test_narrow_band_fits)
+{
+    pmx_result r;
+    explain_file("outside_altaz_band_temp.dat", &r);
+    ck_assert_int_ge(r.n_findings, 1);
+    ck_assert_str_eq(r.findings[0].effect, "temperature");
+    printf("check_explain_outside: alt-az band: baseline %.3f\", %s\n", r.base_sigma_arcsec,
+           r.findings[0].effect);
+}
+END_TEST
+
+START_TEST(test_period_range)
+{
+    static const struct {
+        const char *file, *effect;
+        double G;
+        int partial; /* the axis is sampled over part of its circle */
+    } C[] = {{"outside_altaz_el309.dat", "dec_periodic", 309, 1},
+             {"outside_gem_dec260.dat", "dec_periodic", 260, 1},
+             {"outside_fork_dec88.dat", "dec_periodic", 88, 1},
+             {"outside_gem_ha144_full.dat", "ha_periodic", 144, 0}};
+    pmx_result r;
+    const pmx_finding *f;
+    explain_file(C[_i].file, &r);
+    ck_assert_int_ge(r.n_findings, 1);
+    f = &r.findings[0];
+    printf("check_explain_outside: %s: %s G %g (range %g..%g), true %g\n", C[_i].file,
+           f->effect, f->cycles_per_rev, f->cycles_lo, f->cycles_hi, C[_i].G);
+    ck_assert_str_eq(f->effect, C[_i].effect);
+    ck_assert(f->cycles_lo <= f->cycles_per_rev && f->cycles_per_rev <= f->cycles_hi);
+    ck_assert_msg(f->cycles_lo <= C[_i].G && C[_i].G <= f->cycles_hi,
+                  "true G %g outside the range %g..%g", C[_i].G, f->cycles_lo, f->cycles_hi);
+    ck_assert(f->cycles_hi - f->cycles_lo <= 2);
+    if (!C[_i].partial) /* a whole circle fixes the count */
+        ck_assert(f->cycles_lo == C[_i].G && f->cycles_hi == C[_i].G);
+}
+END_TEST
+
+static Suite *suite(void)
+{
+    Suite *s = suite_create("explain_outside");
+    TCase *t = tcase_create("outside");
+    tcase_set_timeout(t, 300);
+    tcase_add_test(t, test_long_way_round);
+    tcase_add_test(t, test_narrow_band_fits);
+    tcase_add_loop_test(t, test_period_range, 0, 4);
+    suite_add_tcase(s, t);
+    return s;
+}
+
+int main(void)
+{
+    return tu_run_suite(suite());
+}
