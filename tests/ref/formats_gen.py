@@ -110,23 +110,33 @@ def dms(deg, places=3):
     return "%s%02d:%02d:%0*.*f" % (sign, d, m, places + 3, places, s)
 
 
-def astrom(lst, eo, lat, refa, refb):
+def astrom(lst, eo, lat, refa, refb, diurab):
     a = np.zeros((), dtype=erfa.dt_eraASTROM)
     a["eral"] = lst + eo
     a["sphi"], a["cphi"] = math.sin(lat), math.cos(lat)
     a["refa"], a["refb"] = refa, refb
+    a["diurab"] = diurab
     return a
 
 
-def j2000_of(ha, dec, hours, lat, refa, refb):
-    """The ICRS (J2000) place whose observed (refa, refb: refracted; 0, 0:
-    apparent) HA/Dec at DATE + hours is (ha, dec), radians: eraAtoiq on a
-    hand-built context (local ERA = LST + eo, no polar motion, no diurnal
-    aberration), then eraAtic13."""
+def diurab_at(lat):
+    """The diurnal aberration (radians) at latitude lat, HEIGHT_M: the
+    observer's speed over c, from erfa.pvtob (no polar motion)."""
+    pv = erfa.pvtob(0.0, lat, HEIGHT_M, 0.0, 0.0, 0.0, 0.0)
+    return math.hypot(pv[1][0], pv[1][1]) / erfa.CMPS
+
+
+def j2000_of(ha, dec, hours, lat, refa, refb, observed=True):
+    """The ICRS (J2000) place whose place at DATE + hours is (ha, dec),
+    radians: observed (the diurnal aberration, and refraction with refa,
+    refb) or, observed False, the apparent place of date (what a mount's
+    driver converts: neither).  eraAtoiq on a hand-built context (local
+    ERA = LST + eo, no polar motion), then eraAtic13."""
     _, _, t1, t2 = utc_tt(hours)
     lst = lst_rad(hours)
     eo = float(erfa.eo06a(t1, t2))
-    ri, di = erfa.atoiq("H", ha, dec, astrom(lst, eo, lat, refa, refb))
+    ctx = astrom(lst, eo, lat, refa, refb, diurab_at(lat) if observed else 0.0)
+    ri, di = erfa.atoiq("H", ha, dec, ctx)
     rc, dc, _ = erfa.atic13(ri, di, t1, t2)
     return float(rc), float(dc)
 
@@ -165,7 +175,8 @@ def rts2_j2000(lat, rows):
     out = ["#  Observation\t  MJD\t   LST-MNT RA-MNT   DEC-MNT   AXRA\t  AXDEC   RA-TRUE  DEC-TRUE\n",
            "# RTS2 gpoint input with J2000 true places (astrometry of the images): read\n",
            "# with --equinox J2000.  Written by tests/ref/formats_gen.py from\n",
-           "# tests/data/formats_source_eq.dat (eraAtoiq + eraAtic13, standard atmosphere).\n",
+           "# tests/data/formats_source_eq.dat (eraAtoiq + eraAtic13: diurnal aberration,\n",
+           "# refraction in the standard atmosphere).\n",
            "#observatory %.1f %.1f %.0f\n" % (LON_DEG, lat, HEIGHT_M)]
     mjd0 = erfa.cal2jd(*DATE)[1]
     for k, r in enumerate(rows):
@@ -225,7 +236,8 @@ def csv_j2000(lat, rows):
     out = ["# N.I.N.A./ASCOM-style CSV pointing log (docs/formats.md, section 6): the\n",
            "# mount's RA/Dec as the driver reports them, the plate-solved RA/Dec, ASCOM's\n",
            "# SideOfPier, the UTC time.  Written by tests/ref/formats_gen.py from\n",
-           "# tests/data/formats_source_eq.dat: J2000 places by eraAtoiq + eraAtic13.\n",
+           "# tests/data/formats_source_eq.dat: J2000 places by eraAtoiq + eraAtic13\n",
+           "# (the solved place observed: diurnal aberration and refraction).\n",
            "# equinox: J2000\n", "# latitude: %.1f\n" % lat, "# longitude: %.1f\n" % LON_DEG,
            "# height: %.0f\n" % HEIGHT_M, "# pressure: %.1f\n" % WEATHER[0],
            "# temperature: %.1f\n" % WEATHER[1], "# humidity: %.2f\n" % WEATHER[2],
@@ -236,7 +248,7 @@ def csv_j2000(lat, rows):
         # the mount's place: the driver's J2000 conversion of its apparent
         # place (no refraction); the solved place: the J2000 place observed
         # (refracted) at the star's (T, D)
-        rm, dm = j2000_of(ha_m * D2R, dec_m * D2R, r["time"], lat * D2R, 0.0, 0.0)
+        rm, dm = j2000_of(ha_m * D2R, dec_m * D2R, r["time"], lat * D2R, 0.0, 0.0, False)
         rs, ds = j2000_of(r["T"] * D2R, r["D"] * D2R, r["time"], lat * D2R, refa, refb)
         out.append('%s,"Star %d, field",%s,%s,%s,%s,%s,%.2f\n' % (
             iso(r["time"]), k + 1, hms(rm / D2R / 15.0), dms(dm / D2R), hms(rs / D2R / 15.0),

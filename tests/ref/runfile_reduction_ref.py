@@ -9,10 +9,12 @@ The reduction (docs/formats.md, "The reduction"):
   UTC (run date at 0h + hours) -> TAI -> TT          erfa.dtf2d/utctai/taitt
   J2000 catalogue place -> CIRS, eo                  erfa.atci13 (TT for TDB)
   apparent RA = CIRS RA - eo; HA = LST - RA          erfa.anp/anpm
+  diurnal aberration toward the east point           diurab from erfa.pvtob
   refraction dZ = A tan Z + B tan^3 Z                erfa.refco, hd2ae/ae2hd
-The refracted place is computed twice: with the formula above, and with
+The refracted place is computed twice: with the formulae above, and with
 erfa.atioq on a hand-built ASTROM context (local ERA = LST + eo, no polar
-motion, no diurnal aberration), which applies ERFA's own refraction code.
+motion, diurab from erfa.pvtob), which applies ERFA's own diurnal
+aberration and refraction code.
 eraAtioq turns the vector by the refraction dz with cos dz ~ 1 - dz^2/2,
 sin dz ~ dz, so the two may differ by up to dz^3/6 (2e-10 rad at 15 deg
 elevation, 2e-8 rad at the 3 deg horizon guard); they must agree to that
@@ -83,7 +85,8 @@ def read(path):
     if rh > 1:
         rh /= 100.0
     wl = run[10] if len(run) > 10 else 0.55
-    return lat, (y, m, d), (p, tc, rh, wl), recs
+    height = run[8] if len(run) > 8 else 0.0
+    return lat, height, (y, m, d), (p, tc, rh, wl), recs
 
 
 def utc_hours(recs):
@@ -110,18 +113,31 @@ def refract(ha, dec, lat, refa, refb):
     return ha, dec, dz, guarded
 
 
-def atioq_path(ri, di, eo, lst, lat, refa, refb):
+def diurnal(ha, dec, diurab):
+    """Diurnal aberration toward the east point, to first order in diurab
+    (the form eraAtioq uses), on (HA, Dec) radians."""
+    v = erfa.s2c(-ha, dec)                       # y toward the east point
+    f = 1.0 - diurab * v[1]
+    w = np.array([f * v[0], f * (v[1] + diurab), f * v[2]])
+    lon, lat = erfa.c2s(w)
+    return -float(lon), float(lat)
+
+
+def atioq_path(ri, di, eo, lst, lat, refa, refb, diurab):
     a = np.zeros((), dtype=erfa.dt_eraASTROM)
     a["eral"] = lst + eo
     a["sphi"], a["cphi"] = math.sin(lat), math.cos(lat)
+    a["diurab"] = diurab
     a["refa"], a["refb"] = refa, refb
     _, _, hob, dob, _ = erfa.atioq(ri, di, a)
     return float(erfa.anpm(hob)), float(dob)
 
 
 def rows_for(rel):
-    lat, (y, m, d), (p, tc, rh, wl), recs = read(os.path.join(TOP, rel))
+    lat, height, (y, m, d), (p, tc, rh, wl), recs = read(os.path.join(TOP, rel))
     refa, refb = erfa.refco(p, tc, rh, wl)
+    pv = erfa.pvtob(0.0, lat, height, 0.0, 0.0, 0.0, 0.0)
+    diurab = math.hypot(pv[1][0], pv[1][1]) / erfa.CMPS
     u1, u2 = erfa.dtf2d("UTC", y, m, d, 0, 0, 0.0)
     rows, worst, nguard = [], 0.0, 0
     for r, h in zip(recs, utc_hours(recs)):
@@ -129,12 +145,13 @@ def rows_for(rel):
         tt1, tt2 = erfa.taitt(tai1, tai2)
         ri, di, eo = erfa.atci13(r["ra"], r["dec"], 0.0, 0.0, 0.0, 0.0, tt1, tt2)
         ha0 = float(erfa.anpm(r["lst"] - erfa.anp(ri - eo)))
-        dec0 = float(di)
+        ha0, dec0 = diurnal(ha0, float(di), diurab)
+        ha0 = float(erfa.anpm(ha0))
         ha1, dec1, dz, guarded = refract(ha0, dec0, lat, refa, refb)
         ha1 = float(erfa.anpm(ha1))
         dec1 = float(dec1)
-        ha2, dec2 = atioq_path(ri, di, eo, r["lst"], lat, refa, refb)
-        ha3, dec3 = atioq_path(ri, di, eo, r["lst"], lat, 0.0, 0.0)
+        ha2, dec2 = atioq_path(ri, di, eo, r["lst"], lat, refa, refb, diurab)
+        ha3, dec3 = atioq_path(ri, di, eo, r["lst"], lat, 0.0, 0.0, diurab)
         diff = float(erfa.seps(ha1, dec1, ha2, dec2))     # on the sky (rad)
         diff0 = float(erfa.seps(ha0, dec0, ha3, dec3))
         bound = abs(dz) ** 3 / 6.0 * 1.05 + 1e-12

@@ -490,7 +490,7 @@ private:
         }
         Reduction red;
         std::string why;
-        if (!red.setup(t0.year, t0.month, t0.day, std::isnan(lat_deg_) ? 0.0 : lat_deg_ * kDeg,
+        if (!red.setup(t0.year, t0.month, t0.day, lat_deg_ * kDeg, site.height_m,
                        refr ? &w : nullptr, why))
             return ctx_.fail(first_t ? first_t->line : header_line_, "%s", why.c_str());
         if (red.dubious && need_time)
@@ -522,6 +522,7 @@ private:
                 mdec = r.mdec * kDeg;
                 sha = eraAnpm(lst - r.sra * kHour);
                 sdec = r.sdec * kDeg;
+                red.topocentric(sha, sdec);
                 red.refract_place(sha, sdec);
             }
             o.pier = has_[static_cast<int>(Col::kPier)] ? r.pier : PMRUN_PIER_EAST;

@@ -138,12 +138,20 @@ struct Weather {
 // The ERFA reduction of one catalogue place (J2000 mean place, radians)
 // to observed hour angle / declination at the given UTC instant (date at
 // 0h + utc_h hours) and local sidereal time.  `weather` NULL: no
-// refraction.  Returns false with `why` if ERFA rejects the date.
+// refraction.  latitude_rad NaN: unknown (no refraction then, and no
+// diurnal aberration); height_m NaN: 0.  Returns false with `why` if ERFA
+// rejects the date.
 struct Reduction {
-    bool setup(int year, int month, int day, double latitude_rad,
+    bool setup(int year, int month, int day, double latitude_rad, double height_m,
                const Weather *weather, std::string &why);
+    // The observed place: apparent, diurnal aberration (topocentric), then
+    // refraction if used.
     bool observed(double ra, double dec, double lst, double utc_h, double &ha,
                   double &dec_obs, std::string &why) const;
+    // Diurnal aberration of an apparent (geocentric) HA/Dec, in place:
+    // toward the east point by diurab (0.32" cos(latitude) at sea level),
+    // as eraAtioq applies it; nothing where the latitude is unknown.
+    void topocentric(double &ha, double &dec) const;
     // The same without refraction (the apparent place of date), whatever
     // `refract` says.
     bool apparent(double ra, double dec, double lst, double utc_h, double &ha,
@@ -157,6 +165,7 @@ struct Reduction {
     bool refract = false;
     bool dubious = false;             // outside ERFA's leap-second table
     double refa = 0, refb = 0;
+    double diurab = 0;                // diurnal aberration (radians)
 };
 
 // Standard-atmosphere pressure (hPa) at height h (m).

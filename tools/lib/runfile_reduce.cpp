@@ -4,14 +4,15 @@
 #include "runfile_internal.hpp"
 
 #include <erfa.h>
+#include <erfam.h>
 
 #include <algorithm>
 #include <cmath>
 
 namespace pmrun_detail {
 
-bool Reduction::setup(int year, int month, int day, double latitude_rad, const Weather *weather,
-                      std::string &why)
+bool Reduction::setup(int year, int month, int day, double latitude_rad, double height_m,
+                      const Weather *weather, std::string &why)
 {
     if (eraDtf2d("UTC", year, month, day, 0, 0, 0.0, &utc1, &utc2) < 0) {
         why = format("date %d %d %d rejected by ERFA, expected a valid UTC date y m d", year, month,
@@ -20,7 +21,16 @@ bool Reduction::setup(int year, int month, int day, double latitude_rad, const W
     }
     double dat;
     dubious = eraDat(year, month, day, 0.5, &dat) == 1;
-    latitude = latitude_rad;
+    // The observer's speed from the Earth's rotation over c (eraApco's
+    // diurab, without polar motion): eraPvtob on the WGS84 ellipsoid.
+    diurab = 0;
+    if (std::isfinite(latitude_rad)) {
+        double pv[2][3];
+        eraPvtob(0.0, latitude_rad, std::isfinite(height_m) ? height_m : 0.0, 0.0, 0.0, 0.0, 0.0,
+                 pv);
+        diurab = std::hypot(pv[1][0], pv[1][1]) / ERFA_CMPS;
+    }
+    latitude = std::isfinite(latitude_rad) ? latitude_rad : 0.0;
     refract = weather != nullptr;
     refa = refb = 0;
     if (weather)
@@ -67,6 +77,21 @@ bool Reduction::apparent(double ra, double dec, double lst, double utc_h, double
     return true;
 }
 
+void Reduction::topocentric(double &ha, double &dec) const
+{
+    if (diurab == 0) return;
+    // (x toward the meridian's equator, y toward the east point, z the pole:
+    // eraAtioq's first-order form)
+    double cd = std::cos(dec);
+    double x = cd * std::cos(ha), y = -cd * std::sin(ha), z = std::sin(dec);
+    double f = 1.0 - diurab * y;
+    x *= f;
+    y = f * (y + diurab);
+    z *= f;
+    ha = std::atan2(-y, x);
+    dec = std::atan2(z, std::hypot(x, y));
+}
+
 void Reduction::refract_place(double &ha, double &dec) const
 {
     if (!refract) return;
@@ -79,6 +104,7 @@ bool Reduction::observed(double ra, double dec, double lst, double utc_h, double
 {
     double h, d;
     if (!apparent(ra, dec, lst, utc_h, h, d, why)) return false;
+    topocentric(h, d);
     if (refract) refract_hd(latitude, refa, refb, h, d);
     ha = eraAnpm(h);
     dec_obs = d;

@@ -123,7 +123,8 @@ public:
             if (refr && !refraction_weather(ctx_, recs_[0].line, "the gpoint file", w))
                 return false;
             std::string why;
-            if (!red.setup(iy, im, id, run->site.latitude_rad, refr ? &w : nullptr, why))
+            if (!red.setup(iy, im, id, run->site.latitude_rad, run->site.height_m,
+                           refr ? &w : nullptr, why))
                 return ctx_.fail(recs_[0].line, "%s", why.c_str());
         }
         for (const Record &r : recs_) {

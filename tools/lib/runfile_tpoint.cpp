@@ -522,8 +522,8 @@ private:
         bool refr = ctx_.opt().refraction != 0;
         Reduction red;
         std::string why;
-        if (!red.setup(site.year, site.month, site.day, site.latitude_rad, refr ? &weather_ : nullptr,
-                       why))
+        if (!red.setup(site.year, site.month, site.day, site.latitude_rad, site.height_m,
+                       refr ? &weather_ : nullptr, why))
             return ctx_.fail(run_line_, "%s", why.c_str());
         if (red.dubious)
             ctx_.warn(run_line_, "date %d %d %d is outside ERFA's leap-second table: TAI-UTC is a "
