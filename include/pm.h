@@ -53,11 +53,13 @@ extern "C" {
 #define PM_MAX_EXTRA 16
 #endif
 
-/* The model's definition (what a set of coefficients means): 2 since the
-** anisotropic tilt terms are evaluated at the index-shifted position
-** (docs/model.md, "The tilt terms"); model files say "pm-model 2" and the
-** headers of pmfit --emit-c refuse to compile against another. */
-#define PM_MODEL_DEFINITION 2
+/* The model's definition (what a set of coefficients means): 3 since every
+** anisotropic term (its harmonics and its base vector) is evaluated at the
+** index-shifted, mechanical position (docs/model.md, "The anisotropic
+** terms: at the mechanical position"; 2: only the tilts were); model files
+** say "pm-model 3" and the headers of pmfit --emit-c refuse to compile
+** against another. */
+#define PM_MODEL_DEFINITION 3
 
 /* Free parameters of the harmonic model of order L: 4L^2+12L+6
 ** (6, 22, 46, 78, 118 for L = 0..4; Pal et al. Sec. 3.1 and 5.1). */
@@ -689,7 +691,9 @@ pm_status pm_model_residual(const pm_model *m, const pm_context *ctx,
 **
 **  Given:
 **     order    int         L, 0..PM_MAX_L
-**     ha, dec  double      encoder position (radians)
+**     ha, dec  double      the position (radians) the terms are evaluated
+**                          at: in a model, the index-shifted (mechanical)
+**                          position (ha + c', dec - e')
 **  Returned:
 **     out      double*     6*(L+1)^2 x 3 values: for harmonic index
 **                          j = l*l + l + m and base vector k = 1..6, the

@@ -119,16 +119,19 @@ V3<double> mt_and_derivs(const Chain &c, const V3<double> &x, V3<double> dq[6])
     return q;
 }
 
-/* The tilt fields A1 p1 + A2 p2, evaluated at the shifted position
-** (t' = t + c', d' = d - e'), move with c' and e': their part of the index
-** columns (exact Jacobian).  p1 = (-sd' ct', st'), p2 = (-sd' st', -ct'). */
-void tilt_index_rows(const Chain &c, double A1, double A2, double *row0, double *row1)
+/* The anisotropic displacement is a function of the shifted position
+** (t' = t + c', d' = d - e': its harmonics and base vectors, docs/model.md),
+** so it moves with c' and e': its part of the index columns (exact
+** Jacobian; rows are +dD/dtheta): d/dc' = d/dt', d/de' = -d/dd'. */
+void shift_index_rows(const Chain &c, const pm_context *ctx, const Trig<double> &g,
+                      double *row0, double *row1)
 {
-    if (A1 == 0 && A2 == 0)
-        return;
-    row0[2] += c.sdp * (A1 * c.stp - A2 * c.ctp); /* d/dc' */
-    row1[2] += A1 * c.ctp + A2 * c.stp;
-    row0[4] += c.cdp * (A1 * c.ctp + A2 * c.stp); /* d/de' */
+    double dt, dd, J[4];
+    aniso_jac_at(c.m, c.k, g, ctx, true, &dt, &dd, J);
+    row0[2] += J[0];
+    row1[2] += J[2];
+    row0[4] -= J[1];
+    row1[4] -= J[3];
 }
 
 /* Two design rows (model derivatives) and the residual of one observation
@@ -148,7 +151,8 @@ void rows(const pm_model *m, const pm_context *ctx, double enc_ha,
     double D[2][3], ly, lz;
     dlog(q, D, &ly, &lz);
     double dt, dd;
-    aniso<double>(m, c.k, g, ctx, &dt, &dd);
+    const double sg[4] = {c.stp, c.ctp, c.sdp, c.cdp};
+    aniso<double>(m, c.k, g, ctx, &dt, &dd, sg);
     r[0] = ly - dt;
     r[1] = lz - dd;
 
@@ -158,16 +162,15 @@ void rows(const pm_model *m, const pm_context *ctx, double enc_ha,
         row1[j] = -(D[1][0] * dq[j].x + D[1][1] * dq[j].y + D[1][2] * dq[j].z);
     }
 
-    /* harmonic terms: linear, row = Y_lm N_lm (u_k, v_k), the tilts'
-    ** (k = 1, 2) at the shifted position; A1, A2: the tilt fields' sums
-    ** sum coef Y N (their dependence on c' and e', below) */
+    /* harmonic terms: linear, row = Y_lm N_lm (u_k, v_k), harmonics and
+    ** base vectors at the shifted position */
     Trig<double> gs = g;
     gs.st = c.stp;
     gs.ct = c.ctp;
     gs.sd = c.sdp;
     gs.cd = c.cdp;
-    double Y[PM_N_HARM(PM_MAX_L)], A1 = 0, A2 = 0;
-    harmonics<double>(m->order, g, Y);
+    double Y[PM_N_HARM(PM_MAX_L)];
+    harmonics<double>(m->order, gs, Y);
     for (int i = 6; i < m->n_base; i++) {
         const pm_term *tm = &m->term[i];
         int j = tm->l * tm->l + tm->l + tm->m;
@@ -176,24 +179,16 @@ void rows(const pm_model *m, const pm_context *ctx, double enc_ha,
         base_uv_at<double>(tm->k, g, gs, &u, &v);
         row0[i] = y * u;
         row1[i] = y * v;
-        if (tm->k == 1)
-            A1 += m->coef[i] * y;
-        else if (tm->k == 2)
-            A2 += m->coef[i] * y;
     }
     Site<double> st;
     if (m->n_terms > m->n_base) {
         /* added terms: linear, row = their displacement per unit coefficient */
         st = site_of<double>(m, c.k, g, ctx);
-        for (int i = m->n_base; i < m->n_terms; i++) {
-            const pm_term &t = m->term[i];
-            term_uv<double>(t, g, st, ctx, &row0[i], &row1[i]);
-            double f;
-            if (t.k <= 2 && term_factor<double>(t, g, st, ctx, &f))
-                (t.k == 1 ? A1 : A2) += m->coef[i] * f;
-        }
+        for (int i = m->n_base; i < m->n_terms; i++)
+            term_uv<double>(m->term[i], g, st, ctx, &row0[i], &row1[i]);
     }
-    tilt_index_rows(c, A1, A2, row0, row1);
+    if (m->n_terms > 6)
+        shift_index_rows(c, ctx, g, row0, row1);
     if (m->n_terms == m->n_base)
         return;
     /* The zenith terms' direction, M^T Z, turns with the isotropic terms:

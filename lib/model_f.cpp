@@ -89,10 +89,16 @@ void frame_finish(const pm_model_f *m, float st, float ct, float t, float d, Fra
     f->ge.sd = f->sd;
     f->ge.cd = f->flip ? -f->cd : f->cd;
     f->ge.have_angles = false;
-    f->g.st = f->ge.st * m->cc - f->ge.ct * m->sc;
-    f->g.ct = f->ge.ct * m->cc + f->ge.st * m->sc;
-    f->g.sd = f->ge.sd * m->ce + f->ge.cd * m->se;
-    f->g.cd = f->ge.cd * m->ce - f->ge.sd * m->se;
+    /* the encoder position's trig: only the added terms' periodic and
+    ** sectoral factors read it (the harmonics and base vectors are at ge) */
+    if (m->n_terms > m->n_base) {
+        f->g.st = f->ge.st * m->cc - f->ge.ct * m->sc;
+        f->g.ct = f->ge.ct * m->cc + f->ge.st * m->sc;
+        f->g.sd = f->ge.sd * m->ce + f->ge.cd * m->se;
+        f->g.cd = f->ge.cd * m->ce - f->ge.sd * m->se;
+    } else {
+        f->g.st = f->g.ct = f->g.sd = f->g.cd = 0;
+    }
     f->g.t = t;
     f->g.d = d;
     f->g.have_angles = true;
@@ -121,11 +127,11 @@ void correction_f(const pm_model_f *m, const pm_context *ctx, const FrameF &f, f
     /* the polar-axis rotation in the local frame: omega' = Q^T (a, b, 0) */
     V3<float> om = rot_dt<float>(ge.sd, ge.cd, rot_zt<float>(ge.st, ge.ct, v3<float>(m->a, m->b, 0)));
 
-    /* anisotropic displacement (same templates as the double build) */
+    /* anisotropic displacement (same templates as the double build): the
+    ** harmonics and base vectors at the shifted position ge */
     float S[6];
-    sh_sums<float, float>(m->order, g, m->dense, S);
-    /* the tilts (S_0, S_1) at the shifted position ge (base_uv_at) */
-    float dt = -ge.sd * (S[0] * ge.ct + S[1] * ge.st) - g.sd * S[3] + g.cd * S[2] + S[5];
+    sh_sums<float, float>(m->order, ge, m->dense, S);
+    float dt = -ge.sd * (S[0] * ge.ct + S[1] * ge.st) - ge.sd * S[3] + ge.cd * S[2] + S[5];
     float dd = S[0] * ge.st - S[1] * ge.ct - S[4];
     if (m->n_terms > m->n_base) {
         int side = ctx && ctx->pier ? (ctx->pier > 0 ? 1 : -1) : (f.flip ? -1 : 1);

@@ -513,15 +513,16 @@ inline void base_uv(int k, const Trig<T> &g, T *u, T *v)
     }
 }
 
-/* The base vector k of a term evaluated at encoder trig g: the tilts
-** (k = 1, 2: rotations about the axes x and y, fixed on the sky) at the
-** index-shifted position gs = (t + c', d - e'), where the telescope points
-** in the mount's frame; the others, which move with the axes, at g
-** (docs/model.md, "The tilt terms"). */
+/* The base vector k of a term, evaluated at the index-shifted position
+** gs = (t + c', d - e'): the mechanical axis angles, where the telescope
+** points in the mount's frame (the encoder's zero points are offsets, not
+** a place on the mount; docs/model.md, "The anisotropic terms: at the
+** mechanical position").  g, the encoder position, is not used. */
 template <typename T>
 inline void base_uv_at(int k, const Trig<T> &g, const Trig<T> &gs, T *u, T *v)
 {
-    base_uv<T>(k, k <= 2 ? gs : g, u, v);
+    (void)g;
+    base_uv<T>(k, gs, u, v);
 }
 
 /* Unit vector displaced from (1,0,0) by the tangent offset (a, b) along y
@@ -843,9 +844,9 @@ inline bool term_factor(const pm_term &t, const Trig<T> &g, const Site<T> &s,
         return false;
     T f = 0;
     switch (t.kind) {
-    case PM_TERM_SH: {
+    case PM_TERM_SH: { /* at the mechanical position, as the base terms */
         T Y[PM_N_HARM(PM_MAX_L)] = {};
-        harmonics<T>(t.l, g, Y);
+        harmonics<T>(t.l, s.gs, Y);
         f = Y[t.l * t.l + t.l + t.m] * (T)norm_lm(t.l, t.m);
         break;
     }
@@ -870,8 +871,10 @@ inline bool term_factor(const pm_term &t, const Trig<T> &g, const Site<T> &s,
     return true;
 }
 
-/* Displacement per unit coefficient of an added term t at position g; the
-** tilt base vectors (k = 1, 2) at the shifted position s.gs (base_uv_at). */
+/* Displacement per unit coefficient of an added term t at position g; its
+** base vector and a harmonic factor at the shifted position s.gs
+** (base_uv_at), a periodic or sectoral factor of the encoder angles (a
+** gear turns with its encoder). */
 template <typename T>
 inline void term_uv(const pm_term &t, const Trig<T> &g, const Site<T> &s,
                     const pm_context *ctx, T *u, T *v)
@@ -1097,42 +1100,60 @@ inline void sh_sums_jac(int L, const Trig<T> &g, const double (*dense)[6], T S[6
     }
 }
 
+/* The index-shifted position (t + c', d - e') of encoder trig g0 as a Trig
+** (sines and cosines only): from sh (sin t', cos t', sin d', cos d') when
+** the caller has them, else computed. */
+template <typename T>
+__attribute__((always_inline)) inline Trig<T> shifted_trig(const Iso<T> &k, const Trig<T> &g0,
+                                                           const T *sh)
+{
+    Trig<T> gs;
+    if (sh) {
+        gs.st = sh[0];
+        gs.ct = sh[1];
+        gs.sd = sh[2];
+        gs.cd = sh[3];
+    } else {
+        shifted<T>(k, g0, &gs.st, &gs.ct, &gs.sd, &gs.cd);
+    }
+    gs.t = gs.d = 0;
+    gs.have_angles = false;
+    return gs;
+}
+
 /* Anisotropic displacement (tangent components in the transported frame)
-** at encoder trig g: the base harmonic terms with l >= 1 through the dense
-** table, then the added terms. */
+** at encoder trig g0: the base harmonic terms with l >= 1 through the
+** dense table, then the added terms; harmonics and base vectors at the
+** index-shifted position gs (the mechanical axis angles). */
 template <typename T>
 __attribute__((always_inline)) inline void
-aniso_of_sums(const pm_model *m, const Iso<T> &k, const Trig<T> &g0, const pm_context *ctx,
-              const T *S, T *dt, T *dd, const T *sh);
+aniso_of_sums(const pm_model *m, const Iso<T> &k, const Trig<T> &g0, const Trig<T> &gs,
+              const pm_context *ctx, const T *S, T *dt, T *dd);
 
 template <typename T>
 inline void aniso(const pm_model *m, const Iso<T> &k, const Trig<T> &g0,
                   const pm_context *ctx, T *dt, T *dd, const T *sh = 0)
 {
     PM_EVAL_PROBE();
+    const Trig<T> gs = shifted_trig<T>(k, g0, sh);
     T S[6];
-    sh_sums<T, double>(m->order, g0, m->dense, S);
-    aniso_of_sums<T>(m, k, g0, ctx, S, dt, dd, sh);
+    sh_sums<T, double>(m->order, gs, m->dense, S);
+    aniso_of_sums<T>(m, k, g0, gs, ctx, S, dt, dd);
 }
 
-/* The displacement from the harmonic sums S at g0: the projection on the
-** base vectors, then the added terms (aniso and the inverse's aniso_jac:
-** the same operations). */
+/* The displacement from the harmonic sums S at gs: the projection on the
+** base vectors (at gs), then the added terms (aniso and the inverse's
+** aniso_jac: the same operations). */
 template <typename T>
 __attribute__((always_inline)) inline void
-aniso_of_sums(const pm_model *m, const Iso<T> &k, const Trig<T> &g0, const pm_context *ctx,
-              const T *S, T *dt, T *dd, const T *sh)
+aniso_of_sums(const pm_model *m, const Iso<T> &k, const Trig<T> &g0, const Trig<T> &gs,
+              const pm_context *ctx, const T *S, T *dt, T *dd)
 {
     /* sum_k S_k (u_k, v_k), written out (the products of the position's
-    ** trig formed beside the sums: a short chain after them); the tilts
-    ** (S_0, S_1) at the shifted position (base_uv_at; sh: its trig when
-    ** the caller has it, as forward_vec does) */
-    const T stp = sh ? sh[0] : g0.st * k.cc + g0.ct * k.sc;
-    const T ctp = sh ? sh[1] : g0.ct * k.cc - g0.st * k.sc;
-    const T sdp = sh ? sh[2] : g0.sd * k.ce - g0.cd * k.se;
-    const T sc = sdp * ctp, ss = sdp * stp;
-    *dt = ((g0.cd * S[2] + S[5]) - sc * S[0]) - (ss * S[1] + g0.sd * S[3]);
-    *dd = (S[0] * stp - S[4]) - S[1] * ctp;
+    ** trig formed beside the sums: a short chain after them) */
+    const T sc = gs.sd * gs.ct, ss = gs.sd * gs.st;
+    *dt = ((gs.cd * S[2] + S[5]) - sc * S[0]) - (ss * S[1] + gs.sd * S[3]);
+    *dd = (S[0] * gs.st - S[4]) - S[1] * gs.ct;
     if (m->n_terms > m->n_base) {
         const Trig<T> g = with_angles(g0);
         Site<T> s = site_of<T>(m, k, g, ctx);
@@ -1272,10 +1293,11 @@ __attribute__((always_inline)) inline V3<T> forward_framed(const pm_model *m, co
 }
 
 /* The derivatives (ft, fd) along the axes of an added term's factor f at g
-** (term_factor; f itself in *f): harmonic, periodic, sectoral and AUX
-** terms (AUX: constant). */
-__attribute__((noinline)) inline void factor_jac(const pm_term &t, const Trig<double> &g, const pm_context *ctx, double *f,
-                double *ft, double *fd)
+** (term_factor; f itself in *f): harmonic (at the shifted position gs, as
+** term_factor), periodic, sectoral and AUX terms (AUX: constant). */
+__attribute__((noinline)) inline void factor_jac(const pm_term &t, const Trig<double> &g,
+                                                 const Trig<double> &gs, const pm_context *ctx,
+                                                 double *f, double *ft, double *fd)
 {
     *f = *ft = *fd = 0;
     switch (t.kind) {
@@ -1287,7 +1309,7 @@ __attribute__((noinline)) inline void factor_jac(const pm_term &t, const Trig<do
             *f = nl;
             return;
         }
-        harmonics_jac_n<double, 0>(t.l, g, Y, Yt, Yd);
+        harmonics_jac_n<double, 0>(t.l, gs, Y, Yt, Yd);
         *f = Y[j] * nl;
         *ft = Yt[j] * nl;
         *fd = Yd[j] * nl;
@@ -1345,17 +1367,26 @@ __attribute__((noinline)) inline void zenith_jac(const pm_model *m, const Iso<do
 }
 
 /* The displacement D at g, bit for bit as aniso computes it, and its
-** Jacobian J = dD/d(t, d) (J[0] = d dt/dt, J[1] = d dt/dd, J[2] = d dd/dt,
-** J[3] = d dd/dd), analytic for every term kind (a term of one pier side
-** counts on the side g is on, its jump at the pole's edge aside).  One
-** model evaluation. */
-inline void aniso_jac(const pm_model *m, const Iso<double> &k, const Trig<double> &g0,
-               const pm_context *ctx, double *dt, double *dd, double J[4])
+** Jacobian: with shift_only false, J = dD/d(t, d) along the encoder angles
+** (J[0] = d dt/dt, J[1] = d dt/dd, J[2] = d dd/dt, J[3] = d dd/dd),
+** analytic for every term kind (a term of one pier side counts on the side
+** g is on, its jump at the pole's edge aside); with shift_only true, the
+** derivatives along the shifted position (t', d') alone, as the index terms
+** c' and e' move it: what depends on the encoder angles themselves (the
+** periodic and sectoral factors, the zenith terms, whose direction turns
+** with the isotropic rotation and is the isotropic columns' business)
+** held.  The harmonics and base vectors are functions of (t', d') = (t +
+** c', d - e'), so they differentiate alike either way.  One model
+** evaluation. */
+inline void aniso_jac_at(const pm_model *m, const Iso<double> &k, const Trig<double> &g0,
+                         const pm_context *ctx, bool shift_only, double *dt, double *dd,
+                         double J[4])
 {
     PM_EVAL_PROBE();
+    const Trig<double> gs = shifted_trig<double>(k, g0, 0);
     double S[6], St[6], Sd[6];
-    sh_sums_jac<double>(m->order, g0, m->dense, S, St, Sd);
-    aniso_of_sums<double>(m, k, g0, ctx, S, dt, dd, 0);
+    sh_sums_jac<double>(m->order, gs, m->dense, S, St, Sd);
+    aniso_of_sums<double>(m, k, g0, gs, ctx, S, dt, dd);
     double zj[4] = {0, 0, 0, 0}; /* the zenith terms' part of J */
     if (m->n_terms > m->n_base) {
         /* the added terms: factor f times base vector k, so (f, ft, fd)
@@ -1370,6 +1401,8 @@ inline void aniso_jac(const pm_model *m, const Iso<double> &k, const Trig<double
             if (t.side && t.side != s.side)
                 continue;
             if (t.kind == PM_TERM_ZENITH) {
+                if (shift_only)
+                    continue;
                 if (!have_z) {
                     zenith_jac(m, k, g, &z, &zt, &zd);
                     have_z = true;
@@ -1397,24 +1430,32 @@ inline void aniso_jac(const pm_model *m, const Iso<double> &k, const Trig<double
                 continue;
             }
             double f, ft, fd;
-            factor_jac(t, g, ctx, &f, &ft, &fd);
+            factor_jac(t, g, gs, ctx, &f, &ft, &fd);
+            if (shift_only && t.kind != PM_TERM_SH)
+                ft = fd = 0;
             S[t.k - 1] += m->coef[i] * f;
             St[t.k - 1] += m->coef[i] * ft;
             Sd[t.k - 1] += m->coef[i] * fd;
         }
     }
-    double stp, ctp, sdp, cdp;
-    shifted<double>(k, g0, &stp, &ctp, &sdp, &cdp);
-    const Trig<double> &g = g0;
-    /* dt = cd S2 + S5 - sdp ctp S0 - sdp stp S1 - sd S3, dd = stp S0 - S4 -
-    ** ctp S1 (aniso_of_sums); d/dt turns (stp, ctp), d/dd (sd, cd) and
-    ** (sdp, cdp) */
-    J[0] = g.cd * St[2] + St[5] - sdp * (ctp * St[0] - stp * S[0]) -
-           sdp * (stp * St[1] + ctp * S[1]) - g.sd * St[3] + zj[0];
-    J[1] = -g.sd * S[2] + g.cd * Sd[2] + Sd[5] - cdp * (ctp * S[0] + stp * S[1]) -
-           sdp * (ctp * Sd[0] + stp * Sd[1]) - g.cd * S[3] - g.sd * Sd[3] + zj[1];
+    const double stp = gs.st, ctp = gs.ct, sdp = gs.sd, cdp = gs.cd;
+    /* dt = cdp S2 + S5 - sdp ctp S0 - sdp stp S1 - sdp S3, dd = stp S0 -
+    ** S4 - ctp S1 (aniso_of_sums); d/dt turns (stp, ctp), d/dd (sdp,
+    ** cdp) */
+    J[0] = cdp * St[2] + St[5] - sdp * (ctp * St[0] - stp * S[0]) -
+           sdp * (stp * St[1] + ctp * S[1]) - sdp * St[3] + zj[0];
+    J[1] = -sdp * S[2] + cdp * Sd[2] + Sd[5] - cdp * (ctp * S[0] + stp * S[1]) -
+           sdp * (ctp * Sd[0] + stp * Sd[1]) - cdp * S[3] - sdp * Sd[3] + zj[1];
     J[2] = ctp * S[0] + stp * St[0] - St[4] + stp * S[1] - ctp * St[1] + zj[2];
     J[3] = stp * Sd[0] - Sd[4] - ctp * Sd[1] + zj[3];
+}
+
+/* D and J = dD/d(t, d) (aniso_jac_at along the encoder angles): the
+** inverse's Jacobian. */
+inline void aniso_jac(const pm_model *m, const Iso<double> &k, const Trig<double> &g0,
+                      const pm_context *ctx, double *dt, double *dd, double J[4])
+{
+    aniso_jac_at(m, k, g0, ctx, false, dt, dd, J);
 }
 
 /* sin and cos of one angle: sincos_d for doubles, libm for floats. */

@@ -234,13 +234,21 @@ inline unsigned apply_block(const Consts<W, LC> &K, const double *ha, const doub
     shifted<V>(k, g, &stp, &ctp, &sdp, &cdp);
     V S[6];
     {
+        /* the harmonics at the shifted position (shifted_trig) */
+        Trig<V> gs;
+        gs.st = stp;
+        gs.ct = ctp;
+        gs.sd = sdp;
+        gs.cd = cdp;
+        gs.t = gs.d = V(0.0);
+        gs.have_angles = false;
         V Y[PM_N_HARM(LC)];
         if constexpr (LC > 0)
-            harmonics_n<V, LC>(LC, g, Y);
+            harmonics_n<V, LC>(LC, gs, Y);
         harm_sums<W, LC>(K, Y, S);
     }
     const V sc = sdp * ctp, ss = sdp * stp;
-    const V dt = ((g.cd * S[2] + S[5]) - sc * S[0]) - (ss * S[1] + g.sd * S[3]);
+    const V dt = ((cdp * S[2] + S[5]) - sc * S[0]) - (ss * S[1] + sdp * S[3]);
     const V dd = (S[0] * stp - S[4]) - S[1] * ctp;
     const V r2 = dt * dt + dd * dd;
     ok &= Ln::lt(r2.v, Ln::all(1e-4)); /* expmap's series */

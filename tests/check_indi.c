@@ -289,7 +289,12 @@ START_TEST(test_pm_indi_fit_near_singular_order_rejected)
 {
     /* 54 points on six declinations (the rule allows order 2) and a 0.5"
     ** gear error no order holds: order 2 is barely determined there (it fits
-    ** the points and errs between them); leave-one-out keeps order 1 */
+    ** the points and errs between them): order 1 is kept, by leave-one-out
+    ** where the order-2 fit converges, else because it does not (since the
+    ** harmonics are evaluated at the index-shifted position the undetermined
+    ** order-2 terms move the index columns too, and the damped iteration
+    ** creeps along that valley beyond the plugin's 30 passes: the climb
+    ** stops at order 1, reported as a fallback) */
     const double k[6] = {0.4 * D2R, -0.25 * D2R, 0.2 * D2R, -0.12 * D2R, 15 * ARCSEC, 0.5 * ARCSEC};
     pm_model m;
     pm_indi_result r;
@@ -298,7 +303,11 @@ START_TEST(test_pm_indi_fit_near_singular_order_rejected)
     ck_assert_int_eq(r.chosen_order, 2);
     ck_assert_int_eq(r.order, 1);
     printf("near-singular order 2: leave-one-out rms order 1 %.3f\", order 2 %.3g\"\n", r.cv[1] / ARCSEC, r.cv[2] / ARCSEC);
-    ck_assert_msg(r.cv[2] > r.cv[1], "cv %g %g", r.cv[1], r.cv[2]);
+    if (r.cv[2] >= 0)
+        ck_assert_msg(r.cv[2] > r.cv[1], "cv %g %g", r.cv[1], r.cv[2]);
+    else
+        ck_assert_msg(r.fallbacks == 1 && !strcmp(r.bad_term, "status -8"), "fallbacks %d, %s",
+                      r.fallbacks, r.bad_term);
     ck_assert(worst_apply(&m, k) < 1.0 * ARCSEC);
 }
 END_TEST

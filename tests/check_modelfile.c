@@ -101,7 +101,7 @@ START_TEST(test_pmmodel_load_errors_name_line)
     make_tmpdir();
     expect_load_error("", "1", "empty");
     expect_load_error("hello\n", "1", "pm-model");
-    expect_load_error("pm-model 3\n", "1", "version");
+    expect_load_error("pm-model 4\n", "1", "version");
     expect_load_error("pm-model 1\nmount dobsonian\n", "2", "mount");
     expect_load_error("pm-model 1\nmount altaz\norder x\n", "3", "order");
     snprintf(big, sizeof big, "pm-model 1\nmount altaz\norder %d\n", PM_MAX_L + 1);
@@ -129,54 +129,64 @@ END_TEST
 ** index-shifted position, docs/model.md): read where nothing evaluates
 ** differently, refused at the first anisotropic tilt term otherwise; files
 ** are written as version 2. */
+/* An order-1 model file of version `version`: the isotropic terms
+** iso(i), every anisotropic term aniso(i). */
+static void write_old(const char *path, int version, double (*iso)(int), double (*aniso)(int))
+{
+    pm_model m;
+    int i;
+    FILE *f = fopen(path, "w");
+    ck_assert_ptr_nonnull(f);
+    pm_model_init(&m, PM_MOUNT_EQUATORIAL, 1);
+    fprintf(f, "pm-model %d\nmount equatorial\norder 1\nterms %d\n", version, m.n_terms);
+    for (i = 0; i < m.n_terms; i++) {
+        char name[32];
+        pm_term_name(&m, i, name, sizeof name);
+        fprintf(f, "term %s %d %d %d %.17g\n", name, m.term[i].k, m.term[i].l, m.term[i].m,
+                m.term[i].l >= 1 ? aniso(i) : iso(i));
+    }
+    fprintf(f, "end\n");
+    fclose(f);
+}
+
+static double some(int i) { return 1e-5 * (i + 1); }
+static double zero(int i) { (void)i; return 0.0; }
+static double no_index(int i) { return i == 2 || i == 4 ? 0.0 : 1e-5 * (i + 1); }
+
+/* Older versions evaluated anisotropic terms at the encoder reading
+** (version 1: the tilts too; version 2: the harmonics and the other base
+** vectors); version 3 at the index-shifted position.  A file whose moved
+** terms are zero, or whose index terms c' and e' are both zero (the two
+** positions one), reads; any other is refused at the first moved term. */
 START_TEST(test_pmmodel_version_1)
 {
     pm_model m;
     char path[300], err[512], where[320];
     FILE *f;
     char head[32];
-    int i;
+    int v;
     make_tmpdir();
-    path_in(path, sizeof path, "v1.pm");
-    /* order 1 with every tilt term zero but the isotropic a, b */
-    f = fopen(path, "w");
-    ck_assert_ptr_nonnull(f);
-    pm_model_init(&m, PM_MOUNT_EQUATORIAL, 1);
-    fprintf(f, "pm-model 1\nmount equatorial\norder 1\nterms %d\n", m.n_terms);
-    for (i = 0; i < m.n_terms; i++) {
-        char name[32];
-        pm_term_name(&m, i, name, sizeof name);
-        fprintf(f, "term %s %d %d %d %.17g\n", name, m.term[i].k, m.term[i].l, m.term[i].m,
-                m.term[i].k <= 2 && m.term[i].l >= 1 ? 0.0 : 1e-5 * (i + 1));
+    path_in(path, sizeof path, "old.pm");
+    for (v = 1; v <= 2; v++) {
+        write_old(path, v, some, zero);
+        ck_assert_msg(pmmodel_load(path, &m, err, sizeof err) == 0, "%s", err);
+        ck_assert(m.coef[0] == 1e-5 * 1 && m.coef[2] == 1e-5 * 3);
+        write_old(path, v, no_index, some);
+        ck_assert_msg(pmmodel_load(path, &m, err, sizeof err) == 0, "%s", err);
+        ck_assert(m.coef[6] == 1e-5 * 7);
+        write_old(path, v, some, some);
+        ck_assert_int_eq(pmmodel_load(path, &m, err, sizeof err), -1);
+        snprintf(where, sizeof where, "%s:%d:", path, 5 + 6); /* the first l = 1 term */
+        ck_assert_msg(strstr(err, where) && strstr(err, "refit") &&
+                      strstr(err, v == 1 ? "'pm-model 1'" : "'pm-model 2'"), "%s", err);
     }
-    fprintf(f, "end\n");
-    fclose(f);
-    ck_assert_msg(pmmodel_load(path, &m, err, sizeof err) == 0, "%s", err);
-    ck_assert(m.coef[0] == 1e-5 * 1 && m.coef[2] == 1e-5 * 3);
-    /* an anisotropic tilt term with a value: refused at its line */
-    f = fopen(path, "w");
-    ck_assert_ptr_nonnull(f);
-    fprintf(f, "pm-model 1\nmount equatorial\norder 1\nterms %d\n", m.n_terms);
-    for (i = 0; i < m.n_terms; i++) {
-        char name[32];
-        pm_term_name(&m, i, name, sizeof name);
-        fprintf(f, "term %s %d %d %d %.17g\n", name, m.term[i].k, m.term[i].l, m.term[i].m,
-                1e-5 * (i + 1));
-    }
-    fprintf(f, "end\n");
-    fclose(f);
-    ck_assert_int_eq(pmmodel_load(path, &m, err, sizeof err), -1);
-    for (i = 0; i < m.n_terms && !(m.term[i].k <= 2 && m.term[i].l >= 1); i++) {
-    }
-    snprintf(where, sizeof where, "%s:%d:", path, 5 + i);
-    ck_assert_msg(strstr(err, where) && strstr(err, "refit"), "%s", err);
-    /* saved files are version 2 */
+    /* saved files are version 3 */
     ck_assert_int_eq(pmmodel_save(path, &m, NULL, err, sizeof err), 0);
     f = fopen(path, "r");
     ck_assert_ptr_nonnull(f);
     ck_assert_ptr_nonnull(fgets(head, sizeof head, f));
     fclose(f);
-    ck_assert_str_eq(head, "pm-model 2\n");
+    ck_assert_str_eq(head, "pm-model 3\n");
 }
 END_TEST
 

@@ -92,6 +92,7 @@ def rng_for(seed, *tags):
 
 
 ANISO_PARAMS = "all"   # set from --aniso-params
+ANISO_FRAME = "mechanical"  # set from --aniso-frame
 
 
 def draw_config(rng, mount, effects):
@@ -116,6 +117,7 @@ def draw_config(rng, mount, effects):
         "geom": float(rng.uniform(10, 600)),
         "aniso": 0.0 if order0 else float(rng.choice(ANISO_LEVELS)),
         "aniso_order": 1,
+        "aniso_frame": ANISO_FRAME,
     }
     if ANISO_PARAMS != "all":
         cfg["aniso_params"] = list(ANISO_PARAMS)
@@ -327,9 +329,9 @@ def score_multi(effects, d, truth):
 
 def one_task(task):
     """Runs one campaign run; returns a record (never raises)."""
-    kind, effects, mount, r, seed, pmfit, workdir, aniso_params = task
-    global ANISO_PARAMS
-    ANISO_PARAMS = aniso_params
+    kind, effects, mount, r, seed, pmfit, workdir, aniso = task
+    global ANISO_PARAMS, ANISO_FRAME
+    ANISO_PARAMS, ANISO_FRAME = aniso
     rn = Runner(pmfit, workdir)
     tag = "%s_%s_%s_%02d" % (kind, "+".join(effects) or "null", mount, r)
     rec = {"kind": kind, "effects": effects, "mount": mount, "run": r, "tag": tag}
@@ -417,6 +419,9 @@ def main():
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--workdir", default="/tmp/explain_campaign")
+    ap.add_argument("--aniso-frame", choices=("mechanical", "encoder"), default="mechanical",
+                    help="the anisotropy a function of the true axis angles (default: where the "
+                         "mount's parts are) or of the encoder readings (indep_gen.py)")
     ap.add_argument("--aniso-params", default="all",
                     help="which gimbal parameters the anisotropic distortion moves (indep_gen.py "
                          "--aniso-params): all, or a comma list of axis1,axis2,np,coll,tilt_x,tilt_y")
@@ -439,7 +444,8 @@ def main():
         os.path.abspath(pm), snap, sha, time.ctime(os.path.getmtime(pm))))
 
     only = set(a.only.split(",")) if a.only else None
-    aniso_params = "all" if a.aniso_params == "all" else a.aniso_params.split(",")
+    aniso_params = ("all" if a.aniso_params == "all" else a.aniso_params.split(","),
+                    a.aniso_frame)
     tasks = []
     for e in SINGLE:
         if only and e not in only:

@@ -24,10 +24,13 @@ pier side (pier 'W'), beyond the pole: the encoders read (H + 180 + I1,
 
 Anisotropic distortions ("--aniso S"): each of the six gimbal parameters
 (both axis angles, NP, CH, both tilts) varies over the sky as a random
-combination of smooth functions of the ENCODER direction u = (cos e2 cos e1,
-cos e2 sin e1, sin e2): degree 1 (x, y, z) by default, degree 2 (xy, xz, yz,
-x^2 - y^2, 3z^2 - 1) with --aniso-order 2; scaled so that the distortion
-moves the run's points by S arcsec RMS (--aniso-params: only some of the six
+combination of smooth functions of the mechanical direction u = (cos a2 cos
+a1, cos a2 sin a1, sin a2), a = the true axis angles (enc - index: where the
+mount's parts are; --aniso-frame encoder: of the encoder reading e instead,
+as this generator did before pm evaluated its harmonics at the mechanical
+position): degree 1 (x, y, z) by default, degree 2 (xy, xz, yz, x^2 - y^2,
+3z^2 - 1) with --aniso-order 2; scaled so that the distortion moves the
+run's points by S arcsec RMS (--aniso-params: only some of the six
 parameters vary).
 
 Hidden effects ("--effect NAME=SIZE[:G]", SIZE in arcsec; what pmfit explain
@@ -108,6 +111,10 @@ DEFAULTS = {
     "aniso": 0.0,           # RMS arcsec of the smooth distortion
     "aniso_order": 1,
     "aniso_params": "all",  # or a list of: axis1 axis2 np coll tilt_x tilt_y
+    # "mechanical" (the command line's default) or "encoder": gen() takes
+    # "encoder" when not given, so that the "made by" parameters of runs
+    # written before the choice existed make the same run again
+    "aniso_frame": "encoder",
     "effects": [],          # list of 'NAME=SIZE[:G]' or dicts {name, size, G, phase_deg}
     "outliers": None,       # fraction of points (None: 0, or 0.01 with an 'outlier' effect)
     "outlier_size": 40.0,   # middle of the outlier range: U(S/2, 3S/2)
@@ -402,8 +409,12 @@ def gen(params):
         eff[name] = e
         truth_eff.append(x)
 
-    # anisotropic distortion coefficients (unit scale, normalised below)
-    u_enc = unit(enc1, enc2)
+    # anisotropic distortion coefficients (unit scale, normalised below),
+    # functions of the mechanical (true) axis angles, or of the encoders
+    if P["aniso_frame"] == "encoder":
+        u_enc = unit(enc1, enc2)
+    else:
+        u_enc = unit(enc1 - I1 * DEG, enc2 - I2 * DEG)
     ra = stream(seed, "aniso")
     B1 = basis(u_enc, int(P["aniso_order"]))
     Ca = ra.normal(size=(6, B1.shape[1]))
@@ -596,6 +607,9 @@ def main(argv=None):
     ap.add_argument("--aniso-params", default="all",
                     help="which gimbal parameters vary: all, or a comma list of %s" % (
                         ",".join(ANISO_PARAMS)))
+    ap.add_argument("--aniso-frame", choices=("mechanical", "encoder"), default="mechanical",
+                    help="the anisotropy a function of the true axis angles (default) or of the "
+                         "encoder readings")
     ap.add_argument("--effect", action="append", default=[], metavar="NAME=SIZE[:G]")
     ap.add_argument("--outliers", type=float, default=None, metavar="FRAC")
     ap.add_argument("--outlier-size", type=float, default=DEFAULTS["outlier_size"])
@@ -606,7 +620,7 @@ def main(argv=None):
               "noise": a.noise, "coverage": a.coverage, "index_deg": a.index_deg,
               "geom": a.geom, "aniso": a.aniso, "aniso_order": a.aniso_order,
               "aniso_params": a.aniso_params if a.aniso_params == "all" else
-              a.aniso_params.split(","),
+              a.aniso_params.split(","), "aniso_frame": a.aniso_frame,
               "index": [float(x) for x in a.index.split(",")] if a.index else None,
               "effects": a.effect, "outliers": a.outliers, "outlier_size": a.outlier_size,
               "zenith_sign": a.zenith_sign,

@@ -115,7 +115,7 @@ extern "C" int pmmodel_save(const char *path, const pm_model *m, const char *com
     }
     std::string out;
     comment_lines(out, comment, "# ");
-    out += "pm-model 2\n";
+    out += "pm-model 3\n";
     out += std::string("mount ") + (m->mount == PM_MOUNT_ALTAZ ? "altaz" : "equatorial") + "\n";
     out += "order " + std::to_string(m->order) + "\n";
     if (m->latitude != 0)
@@ -144,7 +144,7 @@ namespace {
 struct Loader {
     enum State { HEADER, MOUNT, ORDER, TERMS, BODY, DONE } state = HEADER;
     int lineno = 0, end_line = 0;
-    int mount = 0, version = 2;
+    int mount = 0, version = 3;
     long order = 0, nterms = 0;
     int base = -1; // index of the first added term
     int got = 0;   // terms read
@@ -154,14 +154,32 @@ struct Loader {
     Loader() { std::memset(&m, 0, sizeof m); }
 };
 
-// A version-1 file's anisotropic tilt term: it was evaluated at the
-// encoder reading, this version at the index-shifted position.
-std::string old_tilt(const std::string &name)
+// A term that an older file's version evaluated elsewhere: version 1 the
+// anisotropic tilt terms (k = 1, 2) at the encoder reading, version 2 the
+// harmonics and the other base vectors there; version 3 all at the
+// index-shifted (mechanical) position.  Where the file's index terms c'
+// and e' are both zero the two positions are one.
+std::string old_term(const Loader &L, const std::string &name)
 {
-    return "term " + name + " of a 'pm-model 1' file: versions before 2 evaluated the "
-           "anisotropic tilt terms (k = 1, 2) at the encoder reading, this one at the "
-           "index-shifted position (docs/model.md, \"The tilt terms\"); the model would "
-           "point differently: refit the run and save it again";
+    return "term " + name + " of a 'pm-model " + std::to_string(L.version) +
+           "' file: versions before 3 evaluated " +
+           (L.version == 1 ? "the anisotropic terms" : "the harmonics and the base vectors of "
+                                                       "the axes, the axes' angle and the tube") +
+           " at the encoder reading, this one at the index-shifted (mechanical) position "
+           "(docs/model.md, \"The anisotropic terms: at the mechanical position\"); the model "
+           "would point differently: refit the run and save it again";
+}
+
+// Does this term of an older file evaluate differently now (old_term)?
+bool moved_term(const Loader &L, int kind, long k, long l, double v)
+{
+    if (L.version >= 3 || v == 0 || (L.m.coef[2] == 0 && L.m.coef[4] == 0))
+        return false;
+    if (L.version == 1 && (k == 1 || k == 2) && (kind != PM_TERM_SH || l >= 1))
+        return true; /* (version 1: the tilts at the encoder reading) */
+    if (kind == PM_TERM_SH)
+        return l >= 1;
+    return k == 3 || k == 4; /* base vectors cos d, -sin d */
 }
 
 // The header's lines, one state each: "" when the line is right, else why.
@@ -170,10 +188,10 @@ std::string header_line(Loader &L, const std::vector<std::string> &tok)
     switch (L.state) {
     case Loader::HEADER:
         if (tok.size() != 2 || tok[0] != "pm-model")
-            return "expected 'pm-model 2' (is this a pm model file?)";
-        if (tok[1] != "1" && tok[1] != "2")
-            return "model file version '" + tok[1] + "' not supported (expected 2, or 1)";
-        L.version = tok[1] == "1" ? 1 : 2;
+            return "expected 'pm-model 3' (is this a pm model file?)";
+        if (tok[1] != "1" && tok[1] != "2" && tok[1] != "3")
+            return "model file version '" + tok[1] + "' not supported (expected 3, or 2 or 1)";
+        L.version = tok[1][0] - '0';
         L.state = Loader::MOUNT;
         return "";
     case Loader::MOUNT:
@@ -230,8 +248,8 @@ std::string added_term(Loader &L, const std::vector<std::string> &tok)
         return "bad fields of an added term (expected xterm NAME KIND k l m side aux param value)";
     if (!parse_double(tok[8], &param) || !parse_double(tok[9], &v))
         return "bad parameter or value (expected finite numbers)";
-    if (L.version == 1 && (k == 1 || k == 2) && v != 0)
-        return old_tilt(tok[1]);
+    if (moved_term(L, kind, k, l, v))
+        return old_term(L, tok[1]);
     if (L.base < 0)
         L.base = L.got;
     pm_term &nt = L.m.term[L.got];
@@ -263,8 +281,8 @@ std::string harmonic_term(Loader &L, const std::vector<std::string> &tok)
                "' (expected k in 1..6, l in 0..order, |m| <= l)";
     if (!parse_double(tok[5], &v))
         return "bad value '" + tok[5] + "' (expected a finite number, radians)";
-    if (L.version == 1 && (k == 1 || k == 2) && l >= 1 && v != 0)
-        return old_tilt(tok[1]);
+    if (moved_term(L, PM_TERM_SH, k, l, v))
+        return old_term(L, tok[1]);
     L.m.term[L.got].kind = PM_TERM_SH;
     L.m.term[L.got].k = (unsigned char)k;
     L.m.term[L.got].l = (signed char)l;
@@ -417,9 +435,10 @@ extern "C" int pmmodel_emit_c(const char *path, const pm_model *m, const char *p
     o += "#ifndef " + guard + "\n#define " + guard + "\n\n#include \"pm.h\"\n\n";
     o += "#if PM_MAX_L < " + std::to_string(m->order) + "\n#error \"this model needs PM_MAX_L >= " +
          std::to_string(m->order) + "\"\n#endif\n";
-    o += "#if !defined(PM_MODEL_DEFINITION) || PM_MODEL_DEFINITION != 2\n#error \"this model was "
-         "fitted with the model definition 2 (docs/model.md, The tilt terms); rebuild it with this "
-         "pm.h's pmfit\"\n#endif\n\n";
+    const std::string def = std::to_string(PM_MODEL_DEFINITION);
+    o += "#if !defined(PM_MODEL_DEFINITION) || PM_MODEL_DEFINITION != " + def +
+         "\n#error \"this model was fitted with the model definition " + def +
+         " (include/pm.h, docs/model.md); rebuild it with this pm.h's pmfit\"\n#endif\n\n";
     o += "#define " + guard.substr(0, guard.size() - 2) + "_MOUNT " +
          (m->mount == PM_MOUNT_ALTAZ ? "PM_MOUNT_ALTAZ" : "PM_MOUNT_EQUATORIAL") + "\n";
     o += "#define " + guard.substr(0, guard.size() - 2) + "_ORDER " + std::to_string(m->order) + "\n";

@@ -1,5 +1,5 @@
 # by hand: an alt-az model with a latitude, comments and blank lines
-pm-model 2
+pm-model 3
 mount altaz
 order 0
 latitude 0.55301

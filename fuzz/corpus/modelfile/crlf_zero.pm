@@ -1,4 +1,4 @@
-pm-model 2
+pm-model 3
 mount equatorial
 order 0
 terms 6
