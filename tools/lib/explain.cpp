@@ -19,8 +19,38 @@
 namespace pmhost {
 namespace xdetail {
 
+// The passes of a candidate's (or a fold's) fit: from the default start
+// first (COLD), and where that has not converged, from the fit it grew out
+// of (WARM: a sky that nearly confounds terms makes the damped iteration
+// creep from far, e.g. an alt-az run in a narrow band of elevation).  One
+// that has not converged after both creeps along a valley the data do not
+// determine (order 3 or 4 of a run that cannot tell its terms apart): that
+// candidate is not fitted, as with a failed fit.  (A warm start alone is not
+// better: beside a nearly confounded periodic term it can start where the
+// full Gauss-Newton step fails, 244 passes where the default start takes 3.)
+// The baseline may take pmfit fit's FIT_MAX_PASSES.
+const int COLD_MAX_PASSES = 100, WARM_MAX_PASSES = 200;
+
+// The coefficients of warm's terms copied into m's same terms.
+static void warm_start(pm_model &m, const pm_model &warm)
+{
+    for (int i = 0; i < m.n_terms; i++) {
+        const pm_term &a = m.term[i];
+        for (int j = 0; j < warm.n_terms; j++) {
+            const pm_term &b = warm.term[j];
+            if (a.kind == b.kind && a.k == b.k && a.l == b.l && a.m == b.m && a.side == b.side &&
+                a.aux == b.aux && a.param == b.param) {
+                if (std::isfinite(warm.coef[j]))
+                    m.coef[i] = warm.coef[j];
+                break;
+            }
+        }
+    }
+    pm_model_prepare(&m);
+}
+
 Fit fit_spec(const Run &run, const std::vector<int> &use, int order,
-             const std::vector<std::string> &adds)
+             const std::vector<std::string> &adds, const pm_model *warm)
 {
     Fit r;
     std::vector<Obs> sub;
@@ -32,7 +62,15 @@ Fit fit_spec(const Run &run, const std::vector<int> &use, int order,
     } catch (const std::exception &) {
         return r;
     }
-    r.f = do_fit(run.obs, use, m);
+    if (!warm) {
+        r.f = do_fit(run.obs, use, m, FIT_MAX_PASSES);
+    } else {
+        r.f = do_fit(run.obs, use, m, COLD_MAX_PASSES);
+        if (r.f.status == PM_ERR_DIVERGED) {
+            warm_start(m, *warm);
+            r.f = do_fit(run.obs, use, m, WARM_MAX_PASSES);
+        }
+    }
     if (r.f.status != PM_OK)
         return r;
     r.ok = true;
@@ -400,18 +438,18 @@ void period_range(const Run &run, const State &st, const ExplainOptions &opt,
     auto at = std::find(adds.begin(), adds.end(), std::string(own));
     if (at == adds.end())
         return;
+    Fit own_fit = fit_spec(run, st.use, st.order, adds, warm_of(st.cur));
+    if (!own_fit.ok)
+        return;
     // chi^2 of the full fit with the period g in place of G
     auto chi2_at = [&](double g) {
         std::vector<std::string> a = adds;
         char spec[64];
         std::snprintf(spec, sizeof spec, "%s%.6g", prefix.c_str(), g);
         a[(size_t)(at - adds.begin())] = spec;
-        Fit f = fit_spec(run, st.use, st.order, a);
+        Fit f = fit_spec(run, st.use, st.order, a, warm_of(own_fit));
         return f.ok ? f.chi2 : HUGE_VAL;
     };
-    Fit own_fit = fit_spec(run, st.use, st.order, adds);
-    if (!own_fit.ok)
-        return;
     const double c0 = own_fit.chi2, s2 = c0 / (double)std::max(1L, 2 * own_fit.N - own_fit.P);
     if (G == std::round(G)) { // whole numbers of cycles, up to 5 either way
         for (int k = 1; k <= 5 && G - k >= g_lo && (chi2_at(G - k) - c0) / s2 <= PERIOD_RANGE_CHI2;
@@ -455,7 +493,7 @@ void prefer_integer(const Run &run, const State &st, const char *prefix, double 
         std::snprintf(a, sizeof a, "%s%.6g", prefix, g);
         std::vector<std::string> ai = st.adds;
         ai.push_back(a);
-        return fit_spec(run, st.use, st.order, ai);
+        return fit_spec(run, st.use, st.order, ai, warm_of(st.cur));
     };
     if (G == std::round(G)) {
         // the whole numbers beside it too: on an axis sampled over part of
@@ -556,7 +594,7 @@ bool deleted_residual(const Run &run, const State &st, int i, double &chi2, doub
     for (int k : st.use)
         if (k != i)
             rest.push_back(k);
-    Fit g = fit_spec(run, rest, st.order, st.adds);
+    Fit g = fit_spec(run, rest, st.order, st.adds, warm_of(st.cur));
     if (!g.ok)
         return false;
     const Obs &o = run.obs[i];
@@ -658,11 +696,11 @@ void score(const Run &run, const State &st, std::vector<Candidate> &cands, doubl
 {
     for (Candidate &c : cands) {
         if (c.effect == "outlier") {
-            c.fit = fit_spec(run, without(st.use, c.drop), st.order, st.adds);
+            c.fit = fit_spec(run, without(st.use, c.drop), st.order, st.adds, warm_of(st.cur));
             c.log_fap += std::log(K);
             continue;
         }
-        c.fit = fit_spec(run, st.use, c.order, c.adds);
+        c.fit = fit_spec(run, st.use, c.order, c.adds, warm_of(st.cur));
         if (!c.fit.ok || c.fit.P <= st.cur.P) {
             c.log_fap = 0;
             continue;
@@ -686,7 +724,7 @@ int first_passing(const Run &run, const State &st, std::vector<Candidate> &cands
             break;
         bool out = c.effect == "outlier";
         std::vector<int> nuse = out ? without(st.use, c.drop) : st.use;
-        c.cv = cv_rms(run, nuse, c.order, c.adds, opt.folds, opt.seed);
+        c.cv = cv_rms(run, nuse, c.order, c.adds, opt.folds, opt.seed, {}, warm_of(c.fit));
         // outliers: their test, the deleted residual, is a leave-one-out
         // prediction already (outlier_candidate)
         if (out || c.cv < st.cur_cv)
@@ -716,7 +754,7 @@ int simpler_reading(const Run &run, const State &st, std::vector<Candidate> &can
         double bic = c.fit.chi2 / s2 + c.fit.P * ln2n;
         if (!(bic < best))
             continue;
-        c.cv = cv_rms(run, st.use, c.order, c.adds, opt.folds, opt.seed);
+        c.cv = cv_rms(run, st.use, c.order, c.adds, opt.folds, opt.seed, {}, warm_of(c.fit));
         if (!(c.cv < st.cur_cv))
             continue;
         best = bic;
@@ -747,7 +785,7 @@ int generic_reading(const Run &run, const State &st, std::vector<Candidate> &can
                           [](const Candidate &x) { return x.effect == "higher_order"; });
     if (h == cands.end() || !h->fit.ok || !(h->log_fap < std::log(opt.alpha)))
         return k;
-    Fit both = fit_spec(run, st.use, h->order, c.adds);
+    Fit both = fit_spec(run, st.use, h->order, c.adds, warm_of(h->fit));
     if (!both.ok || both.P <= h->fit.P || both.P <= c.fit.P)
         return k;
     double d2 = (double)(2 * both.N - both.P), s2 = both.chi2 / d2;
@@ -757,7 +795,7 @@ int generic_reading(const Run &run, const State &st, std::vector<Candidate> &can
     bool h_needed = log_f_tail(fh, dh, d2) + std::log((double)cands.size()) < std::log(opt.alpha);
     if (c_needed || !h_needed)
         return k;
-    h->cv = cv_rms(run, st.use, h->order, h->adds, opt.folds, opt.seed);
+    h->cv = cv_rms(run, st.use, h->order, h->adds, opt.folds, opt.seed, {}, warm_of(h->fit));
     if (!(h->cv < st.cur_cv))
         return k;
     return (int)(h - cands.begin());
@@ -801,7 +839,7 @@ std::vector<Candidate> pairs(const Run &run, const State &st, const std::vector<
                 c.adds.push_back(s);
                 c.new_adds.push_back(s);
             }
-            c.fit = fit_spec(run, st.use, c.order, c.adds);
+            c.fit = fit_spec(run, st.use, c.order, c.adds, warm_of(st.cur));
             if (!c.fit.ok)
                 continue;
             double d2 = (double)(2 * c.fit.N - c.fit.P), s2 = c.fit.chi2 / d2;
@@ -874,7 +912,7 @@ bool smooth_alternative(const Run &run, const State &st, const Candidate &c, con
     *cycles = c.peak_g * sampled_extent(run, st.use, comp) / (2 * PI);
     if (!(*cycles < FEW_CYCLES))
         return false;
-    Fit both = fit_spec(run, st.use, h.order, c.adds);
+    Fit both = fit_spec(run, st.use, h.order, c.adds, warm_of(h.fit));
     if (!both.ok || both.P <= h.fit.P)
         return false;
     double d2 = (double)(2 * both.N - both.P), dc = both.P - h.fit.P;
@@ -946,7 +984,7 @@ State baseline(const Run &run, const ExplainOptions &opt)
     st.adds = opt.adds;
     st.cur = fit_spec(run, st.use, st.order, st.adds);
     if (st.cur.ok) {
-        st.cur_cv = cv_rms(run, st.use, st.order, st.adds, opt.folds, opt.seed);
+        st.cur_cv = cv_rms(run, st.use, st.order, st.adds, opt.folds, opt.seed, {}, warm_of(st.cur));
         return st;
     }
     // let the user see why (singular, too few, diverged): the plain fit
@@ -1051,7 +1089,7 @@ void prune(const Run &run, State &st, const ExplainOptions &opt, Explanation &ex
             std::vector<std::string> adds;
             if (!without_finding(run, st, opt, f, &order, &adds))
                 continue;
-            Fit g = fit_spec(run, st.use, order, adds);
+            Fit g = fit_spec(run, st.use, order, adds, warm_of(st.cur));
             double d1 = st.cur.P - g.P, d2 = (double)(2 * st.cur.N - st.cur.P);
             if (!g.ok || !(d1 > 0) || !(d2 > 0))
                 continue;
@@ -1059,7 +1097,7 @@ void prune(const Run &run, State &st, const ExplainOptions &opt, Explanation &ex
             double lp = log_f_tail(F, d1, d2) + std::log(f.trials);
             if (lp < std::log(opt.alpha) || lp <= worst_lp)
                 continue;
-            double cv = cv_rms(run, st.use, order, adds, opt.folds, opt.seed);
+            double cv = cv_rms(run, st.use, order, adds, opt.folds, opt.seed, {}, warm_of(g));
             if (!(cv <= 1.01 * st.cur_cv)) // within the noise of a 5-fold CV
                 continue;
             worst = (int)k;
@@ -1124,8 +1162,8 @@ std::string physical_reading(const Run &run, const Explanation &ex, const Explai
     for (const char *term : {"tube_flexure", "refraction"}) {
         std::vector<int> use(run.obs.size());
         std::iota(use.begin(), use.end(), 0);
-        double cv = arcsec(cv_rms(run, use, 0, {term}, opt.folds, opt.seed));
         Fit f = fit_spec(run, use, 0, {term});
+        double cv = arcsec(cv_rms(run, use, 0, {term}, opt.folds, opt.seed, {}, warm_of(f)));
         if (!f.ok || !(cv <= best_cv))
             continue;
         best = term;
@@ -1149,7 +1187,7 @@ std::string physical_reading(const Run &run, const Explanation &ex, const Explai
 
 double cv_rms(const Run &run, const std::vector<int> &use, int order,
               const std::vector<std::string> &adds, int folds, unsigned seed,
-              const std::vector<int> &train_also)
+              const std::vector<int> &train_also, const pm_model *warm)
 {
     std::vector<int> perm(use);
     std::mt19937 rng(seed);
@@ -1161,7 +1199,7 @@ double cv_rms(const Run &run, const std::vector<int> &use, int order,
         for (size_t j = 0; j < perm.size(); j++)
             ((int)(j % (size_t)folds) == k ? test : train).push_back(perm[j]);
         train.insert(train.end(), train_also.begin(), train_also.end());
-        Fit f = fit_spec(run, train, order, adds);
+        Fit f = fit_spec(run, train, order, adds, warm);
         if (!f.ok)
             return NAN;
         for (int i : test) {

@@ -127,10 +127,11 @@ void print_explain_text(const Run &run, const Explanation &ex, int order, bool a
 
 // k-fold cross-validated RMS per axis (radians) of a model spec on the
 // observations `use`; train_also are added to every training fold, never
-// predicted (to measure what outliers do to the others).
+// predicted (to measure what outliers do to the others); warm: the spec's
+// fit on all of `use`, which starts each fold's (fit_spec).
 double cv_rms(const Run &run, const std::vector<int> &use, int order,
               const std::vector<std::string> &adds, int folds, unsigned seed,
-              const std::vector<int> &train_also = {});
+              const std::vector<int> &train_also = {}, const pm_model *warm = nullptr);
 
 } // namespace pmhost
 

@@ -27,9 +27,15 @@ struct Fit {
 };
 
 // Fit (order, adds) to the observations `use`.  Not applicable (a needed
-// input missing, a singular term) gives ok = false.
+// input missing, a singular term) gives ok = false.  warm: a fitted model
+// whose coefficients start the terms it has too (the current model for a
+// candidate, the whole run's fit for a cross-validation fold): a few
+// passes from near the answer where a sky that nearly confounds terms
+// makes the damped iteration creep from the default start.
 Fit fit_spec(const Run &run, const std::vector<int> &use, int order,
-             const std::vector<std::string> &adds);
+             const std::vector<std::string> &adds, const pm_model *warm = nullptr);
+// A fit's model as a warm start (fit_spec), or none where it did not fit.
+inline const pm_model *warm_of(const Fit &f) { return f.ok ? &f.f.model : nullptr; }
 
 // Where the search stands: the observations used and the current model.
 struct State {
