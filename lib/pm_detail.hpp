@@ -756,8 +756,8 @@ template <typename T> struct Site {
     int side;        /* +1 normal side, -1 beyond the pole */
     bool have_zenith;
     T zx, zy, zz;    /* M^T Z: zx = sin(el), (zy, zz) toward the zenith */
-    Trig<T> gs;      /* the shifted position (t + c', d - e'): the tilt
-                        base vectors' (base_uv_tilt) */
+    Trig<T> gs;      /* the shifted position (t + c', d - e'), where the
+                        harmonics and base vectors are (base_uv_at) */
 };
 
 template <typename T>
