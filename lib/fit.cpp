@@ -119,21 +119,6 @@ V3<double> mt_and_derivs(const Chain &c, const V3<double> &x, V3<double> dq[6])
     return q;
 }
 
-/* The anisotropic displacement is a function of the shifted position
-** (t' = t + c', d' = d - e': its harmonics and base vectors, docs/model.md),
-** so it moves with c' and e': its part of the index columns (exact
-** Jacobian; rows are +dD/dtheta): d/dc' = d/dt', d/de' = -d/dd'. */
-void shift_index_rows(const Chain &c, const pm_context *ctx, const Trig<double> &g,
-                      double *row0, double *row1)
-{
-    double dt, dd, J[4];
-    aniso_jac_at(c.m, c.k, g, ctx, true, &dt, &dd, J);
-    row0[2] += J[0];
-    row1[2] += J[2];
-    row0[4] -= J[1];
-    row1[4] -= J[3];
-}
-
 /* Two design rows (model derivatives) and the residual of one observation
 ** at model m.  Residual: r = log(M^T t) - D(x), in the frame transported
 ** by the isotropic rotation M (docs/model.md). */
@@ -150,9 +135,18 @@ void rows(const pm_model *m, const pm_context *ctx, double enc_ha,
     V3<double> q = mt_and_derivs(c, unit_of(app_ha, app_dec), dq);
     double D[2][3], ly, lz;
     dlog(q, D, &ly, &lz);
-    double dt, dd;
-    const double sg[4] = {c.stp, c.ctp, c.sdp, c.cdp};
-    aniso<double>(m, c.k, g, ctx, &dt, &dd, sg);
+    /* The anisotropic displacement D, a function of the shifted position
+    ** (t' = t + c', d' = d - e': its harmonics and base vectors,
+    ** docs/model.md), and with it, in the same evaluation, how D moves
+    ** with c' and e' (Js: d/dt', d/dd'; its part of the index columns,
+    ** below); D bit for bit as aniso computes it. */
+    double dt, dd, Js[4] = {0, 0, 0, 0};
+    if (m->n_terms > 6) {
+        aniso_jac_at(m, c.k, g, ctx, true, &dt, &dd, Js);
+    } else {
+        const double sg[4] = {c.stp, c.ctp, c.sdp, c.cdp};
+        aniso<double>(m, c.k, g, ctx, &dt, &dd, sg);
+    }
     r[0] = ly - dt;
     r[1] = lz - dd;
 
@@ -187,8 +181,12 @@ void rows(const pm_model *m, const pm_context *ctx, double enc_ha,
         for (int i = m->n_base; i < m->n_terms; i++)
             term_uv<double>(m->term[i], g, st, ctx, &row0[i], &row1[i]);
     }
-    if (m->n_terms > 6)
-        shift_index_rows(c, ctx, g, row0, row1);
+    /* D's part of the index columns (exact Jacobian; rows are +dD/dtheta):
+    ** d/dc' = d/dt', d/de' = -d/dd' */
+    row0[2] += Js[0];
+    row1[2] += Js[2];
+    row0[4] -= Js[1];
+    row1[4] -= Js[3];
     if (m->n_terms == m->n_base)
         return;
     /* The zenith terms' direction, M^T Z, turns with the isotropic terms:
