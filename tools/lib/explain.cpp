@@ -209,17 +209,9 @@ void refine_peak(const Run &run, const FitOut &f, const std::vector<double> &r, 
 double sampled_extent(const Run &run, const std::vector<int> &idx, int comp)
 {
     std::vector<double> a;
-    for (int i : idx) {
-        double th = comp == 0 ? run.obs[i].eh : run.obs[i].ed;
-        a.push_back(th - 2 * PI * std::floor(th / (2 * PI)));
-    }
-    if (a.size() < 2)
-        return 0;
-    std::sort(a.begin(), a.end());
-    double gap = a.front() + 2 * PI - a.back();
-    for (size_t k = 1; k < a.size(); k++)
-        gap = std::max(gap, a[k] - a[k - 1]);
-    return 2 * PI - gap;
+    for (int i : idx)
+        a.push_back(comp == 0 ? run.obs[i].eh : run.obs[i].ed);
+    return a.size() < 2 ? 0 : 2 * PI - widest_gap(a);
 }
 
 // The fewest cycles per revolution searched on axis comp: one and a half

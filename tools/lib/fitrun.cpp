@@ -63,30 +63,42 @@ static int move_sign(double a, double b, double cut, bool cut_ok)
     return d > 0 ? 1 : (d < 0 ? -1 : 0);
 }
 
+double widest_gap(const std::vector<double> &ang, double *middle)
+{
+    std::vector<double> a;
+    for (double x : ang)
+        if (std::isfinite(x))
+            a.push_back(x - 2 * PI * std::floor(x / (2 * PI)));
+    if (middle)
+        *middle = 0;
+    if (a.size() < 2)
+        return 2 * PI;
+    std::sort(a.begin(), a.end());
+    double gap = a.front() + 2 * PI - a.back(), at = a.back() + 0.5 * gap;
+    for (size_t k = 1; k < a.size(); k++)
+        if (a[k] - a[k - 1] > gap) {
+            gap = a[k] - a[k - 1];
+            at = a[k - 1] + 0.5 * gap;
+        }
+    if (middle)
+        *middle = std::remainder(at, 2 * PI);
+    return gap;
+}
+
 // Where an axis's path never goes: the middle of the widest empty arc of
 // its angles over the run, when that arc is wider than a quarter turn.  A
 // mount does not turn its axis through a zone it never points into (a
 // German mount's counterweight-up half, a fork's HA beyond +-180 deg under
 // the pole, the ends of a cable wrap), so a move between the arc's two
 // sides goes the long way round, not across it.  A narrower empty arc is a
-// gap of the sampling.
+// gap of the sampling.  False (and *cut untouched) without such an arc.
 static bool axis_cut(const std::vector<double> &ang, double *cut)
 {
-    std::vector<double> a;
-    for (double x : ang)
-        if (std::isfinite(x))
-            a.push_back(std::remainder(x, 2 * PI));
-    if (a.size() < 2)
+    double middle;
+    if (ang.size() < 2 || !(widest_gap(ang, &middle) > 0.5 * PI))
         return false;
-    std::sort(a.begin(), a.end());
-    double best = a.front() + 2 * PI - a.back(), at = a.back() + 0.5 * best;
-    for (size_t i = 1; i < a.size(); i++)
-        if (a[i] - a[i - 1] > best) {
-            best = a[i] - a[i - 1];
-            at = a[i - 1] + 0.5 * best;
-        }
-    *cut = std::remainder(at, 2 * PI);
-    return best > 0.5 * PI;
+    *cut = middle;
+    return true;
 }
 
 void derive_directions(Run &r)
@@ -100,14 +112,9 @@ void derive_directions(Run &r)
     // the pole (encoder HA +-180 deg: a fork's limit; a German mount always
     // leaves its counterweight-up arc empty), an alt-az azimuth is taken the
     // short way round (a cable wrap's ends are not in the file).
-    double cut1 = PI, cut2 = PI;
-    bool ok1 = axis_cut(e1, &cut1);
-    if (!ok1) {
-        cut1 = PI;
-        ok1 = r.mount == PM_MOUNT_EQUATORIAL;
-    }
-    if (!axis_cut(e2, &cut2)) /* axis 2: the encoder angle's own ends */
-        cut2 = PI;
+    double cut1 = PI, cut2 = PI; /* axis 2 without: the encoder angle's own ends */
+    const bool ok1 = axis_cut(e1, &cut1) || r.mount == PM_MOUNT_EQUATORIAL;
+    axis_cut(e2, &cut2);
     bool have_dir = false;
     for (const Obs &ob : r.obs)
         have_dir = have_dir || ob.ctx.dir != 0;

@@ -59,6 +59,11 @@ Run run_from_pmrun(const pmrun *run, const std::string &path);
 // direction on axis 1 where no observation has one, and the input "dec_dir"
 // where the run has no such column and a context slot is free.
 void derive_directions(Run &r);
+// The widest empty arc of the angles (radians) on the circle: its width
+// (2 pi for fewer than two angles), and where middle is given its middle,
+// in (-pi, pi].  (explain's sampled extent of an axis is the circle less
+// it; derive_directions' cut where an axis never turns.)
+double widest_gap(const std::vector<double> &ang, double *middle = nullptr);
 
 // Name and physical meaning of a model term.
 std::string term_name(const pm_model &m, int i);
