@@ -216,11 +216,15 @@ double sampled_extent(const Run &run, const std::vector<int> &idx, int comp)
 
 // The fewest cycles per revolution searched on axis comp: one and a half
 // cycles over the sampled extent (below), and opt.g_min.
+double lowest_period(double extent, const ExplainOptions &opt)
+{
+    return std::max(opt.g_min, extent > 0 ? 3 * PI / extent : opt.g_max);
+}
+
 double lowest_period(const Run &run, const std::vector<int> &idx, int comp,
                      const ExplainOptions &opt)
 {
-    double extent = sampled_extent(run, idx, comp);
-    return std::max(opt.g_min, extent > 0 ? 3 * PI / extent : opt.g_max);
+    return lowest_period(sampled_extent(run, idx, comp), opt);
 }
 
 // The periodogram of one axis.  A period is identifiable as periodic only
@@ -417,21 +421,19 @@ void add_candidate(std::vector<Candidate> &cands, const State &st, const std::st
 namespace xdetail {
 
 // (explain_internal.hpp)
-void period_range(const Run &run, const State &st, const ExplainOptions &opt,
+void period_range(const Run &run, const State &st, const ExplainOptions &opt, const Fit &own_fit,
                   const std::vector<std::string> &adds, int comp, double G, double *lo,
                   double *hi, double *sampled_deg)
 {
-    const double g_lo = lowest_period(run, st.use, comp, opt), g_hi = opt.g_max;
+    const double extent = sampled_extent(run, st.use, comp);
+    const double g_lo = lowest_period(extent, opt), g_hi = opt.g_max;
     *lo = *hi = G;
-    *sampled_deg = sampled_extent(run, st.use, comp) * 180 / PI;
+    *sampled_deg = extent * 180 / PI;
     const std::string prefix = comp ? "dec_periodic:" : "ha_periodic:";
     char own[64];
     std::snprintf(own, sizeof own, "%s%.6g", prefix.c_str(), G);
     auto at = std::find(adds.begin(), adds.end(), std::string(own));
-    if (at == adds.end())
-        return;
-    Fit own_fit = fit_spec(run, st.use, st.order, adds, warm_of(st.cur));
-    if (!own_fit.ok)
+    if (at == adds.end() || !own_fit.ok)
         return;
     // chi^2 of the full fit with the period g in place of G
     auto chi2_at = [&](double g) {

@@ -340,8 +340,8 @@ std::vector<Finding> describe(const Run &run, const State &st, const Candidate &
             fd.with = c.members[1 - k];
         if (e == "ha_periodic" || e == "dec_periodic") {
             double G = k < c.member_g.size() ? c.member_g[k] : c.peak_g;
-            period_range(run, st, opt, c.adds, e == "ha_periodic" ? 0 : 1, G, &fd.cycles_lo,
-                         &fd.cycles_hi, &fd.sampled_deg);
+            period_range(run, st, opt, c.fit, c.adds, e == "ha_periodic" ? 0 : 1, G,
+                         &fd.cycles_lo, &fd.cycles_hi, &fd.sampled_deg);
             describe_periodic(run, c, newi, e, G, fd);
         }
         else if (e == "outlier")

@@ -82,8 +82,9 @@ std::string largest_bin(const Run &run, const std::vector<int> &use,
 const char *axis_word(const Run &run, int axis, bool raw);
 
 // The periods of axis comp (0, 1) that fit as well as G: the full fit of
-// adds (which holds G's term) with the period g in G's place within
-// PERIOD_RANGE_CHI2 noise variances of G's, from *lo to *hi (G itself where
+// adds (which holds G's term; own_fit, their fit on st.use at st.order,
+// the candidate's) with the period g in G's place within
+// PERIOD_RANGE_CHI2 noise variances of own_fit's, from *lo to *hi (G itself where
 // the data fix it).  Whole numbers of cycles beside an integer G (up to 5
 // either way); beside another G, the half-width of the chi^2 parabola.  An
 // axis sampled over part of its circle (*sampled_deg) resolves G only to
@@ -91,7 +92,7 @@ const char *axis_word(const Run &run, int axis, bool raw);
 // always tell 309 teeth from 310.  Within the periods searched (from
 // lowest_period to opt.g_max).
 const double PERIOD_RANGE_CHI2 = 3.84; // chi^2(1) at 5%
-void period_range(const Run &run, const State &st, const ExplainOptions &opt,
+void period_range(const Run &run, const State &st, const ExplainOptions &opt, const Fit &own_fit,
                   const std::vector<std::string> &adds, int comp, double G, double *lo,
                   double *hi, double *sampled_deg);
 
