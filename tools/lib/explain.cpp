@@ -478,9 +478,10 @@ bool opt_is_scan(const ExplainOptions &opt, int comp)
 // full fits decide: an integer G moves to a whole-number neighbour that
 // fits better; a non-integer G becomes the better of the two integers
 // beside it (a worm has whole teeth) unless its chi^2 exceeds the
-// non-integer's by more than INTEGER_REJECT_CHI2 sigma^2.
+// non-integer's by more than INTEGER_REJECT_CHI2 sigma^2.  *chosen: the
+// fit of the period G ends at (the candidate's, score need not make it).
 void prefer_integer(const Run &run, const State &st, const char *prefix, double g_lo,
-                    double g_hi, double &G)
+                    double g_hi, double &G, Fit *chosen)
 {
     auto fit_at = [&](double g) {
         char a[64];
@@ -512,6 +513,7 @@ void prefer_integer(const Run &run, const State &st, const char *prefix, double 
             G = next;
             here = best;
         }
+        *chosen = here;
         return;
     }
     double g0 = std::floor(G), g1 = g0 + 1;
@@ -519,13 +521,16 @@ void prefer_integer(const Run &run, const State &st, const char *prefix, double 
     // the better
     Fit f0 = g0 >= g_lo ? fit_at(g0) : Fit(), f1 = g1 <= g_hi ? fit_at(g1) : Fit();
     Fit fg = fit_at(G);
+    *chosen = fg;
     if (!fg.ok || (!f0.ok && !f1.ok))
         return;
     bool take1 = f1.ok && (!f0.ok || f1.chi2 < f0.chi2);
     const Fit &fi = take1 ? f1 : f0;
     double s2 = fg.chi2 / (double)std::max(1L, 2 * fg.N - fg.P);
-    if ((fi.chi2 - fg.chi2) / s2 <= INTEGER_REJECT_CHI2)
+    if ((fi.chi2 - fg.chi2) / s2 <= INTEGER_REJECT_CHI2) {
         G = take1 ? g1 : g0;
+        *chosen = fi;
+    }
 }
 
 void periodic_candidates(const Run &run, const State &st, const ExplainOptions &opt,
@@ -540,14 +545,20 @@ void periodic_candidates(const Run &run, const State &st, const ExplainOptions &
         Periodogram pg = periodogram(run, st.cur.f, comp, opt, sg2);
         if (already || !(pg.peak_g > 0))
             continue;
-        if (opt_is_scan(opt, comp))
+        Fit chosen;
+        const bool scan = opt_is_scan(opt, comp);
+        if (scan)
             prefer_integer(run, st, prefix, lowest_period(run, st.use, comp, opt), opt.g_max,
-                           pg.peak_g);
+                           pg.peak_g, &chosen);
         char spec[64];
         std::snprintf(spec, sizeof spec, "%s%.6g", prefix, pg.peak_g);
         add_candidate(cands, st, comp ? "dec_periodic" : "ha_periodic", {spec});
         cands.back().trials = pg.trials;
         cands.back().peak_g = pg.peak_g;
+        if (scan) { /* (the same spec, order and start as score's) */
+            cands.back().fit = chosen;
+            cands.back().fitted = true;
+        }
     }
 }
 
@@ -694,7 +705,8 @@ void score(const Run &run, const State &st, std::vector<Candidate> &cands, doubl
             c.log_fap += std::log(K);
             continue;
         }
-        c.fit = fit_spec(run, st.use, c.order, c.adds, warm_of(st.cur));
+        if (!c.fitted)
+            c.fit = fit_spec(run, st.use, c.order, c.adds, warm_of(st.cur));
         if (!c.fit.ok || c.fit.P <= st.cur.P) {
             c.log_fap = 0;
             continue;

@@ -61,6 +61,7 @@ struct Candidate {
     std::vector<int> drop;             // outliers: observations to drop
     std::vector<double> miss;          // outliers: each one's deleted residual (rad)
     Fit fit;
+    bool fitted = false;               // fit made already (the chosen period's, prefer_integer)
     double log_fap = 0;                // natural log of the false-alarm probability
     double cv = 0;                     // cross-validated RMS once checked
 };
