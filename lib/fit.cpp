@@ -170,7 +170,7 @@ void rows(const pm_model *m, const pm_context *ctx, double enc_ha,
         int j = tm->l * tm->l + tm->l + tm->m;
         double y = Y[j] * norm_lm(tm->l, tm->m);
         double u, v;
-        base_uv_at<double>(tm->k, g, gs, &u, &v);
+        base_uv<double>(tm->k, gs, &u, &v);
         row0[i] = y * u;
         row1[i] = y * v;
     }

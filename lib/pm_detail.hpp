@@ -499,7 +499,9 @@ inline double norm_lm(int l, int m)
 **   p1 = x^p = (-sd ct, st)    p2 = y^p = (-sd st, -ct)    p3 = z^p = (cd, 0)
 **   p4 = (-sd, 0)              p5 = (0, -1)                p6 = (1, 0)
 ** (Pal et al. Eq. tdvectexpansion, projected on e_t = (-st, ct, 0) and
-** e_d = (-sd ct, -sd st, cd)). */
+** e_d = (-sd ct, -sd st, cd)).  A model evaluates them at the index-shifted
+** position (t + c', d - e'), the mechanical axis angles (docs/model.md,
+** "The anisotropic terms: at the mechanical position"). */
 template <typename T>
 inline void base_uv(int k, const Trig<T> &g, T *u, T *v)
 {
@@ -511,18 +513,6 @@ inline void base_uv(int k, const Trig<T> &g, T *u, T *v)
     case 5: *u = 0; *v = -1; break;
     default: *u = 1; *v = 0; break;
     }
-}
-
-/* The base vector k of a term, evaluated at the index-shifted position
-** gs = (t + c', d - e'): the mechanical axis angles, where the telescope
-** points in the mount's frame (the encoder's zero points are offsets, not
-** a place on the mount; docs/model.md, "The anisotropic terms: at the
-** mechanical position").  g, the encoder position, is not used. */
-template <typename T>
-inline void base_uv_at(int k, const Trig<T> &g, const Trig<T> &gs, T *u, T *v)
-{
-    (void)g;
-    base_uv<T>(k, gs, u, v);
 }
 
 /* Unit vector displaced from (1,0,0) by the tangent offset (a, b) along y
@@ -757,7 +747,7 @@ template <typename T> struct Site {
     bool have_zenith;
     T zx, zy, zz;    /* M^T Z: zx = sin(el), (zy, zz) toward the zenith */
     Trig<T> gs;      /* the shifted position (t + c', d - e'), where the
-                        harmonics and base vectors are (base_uv_at) */
+                        harmonics and base vectors are */
 };
 
 template <typename T>
@@ -872,8 +862,8 @@ inline bool term_factor(const pm_term &t, const Trig<T> &g, const Site<T> &s,
 }
 
 /* Displacement per unit coefficient of an added term t at position g; its
-** base vector and a harmonic factor at the shifted position s.gs
-** (base_uv_at), a periodic or sectoral factor of the encoder angles (a
+** base vector and a harmonic factor at the shifted position s.gs (the
+** mechanical axis angles, docs/model.md), a periodic or sectoral factor of the encoder angles (a
 ** gear turns with its encoder). */
 template <typename T>
 inline void term_uv(const pm_term &t, const Trig<T> &g, const Site<T> &s,
@@ -897,7 +887,7 @@ inline void term_uv(const pm_term &t, const Trig<T> &g, const Site<T> &s,
     T f, bu, bv;
     if (!term_factor<T>(t, g, s, ctx, &f))
         return;
-    base_uv_at<T>(t.k, g, s.gs, &bu, &bv);
+    base_uv<T>(t.k, s.gs, &bu, &bv);
     *u = f * bu;
     *v = f * bv;
 }
