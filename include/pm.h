@@ -114,14 +114,18 @@ extern "C" {
 ** 12 -O2, the library at PM_MAX_L = 4:
 **   tracking beyond 0.5 deg of the mount's pole, 10 Hz or faster, terms
 **   within 10 deg / 10' (PM_INVERT_TRACK_MAX_EVALS): the Cortex-M7
-**   double inverse took at most 3,595 instructions at its worst measured
-**   3 evaluations (3,575 before the code moved with pm_model_track,
+**   double inverse took at most 4,015 instructions, at its worst measured
+**   4 evaluations (stop 25; 3,595 at 3 before the anisotropic terms moved
+**   to the mechanical position, 3,575 before the code moved with pm_model_track,
 **   3,565 before solve_branch was split into functions,
 **   3,640 before the typical iteration's lean loop, 3,870 before the
-**   Jacobian's sums were fused); PM_BUDGET_M7_TRACK_INSNS adds 5 more evaluations of
-**   PM_BUDGET_M7_INSNS_PER_EVAL each, for the bound of 8.
-**   pm_model_track's ticks, under the same conditions: at most 3,335
-**   instructions measured (3 evaluations; its typical tick ~1,900 against
+**   Jacobian's sums were fused); PM_BUDGET_M7_TRACK_INSNS adds 5 more
+**   evaluations of PM_BUDGET_M7_INSNS_PER_EVAL each to 3,595, for the
+**   bound of 8 (16,095: above 4,015 + 4 x 2,500 as well).
+**   pm_model_track's ticks, under the same conditions: at most 3,345
+**   instructions measured (2 evaluations; 6,890 at 6 before the next
+**   evaluation took J afresh where a carried one converges slowly, Note 1
+**   of pm_model_track; its typical tick ~1,900 against
 **   invert_near's ~2,700), so PM_BUDGET_M7_TRACK_INSNS holds for it too.
 **   PM_BUDGET_M7_INSNS_PER_EVAL: an evaluation of the Newton iteration
 **   (the displacement with its Jacobian, sin/cos of the point, the
@@ -612,7 +616,13 @@ pm_status pm_model_invert_near(const pm_model *m, const pm_context *ctx,
 **     state from the tick where it was taken, and reused while the start
 **     is within PM_TRACK_J_REACH of that point (the model and the inputs
 **     of its AUX terms unchanged: pm_model.ident and a digest of those
-**     inputs say so).  A tick of a uniformly moving target then costs one
+**     inputs say so).  Where a step h shows the carried J too far off to
+**     converge fast (lip2 |x - x_J| |h| above 100 PM_INVERT_TOL: the
+**     next point's bound could not certify it, and the chord contracts
+**     slowly), the next evaluation takes J afresh (a tick within a few
+**     degrees of the mount's pole took 6 evaluations without it,
+**     where pm_model_invert_near took 4).  With J carried, a tick of a
+**     uniformly moving target costs one
 **     plain evaluation where pm_model_invert_near makes one with the
 **     Jacobian (about three evaluations' worth of arithmetic) and, at
 **     10 Hz, a second one.  Where the state's J is used

@@ -955,6 +955,36 @@ PM_HOT bool carried_j(Branch *s, const Trig<double> &g)
     return true;
 }
 
+/* pm_model_track's J taken afresh at g in this call: the state gets it
+** and its point (Carry). */
+PM_HOT void fresh_j(Branch *s, const Trig<double> &g)
+{
+    double *at = s->carry->t->jac_at;
+    s->carry->fresh = true;
+    at[0] = g.st;
+    at[1] = g.ct;
+    at[2] = g.sd;
+    at[3] = g.cd;
+}
+
+/* After a step h of length hn that the predicted stop did not certify:
+** where J is pm_model_track's, carried from another tick, and its
+** distance alone keeps the next point's bound above 100 PM_INVERT_TOL
+** (the bound is ~100 times the real curvature: the next point would still
+** miss by more than the tolerance), the next evaluation takes J afresh and
+** the chord's matrix with it.  With J carried that far the chord
+** contracts by about its error times |F_D|, slowly within a few degrees of
+** the mount's pole (|F_D| ~ 1/cos of the distance): up to 6 evaluations
+** where a J taken at the start needs 3; a fresh J converges quadratically
+** from the next point on. */
+PM_HOT bool stale_j(Branch *s, double hn)
+{
+    if (!(s->carry && !s->carry->fresh && s->lip2 * s->dist_j * hn > 100 * PM_INVERT_TOL))
+        return false;
+    s->have_j = s->have_n = s->tried_n = false;
+    return true;
+}
+
 /* The first point, in slot 0: the closed form at D^ = 0 (a cold call), or
 ** the start (one evaluation, with J); the branch (side) and whether the
 ** closed form reaches the target. */
@@ -997,14 +1027,8 @@ PM_HOT void first_point(Branch *s)
             aniso_jac(m, k, g, s->ctx, &dt, &dd, s->J);
         else
             aniso<double>(m, k, g, s->ctx, &dt, &dd);
-        if (s->carry && !carried) {
-            double *at = s->carry->t->jac_at;
-            s->carry->fresh = true;
-            at[0] = g.st;
-            at[1] = g.ct;
-            at[2] = g.sd;
-            at[3] = g.cd;
-        }
+        if (s->carry && !carried)
+            fresh_j(s, g);
         s->d0t = dt;
         s->d0d = dd;
         s->used = 1;
@@ -1047,6 +1071,8 @@ PM_HOT void evaluate(Branch *s, const Trig<double> &g, double *dt_out, double *d
         aniso_jac(s->m, *s->k, g, s->ctx, &dt, &dd, s->J);
         s->have_j = true;
         s->dist_j = 0;
+        if (s->carry)
+            fresh_j(s, g); /* (stale_j) */
     }
     *dt_out = dt;
     *dd_out = dd;
@@ -1244,7 +1270,10 @@ PM_HOT bool lean_loop(Branch *s)
             lean_stop(s, L.nxt);
             return true;
         }
+        const bool rejac = stale_j(s, hn);
         lean_advance(s, &L, dt, dd, nt, nd, hn);
+        if (rejac) /* (the best point's distance from where J will be taken) */
+            L.p_dist = hn;
     }
     hand_over(s, &L, end);
     return false;

@@ -336,6 +336,84 @@ START_TEST(test_bounded_tracking_beyond_half_degree)
 }
 END_TEST
 
+/* The same for pm_model_track in a loop's steady state, as the bench's
+** distribution makes it (bench/dist.c): the state started at the solution
+** three ticks before (J taken there), two ticks tracked, the third
+** counted; half the targets 0.5..5 deg from the mount's pole, where the
+** encoder hour angle moves up to ~1e-4 rad a tick.  Every tick PM_OK
+** within the header's bound, and never dearer than pm_model_invert_near
+** from the same position where that needs no more than 4: a J carried
+** from three ticks back contracts the chord slowly there (before the next
+** evaluation took J afresh, stale_j in lib/model.cpp, 6 were seen where
+** invert_near needed 3).  Within about a degree of the pole these models'
+** anisotropic terms (up to 48 of 10' each) turn the closed form's branch
+** as fast as the pole's distance does (the chord's matrix is singular:
+** Newton on the forward model takes over), and invert_near itself needs
+** up to 6 or 7: counted and printed, as forced by the geometry. */
+START_TEST(test_bounded_track_state_beyond_half_degree)
+{
+    static const double dts[4] = {0.001, 0.01, 0.1, 0.05};
+    tu_rng r;
+    unsigned long worst = 0, worst_near = 0, n_over = 0, near_over = 0;
+    int i, j, k, n = 0;
+    tu_seed(&r, 1819);
+    for (i = 0; i < 200; i++) {
+        pm_model m;
+        ck_assert_int_eq(pm_model_init(&m, PM_MOUNT_EQUATORIAL, 1 + i % 2), PM_OK);
+        for (j = 0; j < m.n_terms; j++)
+            m.coef[j] = (2 * tu_uniform(&r) - 1) * (j < 6 ? 10 * DEG : 10 * ARCSEC * 60);
+        ck_assert_int_eq(pm_model_prepare(&m), PM_OK);
+        for (j = 0; j < 40; j++) {
+            double rho = (j % 2 ? 0.5 + tu_uniform(&r) * 4.5 : 5 + tu_uniform(&r) * 85) * DEG;
+            double hemi = tu_uniform(&r) < 0.5 ? 1 : -1;
+            int flip = tu_uniform(&r) < 0.5;
+            double t = (2 * tu_uniform(&r) - 1) * M_PI;
+            double d = m.coef[4] + hemi * (flip ? M_PI / 2 + rho : M_PI / 2 - rho);
+            double ah, ad, x[2], y[2], bh, bd, dh = 7.2921159e-5 * dts[j % 4];
+            unsigned long ev, ev_near;
+            pm_track tk;
+            pm_status st;
+            ck_assert_int_eq(pm_model_apply(&m, NULL, t, d, &ah, &ad), PM_OK);
+            ck_assert_int_eq(pm_model_invert_near(&m, NULL, ah - 3 * dh, ad, t, d, &x[0], &x[1]),
+                             PM_OK);
+            ck_assert_int_eq(pm_track_start(&tk, x[0], x[1]), PM_OK);
+            for (k = 2; k >= 1; k--)
+                ck_assert_int_eq(pm_model_track(&m, NULL, &tk, ah - k * dh, ad, &y[0], &y[1]),
+                                 PM_OK);
+            probe_count = 0;
+            ck_assert_int_eq(pm_model_invert_near(&m, NULL, ah, ad, tk.enc[0], tk.enc[1], &x[0],
+                                                  &x[1]),
+                             PM_OK);
+            ev_near = probe_count;
+            probe_count = 0;
+            st = pm_model_track(&m, NULL, &tk, ah, ad, &y[0], &y[1]);
+            ev = probe_count;
+            ck_assert_msg(st == PM_OK, "track: status %d (%.3f deg from the pole)", (int)st,
+                          rho / DEG);
+            ck_assert_uint_le(ev, PM_INVERT_TRACK_MAX_EVALS);
+            ck_assert_msg(ev <= TRACK_SEEN_MAX || ev <= ev_near,
+                          "track: %lu evaluations where invert_near needs %lu (%.3f deg from "
+                          "the pole, dt %g)", ev, ev_near, rho / DEG, dts[j % 4]);
+            ck_assert_int_eq(pm_model_apply(&m, NULL, y[0], y[1], &bh, &bd), PM_OK);
+            ck_assert_double_le(tu_angle(bh, bd, ah, ad), PM_INVERT_TOL + ROUND_TRIP_SLACK);
+            if (ev > TRACK_SEEN_MAX)
+                printf("track: %lu evaluations (invert_near %lu): %.3f deg from the pole, "
+                       "dt %g\n", ev, ev_near, rho / DEG, dts[j % 4]);
+            worst = ev > worst ? ev : worst;
+            worst_near = ev_near > worst_near ? ev_near : worst_near;
+            n_over += ev > TRACK_SEEN_MAX;
+            near_over += ev_near > TRACK_SEEN_MAX;
+            n++;
+        }
+    }
+    printf("check_bounded: pm_model_track three ticks in, beyond 0.5 deg of the mount's pole, "
+           "%d ticks: worst %lu evaluations (invert_near from the same position %lu; bound "
+           "%d); more than %d in %lu (invert_near %lu)\n", n, worst, worst_near,
+           PM_INVERT_TRACK_MAX_EVALS, TRACK_SEEN_MAX, n_over, near_over);
+    fflush(stdout);
+}
+END_TEST
+
 /* Realistic models (tests/hard_cases.h: L = 0..2, isotropic terms within
 ** +-10 deg, harmonic terms within +-10'), the true encoder position near
 ** the mount's pole -- within 0.5 deg (20,000 cold calls: uniform in area
@@ -458,6 +536,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_bounded_large);
     tcase_add_test(tc, test_bounded_huge);
     tcase_add_test(tc, test_bounded_tracking_beyond_half_degree);
+    tcase_add_test(tc, test_bounded_track_state_beyond_half_degree);
     tcase_add_test(tc, test_bounded_realistic_near_pole);
     tcase_add_test(tc, test_bounded_nonfinite_inputs);
     tcase_add_test(tc, test_bounded_overflow_and_refused_model);

@@ -57,7 +57,7 @@ static void real_model(pm_model *m, tu_rng *r, int order, int aux)
 }
 
 typedef struct tally {
-    long calls, ok, fresh, evals_track, evals_near, worst_far;
+    long calls, ok, fresh, evals_track, evals_near, worst_far, worst_mid;
 } tally;
 
 /* Whether the state took J afresh in the last call: J's point moved. */
@@ -91,6 +91,8 @@ static void track_run(const pm_model *m, pm_context *ctx, double eh, double ed, 
         ck_assert_uint_le(probe_count - e0, PM_INVERT_NEAR_MAX_EVALS);
         if (far && (long)(probe_count - e0) > s->worst_far)
             s->worst_far = (long)(probe_count - e0);
+        if (!far && (long)(probe_count - e0) > s->worst_mid)
+            s->worst_mid = (long)(probe_count - e0);
         e0 = probe_count;
         sn = pm_model_invert_near(m, ctx, ah, dec, before.enc[0], before.enc[1], &nh, &nd);
         s->evals_near += (long)(probe_count - e0);
@@ -146,9 +148,9 @@ START_TEST(test_track_realistic)
     }
     for (i = 0; i < 3; i++) {
         printf("track dt %g: %ld calls, %ld PM_OK, J taken %ld times, evaluations %ld "
-               "(invert_near %ld), worst beyond 5 deg %ld\n",
+               "(invert_near %ld), worst beyond 5 deg %ld, at 0.5-5 deg %ld\n",
                dts[i], s[i].calls, s[i].ok, s[i].fresh, s[i].evals_track, s[i].evals_near,
-               s[i].worst_far);
+               s[i].worst_far, s[i].worst_mid);
         ck_assert_int_eq(s[i].ok, s[i].calls);
         ck_assert_int_le(s[i].worst_far, PM_INVERT_TRACK_MAX_EVALS);
     }
