@@ -99,6 +99,18 @@ $(foreach t,$(BENCH_TARGETS),$(eval $(call dist_target,$(t))))
 
 DIST_ELFS := $(foreach t,$(BENCH_TARGETS),$(BN)/$(t)/dist.elf)
 
+# The dearest tracking ticks on the Cortex-M7 (bench/track_worst_cm.c: the
+# steady-state ticks check_bounded bounds; PM_BUDGET_M7_TRACK_INSNS).
+$(BN)/m7/track_worst.elf: $(BN)/m7/dist/track_worst_cm.o $(BN)/m7/platform_cm.o \
+                          $(addprefix $(BN)/m7/core/,$(FW_CORE_NAMES)) firmware_demo/cortex_m.ld
+	$(ARM_CC) $(FW_CPU_m7) $(filter %.o,$^) -o $@ $(FW_ARM_LDFLAGS) -lm
+
+bench-track-worst: fw-toolchain $(BN)/m7/track_worst.elf
+	timeout 600 $(QEMU_ARM) -M $(FW_MACHINE_m7) -nographic -semihosting \
+	  -icount shift=0,align=off,sleep=off -kernel $(BN)/m7/track_worst.elf
+
+.PHONY: bench-track-worst
+
 
 bench-run: fw-toolchain $(BN)/pmbench $(BN)/pmbench_fit $(BN)/pmbench_explain $(BENCH_ELFS) \
            $(BN)/pmbench_dist $(BN)/pmbench_dist_probe $(DIST_ELFS)

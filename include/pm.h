@@ -121,7 +121,14 @@ extern "C" {
 **   3,640 before the typical iteration's lean loop, 3,870 before the
 **   Jacobian's sums were fused); PM_BUDGET_M7_TRACK_INSNS adds 5 more
 **   evaluations of PM_BUDGET_M7_INSNS_PER_EVAL each to 3,595, for the
-**   bound of 8 (16,095: above 4,015 + 4 x 2,500 as well).
+**   bound of 8 (16,095: above 4,015 + 4 x 2,500 as well).  The bench's
+**   situations hold no tick that needs Newton; the dearest measured at
+**   all ("make bench-track-worst": check_bounded's 8,000 steady-state
+**   ticks, half of them 0.5-5 deg from the pole) are 8,840 (invert_near)
+**   and 8,600 instructions (pm_model_track) at 6 evaluations, 0.504 deg
+**   from the pole, where the fixed point's matrix is singular and Newton
+**   finishes (~1,800 instructions a trial point there): two more
+**   evaluations of PM_BUDGET_M7_INSNS_PER_EVAL give 13,840, within it.
 **   pm_model_track's ticks, under the same conditions: at most 3,345
 **   instructions measured (2 evaluations; 6,890 at 6 before the next
 **   evaluation took J afresh where a carried one converges slowly, Note 1

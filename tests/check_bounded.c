@@ -352,53 +352,38 @@ END_TEST
 ** up to 6 or 7: counted and printed, as forced by the geometry. */
 START_TEST(test_bounded_track_state_beyond_half_degree)
 {
-    static const double dts[4] = {0.001, 0.01, 0.1, 0.05};
     tu_rng r;
     unsigned long worst = 0, worst_near = 0, n_over = 0, near_over = 0;
-    int i, j, k, n = 0;
+    int i, j, n = 0;
     tu_seed(&r, 1819);
     for (i = 0; i < 200; i++) {
         pm_model m;
-        ck_assert_int_eq(pm_model_init(&m, PM_MOUNT_EQUATORIAL, 1 + i % 2), PM_OK);
-        for (j = 0; j < m.n_terms; j++)
-            m.coef[j] = (2 * tu_uniform(&r) - 1) * (j < 6 ? 10 * DEG : 10 * ARCSEC * 60);
-        ck_assert_int_eq(pm_model_prepare(&m), PM_OK);
+        ck_assert_int_eq(hc_track_model(&m, &r, i), 0);
         for (j = 0; j < 40; j++) {
-            double rho = (j % 2 ? 0.5 + tu_uniform(&r) * 4.5 : 5 + tu_uniform(&r) * 85) * DEG;
-            double hemi = tu_uniform(&r) < 0.5 ? 1 : -1;
-            int flip = tu_uniform(&r) < 0.5;
-            double t = (2 * tu_uniform(&r) - 1) * M_PI;
-            double d = m.coef[4] + hemi * (flip ? M_PI / 2 + rho : M_PI / 2 - rho);
-            double ah, ad, x[2], y[2], bh, bd, dh = 7.2921159e-5 * dts[j % 4];
+            hc_track_tick c;
+            double x[2], y[2], bh, bd;
             unsigned long ev, ev_near;
-            pm_track tk;
             pm_status st;
-            ck_assert_int_eq(pm_model_apply(&m, NULL, t, d, &ah, &ad), PM_OK);
-            ck_assert_int_eq(pm_model_invert_near(&m, NULL, ah - 3 * dh, ad, t, d, &x[0], &x[1]),
-                             PM_OK);
-            ck_assert_int_eq(pm_track_start(&tk, x[0], x[1]), PM_OK);
-            for (k = 2; k >= 1; k--)
-                ck_assert_int_eq(pm_model_track(&m, NULL, &tk, ah - k * dh, ad, &y[0], &y[1]),
-                                 PM_OK);
+            ck_assert_int_eq(hc_track_case(&m, &r, j, &c), 0);
             probe_count = 0;
-            ck_assert_int_eq(pm_model_invert_near(&m, NULL, ah, ad, tk.enc[0], tk.enc[1], &x[0],
-                                                  &x[1]),
+            ck_assert_int_eq(pm_model_invert_near(&m, NULL, c.ah, c.ad, c.tk.enc[0], c.tk.enc[1],
+                                                  &x[0], &x[1]),
                              PM_OK);
             ev_near = probe_count;
             probe_count = 0;
-            st = pm_model_track(&m, NULL, &tk, ah, ad, &y[0], &y[1]);
+            st = pm_model_track(&m, NULL, &c.tk, c.ah, c.ad, &y[0], &y[1]);
             ev = probe_count;
             ck_assert_msg(st == PM_OK, "track: status %d (%.3f deg from the pole)", (int)st,
-                          rho / DEG);
+                          c.rho / DEG);
             ck_assert_uint_le(ev, PM_INVERT_TRACK_MAX_EVALS);
             ck_assert_msg(ev <= TRACK_SEEN_MAX || ev <= ev_near,
                           "track: %lu evaluations where invert_near needs %lu (%.3f deg from "
-                          "the pole, dt %g)", ev, ev_near, rho / DEG, dts[j % 4]);
+                          "the pole, dt %g)", ev, ev_near, c.rho / DEG, c.dt);
             ck_assert_int_eq(pm_model_apply(&m, NULL, y[0], y[1], &bh, &bd), PM_OK);
-            ck_assert_double_le(tu_angle(bh, bd, ah, ad), PM_INVERT_TOL + ROUND_TRIP_SLACK);
+            ck_assert_double_le(tu_angle(bh, bd, c.ah, c.ad), PM_INVERT_TOL + ROUND_TRIP_SLACK);
             if (ev > TRACK_SEEN_MAX)
                 printf("track: %lu evaluations (invert_near %lu): %.3f deg from the pole, "
-                       "dt %g\n", ev, ev_near, rho / DEG, dts[j % 4]);
+                       "dt %g\n", ev, ev_near, c.rho / DEG, c.dt);
             worst = ev > worst ? ev : worst;
             worst_near = ev_near > worst_near ? ev_near : worst_near;
             n_over += ev > TRACK_SEEN_MAX;

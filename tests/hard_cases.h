@@ -12,13 +12,20 @@
 #include "pm.h"
 #include "testutil.h"
 
+/* (static: each includer uses some of them) */
+#if defined(__GNUC__)
+#define HC_FN static __attribute__((unused))
+#else
+#define HC_FN static
+#endif
+
 /* Coefficient scales: ordinary mounts, badly built ones, and absurd. */
 enum { HC_SCALE_NORMAL, HC_SCALE_LARGE, HC_SCALE_HUGE, HC_N_SCALES };
 
 /* A random model of every term kind at the given scale (any order up to
 ** PM_MAX_L, equatorial or alt-az, up to five added terms of the kinds
 ** FOURIER..AUX).  Returns 0, or -1 if the library refused it. */
-static int hc_random_model(pm_model *m, tu_rng *r, int scale)
+HC_FN int hc_random_model(pm_model *m, tu_rng *r, int scale)
 {
     static const double iso_scale[HC_N_SCALES] = {1e-2, 0.3, 1e3};
     static const double an_scale[HC_N_SCALES] = {1e-3, 3e-2, 10.0};
@@ -64,7 +71,7 @@ static int hc_random_model(pm_model *m, tu_rng *r, int scale)
 }
 
 /* A context with ordinary, huge or denormal values. */
-static void hc_random_context(pm_context *c, tu_rng *r)
+HC_FN void hc_random_context(pm_context *c, tu_rng *r)
 {
     static const double vals[] = {0.0, 1e300, -1e300, 4.9e-324, 1e6, -40.0};
     int j;
@@ -80,7 +87,7 @@ static void hc_random_context(pm_context *c, tu_rng *r)
 /* An adversarial apparent position (ha, dec) for model m: the celestial
 ** poles, the mount's pole (within the anisotropic amplitude of it), hour
 ** angles at and next to +-180 deg and far outside (-pi, pi]. */
-static void hc_hard_target(const pm_model *m, tu_rng *r, double *ha, double *dec)
+HC_FN void hc_hard_target(const pm_model *m, tu_rng *r, double *ha, double *dec)
 {
     static const double has[] = {M_PI, -M_PI, 3.141592653589793, -3.1415926535897927,
                                  0.0, -0.0, 1e6, -1e300, 7 * M_PI};
@@ -105,7 +112,7 @@ static void hc_hard_target(const pm_model *m, tu_rng *r, double *ha, double *dec
 
 /* The start of pm_model_invert_near for a hard case: near the solution
 ** just found (sol != 0: within ~1e-3 rad of it), or absurd. */
-static void hc_hard_start(tu_rng *r, const double *sol, double *sh, double *sd)
+HC_FN void hc_hard_start(tu_rng *r, const double *sol, double *sh, double *sd)
 {
     static const double starts[] = {1e300, -1e300, 1e7, M_PI, -M_PI, 0.0};
     if (sol && tu_uniform(r) < 0.5) {
@@ -120,7 +127,7 @@ static void hc_hard_start(tu_rng *r, const double *sol, double *sh, double *sd)
 /* A realistic model near the mount's pole (issue 18): equatorial, order
 ** L = 0..2, every isotropic term uniform within +-10 deg, every harmonic
 ** term within +-10'.  Returns 0, or -1 if the library refused it. */
-static int hc_real_model(pm_model *m, tu_rng *r)
+HC_FN int hc_real_model(pm_model *m, tu_rng *r)
 {
     int order = (int)(tu_uniform(r) * 3), j;
     if (pm_model_init(m, PM_MOUNT_EQUATORIAL, order) != PM_OK)
@@ -135,7 +142,7 @@ static int hc_real_model(pm_model *m, tu_rng *r)
 ** distance uniform in area (40%), uniform (30%), log-uniform from 1e-10
 ** rad (20%), or exactly on the pole's edge (10%: rho = 0).  Returns the
 ** distance (*kind: which of the four). */
-static double hc_real_position(const pm_model *m, tu_rng *r, double rho_max, double rho_min,
+HC_FN double hc_real_position(const pm_model *m, tu_rng *r, double rho_max, double rho_min,
                                int *side, double *t, double *d, int *kind)
 {
     double u = tu_uniform(r), rho;
@@ -154,6 +161,54 @@ static double hc_real_position(const pm_model *m, tu_rng *r, double rho_max, dou
     *t = (2 * tu_uniform(r) - 1) * M_PI;
     *d = m->coef[4] + hemi * (*side == PM_SIDE_NORMAL ? M_PI / 2 - rho : M_PI / 2 + rho);
     return rho;
+}
+
+/* pm_model_track in a loop's steady state (tests/check_bounded.c,
+** test_bounded_track_state_beyond_half_degree; bench/track_worst_cm.c
+** measures the same ticks on the Cortex-M7).  The models: order 1 + i % 2,
+** isotropic terms uniform within +-10 deg, every harmonic term within
+** +-10'.  Returns 0, or -1 if the library refused it. */
+HC_FN int hc_track_model(pm_model *m, tu_rng *r, int i)
+{
+    int j;
+    if (pm_model_init(m, PM_MOUNT_EQUATORIAL, 1 + i % 2) != PM_OK)
+        return -1;
+    for (j = 0; j < m->n_terms; j++)
+        m->coef[j] = (2 * tu_uniform(r) - 1) * (j < 6 ? 10 * DEG : 10 * ARCSEC * 60);
+    return pm_model_prepare(m) == PM_OK ? 0 : -1;
+}
+
+/* Tick j of model m: the target (ah, ad) rho rad from the mount's pole
+** (0.5..5 deg for odd j, 5..90 for even), either pole and side, dt s of
+** sidereal motion per tick (1 ms, 10 ms, 0.1 s, 50 ms by j); tk tracking
+** it three ticks in (started at the solution three ticks before, J taken
+** there, two ticks made), ready for the tick at (ah, ad).  Returns 0, or
+** -1 if a call on the way did not give PM_OK. */
+typedef struct hc_track_tick {
+    double rho, dt, ah, ad;
+    pm_track tk;
+} hc_track_tick;
+
+HC_FN int hc_track_case(const pm_model *m, tu_rng *r, int j, hc_track_tick *c)
+{
+    static const double dts[4] = {0.001, 0.01, 0.1, 0.05};
+    double hemi, t, d, x[2], y[2], dh;
+    int flip, k;
+    c->rho = (j % 2 ? 0.5 + tu_uniform(r) * 4.5 : 5 + tu_uniform(r) * 85) * DEG;
+    hemi = tu_uniform(r) < 0.5 ? 1 : -1;
+    flip = tu_uniform(r) < 0.5;
+    t = (2 * tu_uniform(r) - 1) * M_PI;
+    d = m->coef[4] + hemi * (flip ? M_PI / 2 + c->rho : M_PI / 2 - c->rho);
+    c->dt = dts[j % 4];
+    dh = 7.2921159e-5 * c->dt;
+    if (pm_model_apply(m, NULL, t, d, &c->ah, &c->ad) != PM_OK ||
+        pm_model_invert_near(m, NULL, c->ah - 3 * dh, c->ad, t, d, &x[0], &x[1]) != PM_OK ||
+        pm_track_start(&c->tk, x[0], x[1]) != PM_OK)
+        return -1;
+    for (k = 2; k >= 1; k--)
+        if (pm_model_track(m, NULL, &c->tk, c->ah - k * dh, c->ad, &y[0], &y[1]) != PM_OK)
+            return -1;
+    return 0;
 }
 
 #endif
