@@ -996,9 +996,15 @@ PM_HOT void first_point(Branch *s)
     if (iso_only(m)) {
         /* No anisotropic term: the closed form is the solution (no
         ** evaluation); from a start, on its branch. */
-        if (s->start) {
-            Trig<double> gs = trig_of(s->start[0], s->start[1]);
-            double cdp = gs.cd * k.ce + gs.sd * k.se;
+        if (s->start) { /* (the branch needs the start's declination alone) */
+            double sd0, cd0;
+            if (s->carry && s->carry->strig) {
+                sd0 = s->carry->strig[2];
+                cd0 = s->carry->strig[3];
+            } else {
+                sincos_d(s->start[1], &sd0, &cd0);
+            }
+            double cdp = cd0 * k.ce + sd0 * k.se;
             s->side = cdp * k.ci >= 0 ? 1 : -1;
         }
         s->reachable = iso_inverse0<double>(k, *s->tg, s->side, &g);
