@@ -114,14 +114,14 @@ extern "C" {
 ** 12 -O2, the library at PM_MAX_L = 4:
 **   tracking beyond 0.5 deg of the mount's pole, 10 Hz or faster, terms
 **   within 10 deg / 10' (PM_INVERT_TRACK_MAX_EVALS): the Cortex-M7
-**   double inverse took at most 4,015 instructions, at its worst measured
+**   double inverse took at most 4,020 instructions, at its worst measured
 **   4 evaluations (stop 25; 3,595 at 3 before the anisotropic terms moved
 **   to the mechanical position, 3,575 before the code moved with pm_model_track,
 **   3,565 before solve_branch was split into functions,
 **   3,640 before the typical iteration's lean loop, 3,870 before the
 **   Jacobian's sums were fused); PM_BUDGET_M7_TRACK_INSNS adds 5 more
 **   evaluations of PM_BUDGET_M7_INSNS_PER_EVAL each to 3,595, for the
-**   bound of 8 (16,095: above 4,015 + 4 x 2,500 as well).  The bench's
+**   bound of 8 (16,095: above 4,020 + 4 x 2,500 as well).  The bench's
 **   situations hold no tick that needs Newton; the dearest measured at
 **   all ("make bench-track-worst": check_bounded's 8,000 steady-state
 **   ticks, half of them 0.5-5 deg from the pole) are 8,840 (invert_near)
