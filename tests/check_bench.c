@@ -76,6 +76,40 @@ START_TEST(test_bench_report_cm_rows)
 }
 END_TEST
 
+/* bench/qemu_profile.py on a hand-made QEMU log: translation blocks ("IN:"
+** and their instructions) and executions ("Trace"), two marked regions;
+** a block executed twice counts twice, the markers' own blocks not at all,
+** blocks outside the regions not at all */
+START_TEST(test_bench_qemu_profile)
+{
+    char cmd[4096];
+    const char *d = "build/bench/smoke_qprof";
+    snprintf(cmd, sizeof cmd, "cd '%s' && rm -rf %s && mkdir -p %s && printf '%%s\\n' "
+             "'IN: marker_begin' '0x00000100:  bx lr' '' "
+             "'Trace 0: 0x7f00 [00000000/00000100/00000000/00000000] marker_begin' "
+             "'IN: f' '0x00000200:  movs r0, #1' '0x00000202:  movs r1, #2' '' "
+             "'Trace 0: 0x7f01 [00000000/00000200/00000000/00000000] f' "
+             "'Trace 0: 0x7f01 [00000000/00000200/00000000/00000000] f' "
+             "'IN: g' '0x00000300:  bx lr' '' "
+             "'Trace 0: 0x7f02 [00000000/00000300/00000000/00000000] g' "
+             "'IN: marker_end' '0x00000400:  bx lr' '' "
+             "'Trace 0: 0x7f03 [00000000/00000400/00000000/00000000] marker_end' "
+             "'Trace 0: 0x7f01 [00000000/00000200/00000000/00000000] f' "
+             "'Trace 0: 0x7f00 [00000000/00000100/00000000/00000000] marker_begin' "
+             "'Trace 0: 0x7f02 [00000000/00000300/00000000/00000000] g' "
+             "'Trace 0: 0x7f03 [00000000/00000400/00000000/00000000] marker_end' "
+             "> %s/q.log && /usr/bin/python3 bench/qemu_profile.py %s/q.log > %s/out.txt && "
+             "/usr/bin/python3 -c '"
+             "t = open(\"%s/out.txt\").read().split(\"== \")[1:]\n"
+             "assert len(t) == 2, t\n"
+             "assert t[0].startswith(\"region 0: 5 instructions\"), t\n"
+             "assert \"4.0  f\" in t[0] and \"1.0  g\" in t[0], t\n"
+             "assert t[1].startswith(\"region 1: 1 instructions\"), t\n"
+             "' > %s/check.txt 2>&1", top(), d, d, d, d, d, d, d);
+    ck_assert_msg(sh(cmd) == 0, "qemu_profile.py: see %s/check.txt, out.txt", d);
+}
+END_TEST
+
 /* the explain bench at its smallest size: a JSON line with the time and
 ** the two hidden effects found (timing is judged in bench/, not here) */
 START_TEST(test_bench_explain_smoke)
@@ -106,6 +140,7 @@ static Suite *suite(void)
     TCase *tc = tcase_create("smoke");
     tcase_add_test(tc, test_bench_smoke_json);
     tcase_add_test(tc, test_bench_report_cm_rows);
+    tcase_add_test(tc, test_bench_qemu_profile);
     tcase_add_test(tc, test_bench_explain_smoke);
     tcase_set_timeout(tc, 120);
     suite_add_tcase(s, tc);
