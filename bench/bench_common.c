@@ -13,17 +13,29 @@
 
 const int bench_orders[BENCH_NORDERS] = {0, 1, 2, 4};
 
-const char *const bench_op_name[BENCH_NOPS] = {"empty",     "fwd",       "inv",
-                                               "inv_near",  "naive_fwd", "naive_inv",
-                                               "track10",   "track1k"};
+const char *const bench_op_name[BENCH_NOPS] = {
+    "empty",     "fwd",     "inv",           "inv_near",     "naive_fwd",
+    "naive_inv", "track10", "track1k",       "empty_track10", "empty_track1k"};
 
 int bench_op_supported(const bench_api *api, int op)
 {
     if (op == BENCH_NAIVE_FWD || op == BENCH_NAIVE_INV)
         return api == &bench_api_double;
-    if (op == BENCH_TRACK10 || op == BENCH_TRACK1K)
+    if (op == BENCH_TRACK10 || op == BENCH_TRACK1K || op == BENCH_EMPTY_TRACK10 ||
+        op == BENCH_EMPTY_TRACK1K)
         return api->track != 0;
     return 1;
+}
+
+int bench_loop_op(int op)
+{
+    if (op == BENCH_TRACK10)
+        return BENCH_EMPTY_TRACK10;
+    if (op == BENCH_TRACK1K)
+        return BENCH_EMPTY_TRACK1K;
+    if (op == BENCH_EMPTY_TRACK10 || op == BENCH_EMPTY_TRACK1K)
+        return op;
+    return BENCH_EMPTY;
 }
 
 /* ---------------------------------------------------------------------- */
@@ -163,6 +175,29 @@ static int empty_eval(int slot, double x, double y, double *a, double *b)
 }
 static int (*volatile empty_ptr)(int, double, double, double *, double *) = empty_eval;
 
+/* The tracking loops' empty calls: a state set up by nothing, a tick that
+** returns its target (through a volatile pointer, as empty_eval: not
+** inlined into the loop). */
+static int empty_track_start(void *t, double eh, double ed)
+{
+    (void)t;
+    (void)eh;
+    (void)ed;
+    return 0;
+}
+
+static int empty_track(int slot, void *t, double ah, double ad, double *eh, double *ed)
+{
+    (void)slot;
+    (void)t;
+    *eh = ah;
+    *ed = ad;
+    return 0;
+}
+
+static const bench_api empty_track_api = {"empty", 0, 0, 0, 0, empty_track_start, empty_track};
+static const bench_api *volatile empty_track_ptr = &empty_track_api;
+
 /* pm_model_track's states, one per position, for the tracking ops: each
 ** call is the next tick of that position's loop (the target a tick on),
 ** so every timed call is a tick of a loop in its steady state, the calls
@@ -179,13 +214,17 @@ static struct {
         pm_track_f f;
     } t[BENCH_NPOS];
     long k[BENCH_NPOS]; /* the tick the state is at */
-} track_state[2];
+} track_state[4];
 
 static int track_run(const bench_api *api, int slot, int op, const bench_input *in, int n,
                      double *acc)
 {
-    const double tick = (op == BENCH_TRACK10 ? 0.1 : 0.001) * 7.2921159e-5;
-    int w = op == BENCH_TRACK10 ? 0 : 1, i, bad = 0;
+    const int ten = op == BENCH_TRACK10 || op == BENCH_EMPTY_TRACK10;
+    const double tick = (ten ? 0.1 : 0.001) * 7.2921159e-5;
+    /* (the empty loops keep states of their own: measuring them does not
+    ** set up the library's again) */
+    int w = (ten ? 0 : 1) + (op == BENCH_EMPTY_TRACK10 || op == BENCH_EMPTY_TRACK1K ? 2 : 0);
+    int i, bad = 0;
     double a, b;
     if (track_state[w].in != in || track_state[w].api != api || track_state[w].slot != slot) {
         for (i = 0; i < BENCH_NPOS; i++) {
@@ -245,6 +284,10 @@ int bench_run(const bench_api *api, int slot, int op, const bench_input *in, int
         if (!api->track)
             return n;
         bad += track_run(api, slot, op, in, n, &acc);
+        break;
+    case BENCH_EMPTY_TRACK10:
+    case BENCH_EMPTY_TRACK1K:
+        bad += track_run(empty_track_ptr, slot, op, in, n, &acc);
         break;
     case BENCH_NAIVE_FWD:
         for (i = 0; i < n; i++) {

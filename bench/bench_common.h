@@ -67,9 +67,18 @@ enum {
     BENCH_NAIVE_INV, /* the paper's inverse: the same with -coefficients */
     BENCH_TRACK10,   /* pm_model_track, ticks of 0.1 s (bench_run) */
     BENCH_TRACK1K,   /* pm_model_track, ticks of 1 ms */
+    /* the tracking ops' loops with an empty call of the same shape: the
+    ** loop's cost, which there includes the target's arithmetic (each
+    ** tick's hour angle, in double: emulated on an FPU without double) */
+    BENCH_EMPTY_TRACK10,
+    BENCH_EMPTY_TRACK1K,
     BENCH_NOPS
 };
 extern const char *const bench_op_name[BENCH_NOPS];
+
+/* The op whose cost is op's loop (BENCH_EMPTY, or the tracking ops'
+** empty loops); op itself for those. */
+int bench_loop_op(int op);
 
 /* Whether api has operation op (the naive ones: the double API only). */
 int bench_op_supported(const bench_api *api, int op);

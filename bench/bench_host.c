@@ -11,7 +11,8 @@
 **
 **  Every case runs over the same BENCH_NPOS positions per batch
 **  (bench_common.h); the loop's own cost (an empty function called the
-**  same way) is measured the same way and subtracted.  Before timing, the
+**  same way: for the tracking ops a loop that also computes each tick's
+**  target, bench_loop_op) is measured the same way and subtracted.  Before timing, the
 **  naive evaluation is checked against the library (same terms, agreement
 **  to second order in the coefficients), and every call must return PM_OK.
 */
@@ -166,7 +167,8 @@ int main(int argc, char **argv)
         enum { MAXC = 128, MAXA = 8 };
         const bench_api *c_api[MAXC];
         int c_ai[MAXC], c_slot[MAXC], c_op[MAXC], nc = 0, c, r;
-        double *t = malloc(sizeof(double) * MAXC * (size_t)k), loop[MAXA * BENCH_NORDERS];
+        double *t = malloc(sizeof(double) * MAXC * (size_t)k);
+        double loop[MAXA * BENCH_NORDERS * BENCH_NOPS]; /* by api, order, loop op */
         for (a = 0; a < bench_n_apis; a++)
             for (s = 0; s < BENCH_NORDERS; s++)
                 for (op = 0; op < BENCH_NOPS; op++) {
@@ -194,21 +196,21 @@ int main(int argc, char **argv)
             fprintf(stderr, "pmbench: %d calls did not return PM_OK\n", bad);
             return 1;
         }
-        for (c = 0; c < nc; c++) { /* the loop's cost, per api and order */
+        for (c = 0; c < nc; c++) { /* the loops' costs, per api, order and loop op */
             double m = median(t + c * k, k);
-            if (c_op[c] == BENCH_EMPTY)
-                loop[c_ai[c] * BENCH_NORDERS + c_slot[c]] = m;
+            if (bench_loop_op(c_op[c]) == c_op[c])
+                loop[(c_ai[c] * BENCH_NORDERS + c_slot[c]) * BENCH_NOPS + c_op[c]] = m;
             t[c * k] = m;
         }
         for (c = 0; c < nc; c++) {
             char name[96];
-            double l = loop[c_ai[c] * BENCH_NORDERS + c_slot[c]];
+            const int lo = bench_loop_op(c_op[c]);
+            double l = loop[(c_ai[c] * BENCH_NORDERS + c_slot[c]) * BENCH_NOPS + lo];
             bench_case_name(name, sizeof name, "host", c_op[c], bench_orders[c_slot[c]],
                             c_api[c]->prec);
             fprintf(out, "{\"name\": \"%s\", \"ticks_median\": %.1f, \"batches\": %d, "
                          "\"calls_per_batch\": %d, \"unit\": \"%s\"}\n",
-                    name, c_op[c] == BENCH_EMPTY ? t[c * k] : t[c * k] - l, k, BENCH_NPOS,
-                    TICK_UNIT);
+                    name, lo == c_op[c] ? t[c * k] : t[c * k] - l, k, BENCH_NPOS, TICK_UNIT);
         }
         free(t);
     }

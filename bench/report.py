@@ -38,6 +38,15 @@ def read_jsonl(path):
     return rows
 
 
+def loop_name(name):
+    """The case whose cost is name's loop: the tracking ops' own empty loops
+    (they also compute each tick's target), the empty call otherwise."""
+    m = re.search(r"_(track10|track1k)_", name)
+    if m:
+        return name.replace(m.group(0), "_empty_%s_" % m.group(1))
+    return re.sub(r"_(fwd|inv_near|inv|naive_fwd|naive_inv)_", "_empty_", name)
+
+
 def callgrind(dirname):
     """Instructions per call of each case, loop cost subtracted."""
     raw = {}
@@ -58,7 +67,7 @@ def callgrind(dirname):
         if "_empty_" in name:
             out[name] = v
             continue
-        loop = raw.get(re.sub(r"_(fwd|inv_near|inv|track10|track1k|naive_fwd|naive_inv)_", "_empty_", name), 0)
+        loop = raw.get(loop_name(name), 0)
         out[name] = v - loop
     return out
 

@@ -634,8 +634,10 @@ pm_status pm_model_apply_f(const pm_model_f *m, const pm_context *ctx, double en
     if (!finite(t) || !finite(d))
         return PM_ERR_NONFINITE; /* float overflow in the terms: outputs untouched */
     *app_ha = t;
-    /* float rounding can step past the pole by an ulp of float */
-    *app_dec = d > PI / 2 ? PI / 2 : d < -PI / 2 ? -PI / 2 : d;
+    /* float rounding can step past the pole by an ulp of float (the test
+    ** on the bits first: two double comparisons are calls on an FPU
+    ** without double) */
+    *app_dec = !abs_beyond(d, PI / 2) ? d : below0(d) ? -PI / 2 : PI / 2;
     return PM_OK;
 }
 

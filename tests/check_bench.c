@@ -49,6 +49,10 @@ START_TEST(test_bench_smoke_json)
              "    e = n[\"host_%%s_L%%d_double\" %% (op, L)]\n"
              "    assert isinstance(e[\"ticks_median\"], float)\n"
              "    assert (\"ratio\" in e) == (not op.startswith(\"naive\"))\n"
+             "for op in (\"track10\", \"track1k\"):\n"
+             "  for p in (\"double\", \"float\"):\n"
+             "    assert isinstance(n[\"host_%%s_L2_%%s\" %% (op, p)][\"ticks_median\"], float)\n"
+             "    assert \"ratio\" not in n[\"host_empty_%%s_L2_%%s\" %% (op, p)]\n"
              "' > %s/check.txt 2>&1", top(), d, d);
     ck_assert_msg(sh(cmd) == 0, "results.json malformed: see %s/check.txt", d);
 }
@@ -71,6 +75,12 @@ START_TEST(test_bench_report_cm_rows)
              "n = {e[\"name\"]: e for e in json.load(open(\"%s/results.json\"))}\n"
              "assert n[\"mx_fwd_L2_double\"][\"instructions\"] == 1000.0, n\n"
              "assert n[\"mx_inv_L2_double\"][\"instructions\"] == 2300.0, n\n"
+             "import sys; sys.path.insert(0, \"bench\"); import report\n"
+             "assert report.loop_name(\"host_track10_L2_double\") == "
+             "\"host_empty_track10_L2_double\"\n"
+             "assert report.loop_name(\"host_track1k_L4_float\") == "
+             "\"host_empty_track1k_L4_float\"\n"
+             "assert report.loop_name(\"host_inv_near_L2_double\") == \"host_empty_L2_double\"\n"
              "' > %s/check.txt 2>&1", top(), d, d, d, d, d, d, d);
     ck_assert_msg(sh(cmd) == 0, "report.py's Cortex-M rows: see %s/check.txt, report.txt", d);
 }
