@@ -25,6 +25,17 @@ static int sh(const char *cmd)
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
+/* body run by sh in a fresh scratch directory d (under the top, made anew),
+** with $T the top: the fixtures' files by their own names */
+static int sh_scratch(const char *d, const char *body)
+{
+    char cmd[8192];
+    snprintf(cmd, sizeof cmd,
+             "T=$(cd '%s' && pwd) && cd \"$T\" && rm -rf %s && mkdir -p %s && cd %s && %s",
+             top(), d, d, d, body);
+    return sh(cmd);
+}
+
 START_TEST(test_bench_smoke_json)
 {
     char cmd[4096];
@@ -63,26 +74,27 @@ END_TEST
 ** fix subtracted the "empty" case a second time) */
 START_TEST(test_bench_report_cm_rows)
 {
-    char cmd[4096];
     const char *d = "build/bench/smoke_cm";
-    snprintf(cmd, sizeof cmd, "cd '%s' && rm -rf %s && mkdir -p %s && printf '%%s\\n' "
-             "'BENCH {\"name\": \"mx_empty_L2_double\", \"instructions\": 21.0}' "
-             "'BENCH {\"name\": \"mx_fwd_L2_double\", \"instructions\": 1000.0}' "
-             "'BENCH {\"name\": \"mx_inv_L2_double\", \"instructions\": 2300.0}' "
-             "> %s/mx.out && /usr/bin/python3 bench/report.py --dir %s --targets mx "
-             "> %s/report.txt 2>&1 && /usr/bin/python3 -c '"
-             "import json\n"
-             "n = {e[\"name\"]: e for e in json.load(open(\"%s/results.json\"))}\n"
-             "assert n[\"mx_fwd_L2_double\"][\"instructions\"] == 1000.0, n\n"
-             "assert n[\"mx_inv_L2_double\"][\"instructions\"] == 2300.0, n\n"
-             "import sys; sys.path.insert(0, \"bench\"); import report\n"
-             "assert report.loop_name(\"host_track10_L2_double\") == "
-             "\"host_empty_track10_L2_double\"\n"
-             "assert report.loop_name(\"host_track1k_L4_float\") == "
-             "\"host_empty_track1k_L4_float\"\n"
-             "assert report.loop_name(\"host_inv_near_L2_double\") == \"host_empty_L2_double\"\n"
-             "' > %s/check.txt 2>&1", top(), d, d, d, d, d, d, d);
-    ck_assert_msg(sh(cmd) == 0, "report.py's Cortex-M rows: see %s/check.txt, report.txt", d);
+    ck_assert_msg(
+        sh_scratch(d, "printf '%s\\n' "
+                      "'BENCH {\"name\": \"mx_empty_L2_double\", \"instructions\": 21.0}' "
+                      "'BENCH {\"name\": \"mx_fwd_L2_double\", \"instructions\": 1000.0}' "
+                      "'BENCH {\"name\": \"mx_inv_L2_double\", \"instructions\": 2300.0}' "
+                      "> mx.out && /usr/bin/python3 \"$T/bench/report.py\" --dir . --targets mx "
+                      "> report.txt 2>&1 && /usr/bin/python3 -c '"
+                      "import json, sys\n"
+                      "n = {e[\"name\"]: e for e in json.load(open(\"results.json\"))}\n"
+                      "assert n[\"mx_fwd_L2_double\"][\"instructions\"] == 1000.0, n\n"
+                      "assert n[\"mx_inv_L2_double\"][\"instructions\"] == 2300.0, n\n"
+                      "sys.path.insert(0, sys.argv[1]); import report\n"
+                      "assert report.loop_name(\"host_track10_L2_double\") == "
+                      "\"host_empty_track10_L2_double\"\n"
+                      "assert report.loop_name(\"host_track1k_L4_float\") == "
+                      "\"host_empty_track1k_L4_float\"\n"
+                      "assert report.loop_name(\"host_inv_near_L2_double\") == "
+                      "\"host_empty_L2_double\"\n"
+                      "' \"$T/bench\" > check.txt 2>&1") == 0,
+        "report.py's Cortex-M rows: see %s/check.txt, report.txt", d);
 }
 END_TEST
 
@@ -92,31 +104,31 @@ END_TEST
 ** blocks outside the regions not at all */
 START_TEST(test_bench_qemu_profile)
 {
-    char cmd[4096];
     const char *d = "build/bench/smoke_qprof";
-    snprintf(cmd, sizeof cmd, "cd '%s' && rm -rf %s && mkdir -p %s && printf '%%s\\n' "
-             "'IN: marker_begin' '0x00000100:  bx lr' '' "
-             "'Trace 0: 0x7f00 [00000000/00000100/00000000/00000000] marker_begin' "
-             "'IN: f' '0x00000200:  movs r0, #1' '0x00000202:  movs r1, #2' '' "
-             "'Trace 0: 0x7f01 [00000000/00000200/00000000/00000000] f' "
-             "'Trace 0: 0x7f01 [00000000/00000200/00000000/00000000] f' "
-             "'IN: g' '0x00000300:  bx lr' '' "
-             "'Trace 0: 0x7f02 [00000000/00000300/00000000/00000000] g' "
-             "'IN: marker_end' '0x00000400:  bx lr' '' "
-             "'Trace 0: 0x7f03 [00000000/00000400/00000000/00000000] marker_end' "
-             "'Trace 0: 0x7f01 [00000000/00000200/00000000/00000000] f' "
-             "'Trace 0: 0x7f00 [00000000/00000100/00000000/00000000] marker_begin' "
-             "'Trace 0: 0x7f02 [00000000/00000300/00000000/00000000] g' "
-             "'Trace 0: 0x7f03 [00000000/00000400/00000000/00000000] marker_end' "
-             "> %s/q.log && /usr/bin/python3 bench/qemu_profile.py %s/q.log > %s/out.txt && "
-             "/usr/bin/python3 -c '"
-             "t = open(\"%s/out.txt\").read().split(\"== \")[1:]\n"
-             "assert len(t) == 2, t\n"
-             "assert t[0].startswith(\"region 0: 5 instructions\"), t\n"
-             "assert \"4.0  f\" in t[0] and \"1.0  g\" in t[0], t\n"
-             "assert t[1].startswith(\"region 1: 1 instructions\"), t\n"
-             "' > %s/check.txt 2>&1", top(), d, d, d, d, d, d, d);
-    ck_assert_msg(sh(cmd) == 0, "qemu_profile.py: see %s/check.txt, out.txt", d);
+    ck_assert_msg(
+        sh_scratch(d, "printf '%s\\n' "
+                      "'IN: marker_begin' '0x00000100:  bx lr' '' "
+                      "'Trace 0: 0x7f00 [00000000/00000100/00000000/00000000] marker_begin' "
+                      "'IN: f' '0x00000200:  movs r0, #1' '0x00000202:  movs r1, #2' '' "
+                      "'Trace 0: 0x7f01 [00000000/00000200/00000000/00000000] f' "
+                      "'Trace 0: 0x7f01 [00000000/00000200/00000000/00000000] f' "
+                      "'IN: g' '0x00000300:  bx lr' '' "
+                      "'Trace 0: 0x7f02 [00000000/00000300/00000000/00000000] g' "
+                      "'IN: marker_end' '0x00000400:  bx lr' '' "
+                      "'Trace 0: 0x7f03 [00000000/00000400/00000000/00000000] marker_end' "
+                      "'Trace 0: 0x7f01 [00000000/00000200/00000000/00000000] f' "
+                      "'Trace 0: 0x7f00 [00000000/00000100/00000000/00000000] marker_begin' "
+                      "'Trace 0: 0x7f02 [00000000/00000300/00000000/00000000] g' "
+                      "'Trace 0: 0x7f03 [00000000/00000400/00000000/00000000] marker_end' "
+                      "> q.log && /usr/bin/python3 \"$T/bench/qemu_profile.py\" q.log > out.txt "
+                      "&& /usr/bin/python3 -c '"
+                      "t = open(\"out.txt\").read().split(\"== \")[1:]\n"
+                      "assert len(t) == 2, t\n"
+                      "assert t[0].startswith(\"region 0: 5 instructions\"), t\n"
+                      "assert \"4.0  f\" in t[0] and \"1.0  g\" in t[0], t\n"
+                      "assert t[1].startswith(\"region 1: 1 instructions\"), t\n"
+                      "' > check.txt 2>&1") == 0,
+        "qemu_profile.py: see %s/check.txt, out.txt", d);
 }
 END_TEST
 
