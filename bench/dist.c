@@ -53,23 +53,13 @@ int dist_runnable(const dist_call *c, int prec, const int *have_f)
     return prec == 0 || (prec == 1 && have_f[c->model]) || (prec == 2 && c->have_tk);
 }
 
-/* pm_model_track's state at the tick before c's, in a loop that has been
-** tracking c's target (the solution (t, d) of c's tick known) for three
-** ticks of dh radians of hour angle: started at the solution three ticks
-** before, J taken there, the last step known (where the ticks before got
-** PM_OK: within the anisotropic amplitude of the mount's pole they may
-** not, and the state is then as those calls left it). */
+/* pm_model_track's state at the tick before c's, three ticks into its
+** loop (hc_track_state: warnings on the way allowed, the state then as
+** those calls left it). */
 static int track_state(const pm_model *m, dist_call *c, double t, double d, double dh)
 {
-    double x[2], y[2];
-    int k;
-    if (pm_model_invert_near(m, NULL, c->ah - 3 * dh, c->ad, t, d, &x[0], &x[1]) < 0)
+    if (hc_track_state(m, c->ah, c->ad, t, d, dh, &c->tk) < 0)
         return -1;
-    if (pm_track_start(&c->tk, x[0], x[1]) != PM_OK)
-        return -1;
-    for (k = 2; k >= 1; k--)
-        if (pm_model_track(m, NULL, &c->tk, c->ah - k * dh, c->ad, &y[0], &y[1]) < 0)
-            return -1;
     c->have_tk = 1;
     return 0;
 }

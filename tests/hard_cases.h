@@ -178,6 +178,34 @@ HC_FN int hc_track_model(pm_model *m, tu_rng *r, int i)
     return pm_model_prepare(m) == PM_OK ? 0 : -1;
 }
 
+/* pm_model_track's state tk in a loop that has tracked the target (ah, ad)
+** for three ticks of dh radians of hour angle, its solution (t, d) known:
+** started at the solution three ticks before (J taken there), the two
+** ticks before (ah, ad) made.  Returns the first error, else the largest
+** status on the way (PM_OK, or a warning: within the anisotropic
+** amplitude of the mount's pole a tick may end in one, and the state is
+** then as it left it).  (bench/dist.c, hc_track_case) */
+HC_FN pm_status hc_track_state(const pm_model *m, double ah, double ad, double t, double d,
+                               double dh, pm_track *tk)
+{
+    double x[2], y[2];
+    pm_status st, worst;
+    int k;
+    worst = pm_model_invert_near(m, NULL, ah - 3 * dh, ad, t, d, &x[0], &x[1]);
+    if (worst < 0)
+        return worst;
+    st = pm_track_start(tk, x[0], x[1]);
+    if (st != PM_OK)
+        return st;
+    for (k = 2; k >= 1; k--) {
+        st = pm_model_track(m, NULL, tk, ah - k * dh, ad, &y[0], &y[1]);
+        if (st < 0)
+            return st;
+        worst = st > worst ? st : worst;
+    }
+    return worst;
+}
+
 /* Tick j of model m: the target (ah, ad) rho rad from the mount's pole
 ** (0.5..5 deg for odd j, 5..90 for even), either pole and side, dt s of
 ** sidereal motion per tick (1 ms, 10 ms, 0.1 s, 50 ms by j); tk tracking
@@ -192,22 +220,17 @@ typedef struct hc_track_tick {
 HC_FN int hc_track_case(const pm_model *m, tu_rng *r, int j, hc_track_tick *c)
 {
     static const double dts[4] = {0.001, 0.01, 0.1, 0.05};
-    double hemi, t, d, x[2], y[2], dh;
-    int flip, k;
+    double hemi, t, d;
+    int flip;
     c->rho = (j % 2 ? 0.5 + tu_uniform(r) * 4.5 : 5 + tu_uniform(r) * 85) * DEG;
     hemi = tu_uniform(r) < 0.5 ? 1 : -1;
     flip = tu_uniform(r) < 0.5;
     t = (2 * tu_uniform(r) - 1) * M_PI;
     d = m->coef[4] + hemi * (flip ? M_PI / 2 + c->rho : M_PI / 2 - c->rho);
     c->dt = dts[j % 4];
-    dh = 7.2921159e-5 * c->dt;
     if (pm_model_apply(m, NULL, t, d, &c->ah, &c->ad) != PM_OK ||
-        pm_model_invert_near(m, NULL, c->ah - 3 * dh, c->ad, t, d, &x[0], &x[1]) != PM_OK ||
-        pm_track_start(&c->tk, x[0], x[1]) != PM_OK)
+        hc_track_state(m, c->ah, c->ad, t, d, 7.2921159e-5 * c->dt, &c->tk) != PM_OK)
         return -1;
-    for (k = 2; k >= 1; k--)
-        if (pm_model_track(m, NULL, &c->tk, c->ah - k * dh, c->ad, &y[0], &y[1]) != PM_OK)
-            return -1;
     return 0;
 }
 
