@@ -494,6 +494,32 @@ START_TEST(test_smooth_alternative)
 }
 END_TEST
 
+/* A degree-2 distortion (explain_campaign.py's single_higher_order_gem_07,
+** seed 1; the command in the file's first line) on a German mount's one
+** pier side, declinations sampled over 102 deg: half a cycle of a two-cycle
+** declination term fits it as a bump.  The full fit may settle a
+** periodogram peak on a lower period than the search's floor, but not
+** below one cycle over the range sampled (refine_floor): else the bump was
+** named a periodic error of 2 cycles, 20" +- 5", without the smooth
+** reading beside it. */
+START_TEST(test_subcycle_not_periodic)
+{
+    const char *top = getenv("PM_TOP");
+    char path[512], err[512];
+    pmx_options o;
+    pmx_result r;
+    const pmx_finding *f;
+    snprintf(path, sizeof path, "%s/tests/data/indep_ho_gem_subcycle.dat", top ? top : ".");
+    pmx_options_default(&o);
+    ck_assert_msg(pmx_explain_opts(path, &o, &r, err, sizeof err) == 0, "%s", err);
+    ck_assert_int_ge(r.n_findings, 1);
+    f = &r.findings[0];
+    printf("check_explain_reading: indep_ho_gem_subcycle.dat: first finding %s (G %g), "
+           "%d alternative(s)\n", f->effect, f->cycles_per_rev, f->n_alternatives);
+    ck_assert_str_eq(f->effect, "higher_order");
+}
+END_TEST
+
 static Suite *suite(void)
 {
     Suite *s = suite_create("explain_reading");
@@ -506,6 +532,7 @@ static Suite *suite(void)
     tcase_add_test(t, test_backward_pass);
     tcase_add_loop_test(t, test_generic_reading, 0, 2);
     tcase_add_test(t, test_smooth_alternative);
+    tcase_add_test(t, test_subcycle_not_periodic);
     tcase_add_loop_test(t, test_pairs_curve, 0, (int)(sizeof PAIRS / sizeof PAIRS[0]));
     suite_add_tcase(s, t);
     return s;

@@ -90,8 +90,9 @@ const char *axis_word(const Run &run, int axis, bool raw);
 // either way); beside another G, the half-width of the chi^2 parabola.  An
 // axis sampled over part of its circle (*sampled_deg) resolves G only to
 // about a turn's worth of phase over that extent: 80 deg of an axis cannot
-// always tell 309 teeth from 310.  Within the periods searched (from
-// lowest_period to opt.g_max).
+// always tell 309 teeth from 310.  Within the periods the full fit may
+// settle on (from refine_floor, one cycle over the sampled range, to
+// opt.g_max).
 const double PERIOD_RANGE_CHI2 = 3.84; // chi^2(1) at 5%
 void period_range(const Run &run, const State &st, const ExplainOptions &opt, const Fit &own_fit,
                   const std::vector<std::string> &adds, int comp, double G, double *lo,
