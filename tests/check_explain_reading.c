@@ -66,6 +66,21 @@ static void check_reading(const pmx_result *r, const char *what, double truth)
                   "%s: %.4f +- %.4f, truth %.4f", what, x->value, x->error, truth);
 }
 
+/* explain a run of tests/data with options o (pmx_options_default where
+** NULL); a failure to explain it fails the test. */
+static void explain_data(const char *name, const pmx_options *o, pmx_result *r)
+{
+    const char *top = getenv("PM_TOP");
+    char path[512], err[512];
+    pmx_options d;
+    if (!o) {
+        pmx_options_default(&d);
+        o = &d;
+    }
+    snprintf(path, sizeof path, "%s/tests/data/%s", top ? top : ".", name);
+    ck_assert_msg(pmx_explain_opts(path, o, r, err, sizeof err) == 0, "%s: %s", name, err);
+}
+
 /* The independent gimbal: IH 2.5 deg, ID -0.3 deg, CH 40", NP -25",
 ** MA 90" (axis east of the pole), ME -60" (below it), sag 15" toward the
 ** zenith.  Indices are read as true minus encoder: -IH, -ID. */
@@ -380,15 +395,12 @@ END_TEST
 
 START_TEST(test_backward_pass)
 {
-    const char *top = getenv("PM_TOP");
-    char path[512], err[512];
     pmx_options o;
     pmx_result r;
     int k, sag = -1, temp = -1;
-    snprintf(path, sizeof path, "%s/tests/data/indep_temp_sag_fork.dat", top ? top : ".");
     pmx_options_default(&o);
     o.order = 0;
-    ck_assert_msg(pmx_explain_opts(path, &o, &r, err, sizeof err) == 0, "%s", err);
+    explain_data("indep_temp_sag_fork.dat", &o, &r);
     ck_assert_int_eq(r.n_withdrawn, 1);
     ck_assert_str_eq(r.withdrawn[0], "time_drift");
     for (k = 0; k < r.n_findings; k++) {
@@ -411,8 +423,7 @@ START_TEST(test_backward_pass)
     /* a German mount's sag and temperature drift against an order-0
     ** baseline: higher_order (which holds the sag exactly) is found first
     ** and withdrawn for tube flexure */
-    snprintf(path, sizeof path, "%s/tests/data/indep_temp_sag_gem.dat", top ? top : ".");
-    ck_assert_msg(pmx_explain_opts(path, &o, &r, err, sizeof err) == 0, "%s", err);
+    explain_data("indep_temp_sag_gem.dat", &o, &r);
     ck_assert_int_eq(r.n_withdrawn, 1);
     ck_assert_str_eq(r.withdrawn[0], "higher_order");
     sag = temp = -1;
@@ -438,15 +449,10 @@ START_TEST(test_generic_reading)
 {
     static const struct { const char *file; double noise; } C[] = {
         {"indep_ho_altaz.dat", 1.6181809022483622}, {"indep_ho_gem.dat", 2.872469262742089}};
-    const char *top = getenv("PM_TOP");
-    char path[512], err[512];
-    pmx_options o;
     pmx_result r;
     const pmx_finding *f;
     int k;
-    snprintf(path, sizeof path, "%s/tests/data/%s", top ? top : ".", C[_i].file);
-    pmx_options_default(&o);
-    ck_assert_msg(pmx_explain_opts(path, &o, &r, err, sizeof err) == 0, "%s", err);
+    explain_data(C[_i].file, NULL, &r);
     ck_assert_int_ge(r.n_findings, 1);
     f = &r.findings[0];
     printf("check_explain_reading: %s: first finding %s, sigma %.3f\" -> %.3f\" (noise %.3f\"), "
@@ -475,15 +481,10 @@ END_TEST
 ** observation that separates them. */
 START_TEST(test_smooth_alternative)
 {
-    const char *top = getenv("PM_TOP");
-    char path[512], err[512];
-    pmx_options o;
     pmx_result r;
     const pmx_finding *f;
     int j, smooth = -1;
-    snprintf(path, sizeof path, "%s/tests/data/indep_ho_fork_dec.dat", top ? top : ".");
-    pmx_options_default(&o);
-    ck_assert_msg(pmx_explain_opts(path, &o, &r, err, sizeof err) == 0, "%s", err);
+    explain_data("indep_ho_fork_dec.dat", NULL, &r);
     ck_assert_int_ge(r.n_findings, 1);
     f = &r.findings[0];
     for (j = 0; j < f->n_alternatives; j++)
@@ -514,14 +515,9 @@ END_TEST
 ** reading beside it. */
 START_TEST(test_subcycle_not_periodic)
 {
-    const char *top = getenv("PM_TOP");
-    char path[512], err[512];
-    pmx_options o;
     pmx_result r;
     const pmx_finding *f;
-    snprintf(path, sizeof path, "%s/tests/data/indep_ho_gem_subcycle.dat", top ? top : ".");
-    pmx_options_default(&o);
-    ck_assert_msg(pmx_explain_opts(path, &o, &r, err, sizeof err) == 0, "%s", err);
+    explain_data("indep_ho_gem_subcycle.dat", NULL, &r);
     ck_assert_int_ge(r.n_findings, 1);
     f = &r.findings[0];
     printf("check_explain_reading: indep_ho_gem_subcycle.dat: first finding %s (G %g), "
