@@ -239,15 +239,19 @@ double lowest_period(const Run &run, const std::vector<int> &idx, int comp,
 // and a three-cycle runout must stay within reach there.  The search
 // itself keeps its one and a half cycles: a peak below that is not called
 // periodic at all.
-double refine_floor(const Run &run, const std::vector<int> &idx, int comp,
-                    const ExplainOptions &opt)
+double refine_floor(double extent, double n, const ExplainOptions &opt)
 {
-    const double n = (double)idx.size(), extent = sampled_extent(run, idx, comp);
     if (!(n > 1 && extent > 0))
         return lowest_period(extent, opt);
     const double range =
         std::min(2 * PI, extent * (n + 1) / (n - 1) * (1 + 2 * std::sqrt(2.0) / n));
     return std::max(opt.g_min, 2 * PI / range);
+}
+
+double refine_floor(const Run &run, const std::vector<int> &idx, int comp,
+                    const ExplainOptions &opt)
+{
+    return refine_floor(sampled_extent(run, idx, comp), (double)idx.size(), opt);
 }
 
 // The periodogram of one axis.  A period is identifiable as periodic only
@@ -449,7 +453,7 @@ void period_range(const Run &run, const State &st, const ExplainOptions &opt, co
                   double *hi, double *sampled_deg)
 {
     const double extent = sampled_extent(run, st.use, comp);
-    const double g_lo = refine_floor(run, st.use, comp, opt), g_hi = opt.g_max;
+    const double g_lo = refine_floor(extent, (double)st.use.size(), opt), g_hi = opt.g_max;
     *lo = *hi = G;
     *sampled_deg = extent * 180 / PI;
     const std::string prefix = comp ? "dec_periodic:" : "ha_periodic:";
