@@ -971,7 +971,7 @@ py::tuple fit_run(const RunData &d, int order, std::vector<std::string> adds, bo
 // pmfit explain RUN --json, as the same JSON text (json.loads in Python).
 std::string explain_run(const RunData &d, int order, std::vector<std::string> adds, double alpha,
                         std::vector<double> gears_ha, std::vector<double> gears_dec, bool pairs,
-                        int folds)
+                        int folds, bool compose)
 {
     if (order < 0 || order > PM_MAX_L)
         fail(K_ARGUMENT, "order " + std::to_string(order) + ": expected 0.." + std::to_string(PM_MAX_L));
@@ -993,6 +993,7 @@ std::string explain_run(const RunData &d, int order, std::vector<std::string> ad
     eo.gears_dec = gears_dec;
     eo.pairs = pairs;
     eo.folds = folds;
+    eo.compose = compose;
     // explain() fits through pmhost::do_fit's one static workspace: the GIL
     // is kept, so that two Python threads never explain at once.
     Explanation ex;

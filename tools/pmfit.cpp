@@ -68,6 +68,7 @@ struct Options {
     std::string plots;             // explain: --plots DIR
     double alpha = 0.01;           // explain: --alpha
     std::vector<double> gears_ha, gears_dec; // explain: --gear [ha:|dec:]G
+    bool compose = true;           // explain: the baseline composed as a gimbal (--no-compose: not)
     bool robust = false;           // fit, explain: --robust (docs/robust.md)
     double clip = ROBUST_DEFAULT_CLIP; // --clip K
     bool clip_given = false;
@@ -153,7 +154,7 @@ void usage(FILE *f)
         "\n"
         "usage: pmfit explain RUN [--order L] [--add EFFECT ...] [--json] [--plots DIR]\n"
         "                     [--alpha P] [--gear [ha:|dec:]G ...] [--no-refraction]\n"
-        "                     [--skip-bad] [--robust [--clip K]]\n"
+        "                     [--skip-bad] [--robust [--clip K]] [--no-compose]\n"
         "\n"
         "  fits the baseline model (order L, default 1, plus --add terms), locates where the\n"
         "  residuals are too large, names the physics left out (ha_periodic, dec_periodic,\n"
@@ -165,7 +166,9 @@ void usage(FILE *f)
         "  robust fit of the baseline keeps (the rejected ones are listed); --gear G: a known\n"
         "  gear period (cycles per revolution, e.g. the worm's tooth count; ha:G or dec:G for\n"
         "  one axis, repeatable): the periodic search looks at the given periods only, so a\n"
-        "  smaller periodic error is significant (docs/explain.md)\n"
+        "  smaller periodic error is significant (docs/explain.md); the baseline's anisotropic\n"
+        "  terms are read as the mount's gimbal composes them, their second-order part taken\n"
+        "  out before the search where that fits better (--no-compose: to first order)\n"
         "\n"
         "usage: pmfit eval MODEL RUN [--json] [--residuals FILE] [--no-refraction] [--skip-bad]\n"
         "\n"
@@ -442,6 +445,8 @@ bool explain_option(Options &o, const Cmd &c, Args &g)
         o.plots = g.need("a directory");
     } else if (a == "--alpha") {
         o.alpha = number(a, g.need("a probability"), 1e-12, 0.5);
+    } else if (a == "--no-compose") {
+        o.compose = false;
     } else if (a == "--gear") {
         std::string v = g.need("a gear period in cycles per revolution ([ha:|dec:]G)");
         bool ha = true, dec = true;
@@ -1201,6 +1206,7 @@ int cmd_explain(const Options &o, const Run &full)
     eo.alpha = o.alpha;
     eo.gears_ha = o.gears_ha;
     eo.gears_dec = o.gears_dec;
+    eo.compose = o.compose;
     // --robust: explain the observations a robust fit of the baseline keeps
     Run clean;
     RobustFit rf;

@@ -655,13 +655,14 @@ def fit(enc_ha, enc_dec, app_ha, app_dec, *, order=1, add=(), split=False, mount
 
 
 def explain(run, *, order=1, add=(), alpha=0.01, gears=(), gears_ha=(), gears_dec=(),
-            pairs=True, folds=5):
+            pairs=True, folds=5, compose=True):
     """What did the model leave out? ``pmfit explain RUN --json`` as a dict
     (keys in docs/formats.md, "pmfit explain --json"; docs/explain.md for
     the method): the baseline, its physical reading, where the residuals are
     too large, the findings with their sizes and false-alarm probabilities,
     and the final model.  ``gears``: known gear periods (cycles per
-    revolution) of both axes (--gear G), ``gears_ha``/``gears_dec`` of one."""
+    revolution) of both axes (--gear G), ``gears_ha``/``gears_dec`` of one;
+    ``compose=False``: the baseline read to first order (--no-compose)."""
     r = _run(run)
 
     def g(name, v):
@@ -672,7 +673,7 @@ def explain(run, *, order=1, add=(), alpha=0.01, gears=(), gears_ha=(), gears_de
     if not isinstance(folds, (int, _np.integer)) or isinstance(folds, bool):
         raise ArgumentError("folds: expected an integer")
     text = _pm.explain_run(r._data, _order(order), _adds(add), float(alpha), gh, gd,
-                           bool(pairs), int(folds))
+                           bool(pairs), int(folds), bool(compose))
     return _json.loads(text)
 
 

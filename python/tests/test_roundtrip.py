@@ -278,6 +278,17 @@ def test_explain_options_match_pmfit(sim_dir):
     assert got["baseline"]["order"] == 2
 
 
+def test_explain_compose_matches_pmfit():
+    """compose=False is pmfit explain --no-compose (docs/explain.md, step 1): on a run of
+    10' of gimbal anisotropy, the composition taken out is reported, and off it is 0."""
+    run = os.path.join(TOP, "tests", "data", "indep_aniso600_gem.dat")
+    on = pm.explain(run)
+    off = pm.explain(run, compose=False)
+    assert off == json.loads(run_cmd(PMFIT, "explain", run, "--json", "--no-compose").stdout)
+    assert on["baseline"]["composition_rms_arcsec"] > 0.3
+    assert off["baseline"]["composition_rms_arcsec"] == 0
+
+
 def test_read_run_columns(tmp_path):
     """The reader's columns: what the file says, in radians, pier from the
     column, skipped records listed with file:line."""

@@ -1308,8 +1308,10 @@ Explanation explain_pass(const Run &run, const ExplainOptions &opt)
 // The pipeline, and again without any family the backward pass withdrew
 // (so that every finding is described in a model without it), until
 // nothing more is withdrawn.
-Explanation explain(const Run &run, const ExplainOptions &opt)
+Explanation explain(const Run &given, const ExplainOptions &opt)
 {
+    double comp = 0;
+    const Run run = opt.compose ? composed_run(given, opt, &comp) : given;
     Explanation ex = explain_pass(run, opt);
     ExplainOptions o = opt;
     for (int round = 0; round < 4 && !ex.withdrawn.empty(); round++) {
@@ -1324,6 +1326,7 @@ Explanation explain(const Run &run, const ExplainOptions &opt)
         if (!more)
             break;
     }
+    ex.compose_rms_arcsec = arcsec(comp);
     return ex;
 }
 
@@ -1356,6 +1359,7 @@ extern "C" void pmx_options_default(pmx_options *o)
     o->n_gears = 0;
     o->pairs = d.pairs ? 1 : 0;
     o->folds = d.folds;
+    o->compose = d.compose ? 1 : 0;
 }
 
 namespace {
@@ -1414,6 +1418,7 @@ void explanation_to_c(const pmhost::Explanation &ex, pmx_result &r)
         b.error = it.error;
     }
     r.physical_reading = !ex.physical_reading.empty();
+    r.compose_rms_arcsec = ex.compose_rms_arcsec;
     for (const Finding &w : ex.withdrawn)
         if (r.n_withdrawn < PMX_MAX_FINDINGS)
             std::snprintf(r.withdrawn[r.n_withdrawn++], sizeof r.withdrawn[0], "%s", w.effect.c_str());
@@ -1439,6 +1444,7 @@ extern "C" int pmx_explain_opts(const char *path, const pmx_options *opt, pmx_re
         o.alpha = opt->alpha;
         o.pairs = opt->pairs != 0;
         o.folds = opt->folds;
+        o.compose = opt->compose != 0;
         for (int i = 0; i < n_gears; i++) {
             if (!(gears[i] > 0 && gears[i] <= 1e6)) {
                 set_err(err, errlen, "pmx_explain: a gear period must be in (0, 1e6]");

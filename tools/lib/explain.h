@@ -67,6 +67,7 @@ typedef struct pmx_result {
     int physical_reading;            /* 1: order 0 + one term predicts as well as order 1 */
     int n_withdrawn;                 /* found, then not needed once later findings were in */
     char withdrawn[PMX_MAX_FINDINGS][24];
+    double compose_rms_arcsec;       /* the composition taken out, RMS per axis (0: none) */
 } pmx_result;
 
 /* Explain the run in file path from a baseline of the given order; alpha is
@@ -89,6 +90,8 @@ typedef struct pmx_options {
     int n_gears;
     int pairs;                       /* 1: where no single family passes, try pairs */
     int folds;                       /* k of the k-fold cross-validation */
+    int compose;                     /* 1: the baseline composed as a gimbal
+                                        (docs/explain.md, step 1); 0: --no-compose */
 } pmx_options;
 
 void pmx_options_default(pmx_options *o);

@@ -32,6 +32,8 @@ struct ExplainOptions {
     double close_delta_bic = 6;    // alternatives: Delta BIC below this (for readings of
                                    // as many terms: a likelihood ratio below 20)
     std::vector<std::string> exclude; // families not to try (the ones a backward pass withdrew)
+    bool compose = true;           // take out the baseline's second-order
+                                   // composition (docs/explain.md, step 1; --no-compose)
 };
 
 // One located statistic: a part of the data whose residuals are too large.
@@ -108,6 +110,7 @@ struct Explanation {
     std::vector<int> kept;               // observations used by the final fit
     std::vector<std::string> final_adds;
     int final_order = 1;
+    double compose_rms_arcsec = 0;       // the composition taken out (RMS per axis), 0 if none
 };
 
 // The pipeline: baseline -> locate -> candidates -> select (singles, then

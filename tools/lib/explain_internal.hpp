@@ -98,6 +98,12 @@ void period_range(const Run &run, const State &st, const ExplainOptions &opt, co
                   const std::vector<std::string> &adds, int comp, double G, double *lo,
                   double *hi, double *sampled_deg);
 
+// Step 1's composition (explain_compose.cpp): the run with the second-order composition
+// of its baseline's anisotropic terms (read as gimbal parameters) taken out
+// of the observed positions; *rms its RMS per axis (radians).  The run as
+// it is where the baseline does not fit.
+Run composed_run(const Run &run, const ExplainOptions &opt, double *rms);
+
 // The finding(s) one accepted candidate makes: one per member family.
 std::vector<Finding> describe(const Run &run, const State &st, const Candidate &c,
                               const ExplainOptions &opt);

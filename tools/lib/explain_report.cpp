@@ -84,7 +84,8 @@ std::string explain_json(const Run &run, const Explanation &ex, int order)
     std::string j = "\"baseline\": {\"order\": " + std::to_string(order) +
                     ", \"sigma_arcsec\": " + num(ex.base_sigma_arcsec) +
                     ", \"cv_rms_arcsec\": " + num(ex.base_cv_rms_arcsec) +
-                    ", \"n_params\": " + std::to_string(ex.base_n_params) + "}, \"mount\": " +
+                    ", \"n_params\": " + std::to_string(ex.base_n_params) +
+                    ", \"composition_rms_arcsec\": " + num(ex.compose_rms_arcsec) + "}, \"mount\": " +
                     str(run.mount == PM_MOUNT_ALTAZ ? "altaz" : "equatorial") +
                     ", \"interpretation\": " + interpretation_json(ex) + ", \"physical_reading\": " +
                     (ex.physical_reading.empty() ? "null" : str(ex.physical_reading)) +
@@ -203,6 +204,10 @@ void print_explain_text(const Run &run, const Explanation &ex, int order, bool a
     std::printf("baseline: order %d%s, P = %d, unbiased sigma %.3f\", cross-validated RMS %s\n",
                 order, added ? " + added terms" : "", ex.base_n_params, ex.base_sigma_arcsec,
                 cv_text(ex.base_cv_rms_arcsec).c_str());
+    if (ex.compose_rms_arcsec >= 0.01)
+        std::printf("  its anisotropic terms composed as the mount's gimbal composes them: "
+                    "%.3f\" RMS of second order, taken out of the observed positions\n",
+                    ex.compose_rms_arcsec);
     if (!ex.interpretation.empty()) {
         std::printf("\nwhat the baseline holds (its physical reading):\n");
         for (const Interpretation &it : ex.interpretation)
