@@ -291,7 +291,7 @@ void null_bounds(const pm_model &m, double bound[N_NULL])
 // failed (*out is then the last good correction).
 bool compose_passes(const Run &run, const ExplainOptions &opt, const std::vector<int> &all,
                     int passes, bool nulls, Null *nu, Run *out, double *chi2, int *P,
-                    double *chi2_first)
+                    double *chi2_first, Fit *first_fit = nullptr)
 {
     double before = 0;
     for (int pass = 0; pass <= passes; pass++) {
@@ -302,6 +302,8 @@ bool compose_passes(const Run &run, const ExplainOptions &opt, const std::vector
         *P = f.P;
         if (pass == 0 && chi2_first)
             *chi2_first = f.chi2;
+        if (pass == 0 && first_fit)
+            *first_fit = f;
         if (pass == passes || (nulls && pass >= 2 && !(f.chi2 < 0.999 * before)))
             return true;
         before = f.chi2;
@@ -319,6 +321,26 @@ bool compose_passes(const Run &run, const ExplainOptions &opt, const std::vector
         *out = next;
     }
     return true;
+}
+
+// Whether a fitted baseline determines its anisotropic terms: every
+// harmonic coefficient of degree >= 1 known to better than the largest of
+// them.  A gimbal's second-order terms are products of its parameters'
+// variations; where some combination of them is not determined at the
+// scale of the distortion itself (an order-3 baseline on 129 alt-az
+// points: coefficients of 7,500" +- 28,000"), its products are arbitrary,
+// and a "composition" of 94" came out of one.
+bool determined(const Fit &f)
+{
+    double big = 0, err = 0;
+    for (int i = 0; i < f.f.model.n_base; i++) {
+        const pm_term &t = f.f.model.term[i];
+        if (t.kind == PM_TERM_SH && t.l >= 1) {
+            big = std::max(big, std::fabs(f.f.model.coef[i]));
+            err = std::max(err, f.f.res.err[i]);
+        }
+    }
+    return err < big;
 }
 
 // Every k-th observation of run, k the smallest that leaves at most `most`.
@@ -355,8 +377,8 @@ std::vector<int> all_of(size_t n)
 // amounts fitted to a run without them would pass once in a hundred); the
 // composed reading is kept only where it fits better than the
 // first-order one (chi^2; the same terms, the reading the data prefer).
-// Else, and where the baseline does not fit or has no anisotropic terms,
-// the run as it is and *rms = 0.
+// Else, and where the baseline does not fit, has no anisotropic terms or
+// does not determine them, the run as it is and *rms = 0.
 Run composed_run(const Run &run, const ExplainOptions &opt, double *rms)
 {
     const double CHI2_3_AT_1PC = 11.34;
@@ -367,7 +389,10 @@ Run composed_run(const Run &run, const ExplainOptions &opt, double *rms)
     Run plain = run;
     double chi2_first = 0, chi2_plain = 0, chi2_null = 0;
     int P = 0;
-    if (!compose_passes(run, opt, all, 2, false, &none, &plain, &chi2_plain, &P, &chi2_first))
+    Fit first;
+    if (!compose_passes(run, opt, all, 2, false, &none, &plain, &chi2_plain, &P, &chi2_first,
+                        &first) ||
+        !determined(first))
         return run;
     const Run *best = &plain;
     double chi2_best = chi2_plain;
