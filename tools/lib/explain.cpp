@@ -861,7 +861,7 @@ std::vector<Candidate> pairs(const Run &run, const State &st, const std::vector<
 {
     std::vector<const Candidate *> ok;
     for (const Candidate &c : singles)
-        if (c.fit.ok && c.effect != "higher_order" && c.effect != "outlier" && c.fit.P > st.cur.P)
+        if (c.fit.ok && pairable(c) && c.fit.P > st.cur.P)
             ok.push_back(&c);
     std::vector<Candidate> out;
     for (size_t a = 0; a < ok.size(); a++)
@@ -1179,7 +1179,7 @@ double step_tests(const std::vector<Candidate> &cands, const ExplainOptions &opt
 {
     double m = 0;
     for (const Candidate &c : cands)
-        if (c.effect != "higher_order" && c.effect != "outlier")
+        if (pairable(c))
             m += 1;
     return (double)cands.size() + (opt.pairs ? m * (m - 1) / 2 : 0.0);
 }

@@ -189,39 +189,6 @@ double sum_sq(const std::vector<double> &r)
     return s;
 }
 
-// Solve the n x n system A x = b (n <= N_NULL) by Gaussian elimination
-// with partial pivoting; false where A is singular to working precision.
-bool solve_small(int n, double A[N_NULL][N_NULL], double b[N_NULL], double x[N_NULL])
-{
-    double scale = 0;
-    for (int i = 0; i < n; i++)
-        scale = std::max(scale, std::fabs(A[i][i]));
-    for (int c = 0; c < n; c++) {
-        int p = c;
-        for (int r = c + 1; r < n; r++)
-            if (std::fabs(A[r][c]) > std::fabs(A[p][c]))
-                p = r;
-        if (!(std::fabs(A[p][c]) > 1e-12 * scale))
-            return false;
-        for (int j = 0; j < n; j++)
-            std::swap(A[c][j], A[p][j]);
-        std::swap(b[c], b[p]);
-        for (int r = c + 1; r < n; r++) {
-            const double f = A[r][c] / A[c][c];
-            for (int j = c; j < n; j++)
-                A[r][j] -= f * A[c][j];
-            b[r] -= f * b[c];
-        }
-    }
-    for (int r = n - 1; r >= 0; r--) {
-        double t = b[r];
-        for (int j = r + 1; j < n; j++)
-            t -= A[r][j] * x[j];
-        x[r] = t / A[r][r];
-    }
-    return true;
-}
-
 // One Gauss-Newton step for the null amounts on the refitted residuals
 // (derivatives by central differences), kept within their bounds and only
 // where it lowers chi^2 (halved up to four times).
@@ -244,15 +211,15 @@ Null null_step(const Run &run, Gimbal &gm, const Null &nu, const double bound[N_
         for (size_t i = 0; i < r0.size(); i++)
             jac[q].push_back((rm[i] - rp[i]) / (2 * eps[q])); // -d(residual)/d(amount)
     }
-    double A[N_NULL][N_NULL] = {}, b[N_NULL] = {}, d[N_NULL];
+    std::vector<double> A(N_NULL * N_NULL, 0.0), d(N_NULL, 0.0);
     for (int q = 0; q < N_NULL; q++) {
         for (int w = 0; w < N_NULL; w++)
             for (size_t i = 0; i < r0.size(); i++)
-                A[q][w] += jac[q][i] * jac[w][i];
+                A[(size_t)(q * N_NULL + w)] += jac[q][i] * jac[w][i];
         for (size_t i = 0; i < r0.size(); i++)
-            b[q] += jac[q][i] * r0[i];
+            d[(size_t)q] += jac[q][i] * r0[i];
     }
-    if (!solve_small(N_NULL, A, b, d))
+    if (!solve(A, d, N_NULL, 1e-12))
         return nu;
     const double chi0 = sum_sq(r0);
     for (int half = 0; half < 5; half++) {

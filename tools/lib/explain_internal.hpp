@@ -98,11 +98,26 @@ void period_range(const Run &run, const State &st, const ExplainOptions &opt, co
                   const std::vector<std::string> &adds, int comp, double G, double *lo,
                   double *hi, double *sampled_deg);
 
-// Step 1's composition (explain_compose.cpp): the run with the second-order composition
-// of its baseline's anisotropic terms (read as gimbal parameters) taken out
-// of the observed positions; *rms its RMS per axis (radians).  The run as
-// it is where the baseline does not fit.
+// Step 1's composition (explain_compose.cpp): the run with the
+// second-order composition of its baseline's anisotropic terms (read as
+// gimbal parameters) taken out of the observed positions; *rms its RMS per
+// axis (radians).  The run as it is (*rms = 0) where the baseline does not
+// fit, has no anisotropic terms or does not determine them, or where the
+// composed reading does not fit better.
 Run composed_run(const Run &run, const ExplainOptions &opt, double *rms);
+
+// Solve the small dense system A x = b (n x n, row-major; x returned in b)
+// by Gaussian elimination with partial pivoting; false where a pivot is not
+// above rel_tol times the largest |A_ii| (0: exactly singular)
+// (explain_interpret.cpp).
+bool solve(std::vector<double> A, std::vector<double> &b, int n, double rel_tol = 0);
+
+// Whether a candidate's family may pair with another (step 4's pairs: not
+// higher_order, not outliers).
+inline bool pairable(const Candidate &c)
+{
+    return c.effect != "higher_order" && c.effect != "outlier";
+}
 
 // The finding(s) one accepted candidate makes: one per member family.
 std::vector<Finding> describe(const Run &run, const State &st, const Candidate &c,

@@ -7,25 +7,25 @@
 // order-1 baseline holds it without naming it.
 #include "explain_internal.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
 namespace pmhost {
 
-using namespace xdetail;
+namespace xdetail {
 
-namespace {
-
-// Solve the small dense system A x = b (n x n, row-major) by Gaussian
-// elimination with partial pivoting; false if singular.
-bool solve(std::vector<double> A, std::vector<double> &b, int n)
+bool solve(std::vector<double> A, std::vector<double> &b, int n, double rel_tol)
 {
+    double scale = 0;
+    for (int k = 0; k < n; k++)
+        scale = std::max(scale, std::fabs(A[(size_t)(k * n + k)]));
     for (int k = 0; k < n; k++) {
         int p = k;
         for (int i = k + 1; i < n; i++)
             if (std::fabs(A[(size_t)(i * n + k)]) > std::fabs(A[(size_t)(p * n + k)]))
                 p = i;
-        if (!(std::fabs(A[(size_t)(p * n + k)]) > 0))
+        if (!(std::fabs(A[(size_t)(p * n + k)]) > rel_tol * scale))
             return false;
         for (int j = 0; j < n; j++)
             std::swap(A[(size_t)(k * n + j)], A[(size_t)(p * n + j)]);
@@ -44,6 +44,12 @@ bool solve(std::vector<double> A, std::vector<double> &b, int n)
     }
     return true;
 }
+
+} // namespace xdetail
+
+using namespace xdetail;
+
+namespace {
 
 double cov_of(const FitOut &f, int i, int j)
 {
