@@ -21,6 +21,14 @@
 **        +-ANISO_ARCMIN, the true position RHO0..RHO1 deg from the mount's
 **        pole (normal side): statuses, round trips through the float and
 **        the double forward models, the float forward's own jitter
+**    pmbench_inv_stress track DT [MODELS] [SEED]   tracking calls, the
+**        figures behind PM_INVERT_TRACK_MAX_EVALS' "measured": 40 targets
+**        per model (MODELS models, default 2,000, L = 1 and 2, isotropic
+**        terms within +-10 deg, harmonic terms within +-10'), the true
+**        position 0.5..1 deg from the mount's pole for half of them, 0.5..90
+**        deg for the rest, either pole and side; pm_model_invert_near from
+**        the solution of the target DT s of sidereal motion earlier:
+**        evaluations per call (histogram) and the calls above 4
 **
 **  Prints one summary line per sample and the failures (up to 20).
 */
@@ -243,8 +251,62 @@ static void float_sample(double iso, double an, double r0, double r1)
            worst_noise);
 }
 
+static void track_sample(double dt, int models, unsigned long long seed)
+{
+    tu_rng r;
+    unsigned long hist[PM_INVERT_NEAR_MAX_EVALS + 1], bad = 0, n = 0, shown = 0;
+    int i, j, worst = 0;
+    memset(hist, 0, sizeof hist);
+    tu_seed(&r, seed);
+    for (i = 0; i < models; i++) {
+        pm_model m;
+        if (pm_model_init(&m, PM_MOUNT_EQUATORIAL, 1 + i % 2) != PM_OK)
+            return;
+        for (j = 0; j < m.n_terms; j++)
+            m.coef[j] = (2 * tu_uniform(&r) - 1) * (j < 6 ? 10 * DEG : 10 * ARCSEC * 60);
+        if (pm_model_prepare(&m) != PM_OK)
+            return;
+        for (j = 0; j < 40; j++) {
+            double rho = (0.5 + tu_uniform(&r) * (j % 2 ? 0.5 : 89.5)) * DEG;
+            double hemi = tu_uniform(&r) < 0.5 ? 1 : -1;
+            int flip = tu_uniform(&r) < 0.5;
+            double t = (2 * tu_uniform(&r) - 1) * M_PI;
+            double d = m.coef[4] + hemi * (flip ? M_PI / 2 + rho : M_PI / 2 - rho);
+            double ah, ad, sh, sd, eh, ed;
+            pm_status st;
+            if (pm_model_apply(&m, NULL, t, d, &ah, &ad) != PM_OK ||
+                pm_model_invert_near(&m, NULL, ah - 7.2921159e-5 * dt, ad, t, d, &sh, &sd) !=
+                    PM_OK) {
+                bad++; /* (the previous tick: beyond the pole's fold, say) */
+                continue;
+            }
+            probe_count = 0;
+            st = pm_model_invert_near(&m, NULL, ah, ad, sh, sd, &eh, &ed);
+            n++;
+            hist[probe_count <= PM_INVERT_NEAR_MAX_EVALS ? probe_count : 0]++;
+            worst = (int)probe_count > worst ? (int)probe_count : worst;
+            if (st != PM_OK)
+                bad++;
+            if ((probe_count > 4 || st != PM_OK) && shown++ < 20)
+                printf("  model %d target %d: %.4f deg from the pole, status %d, %lu "
+                       "evaluations\n", i, j, rho / DEG, (int)st, probe_count);
+        }
+    }
+    printf("track dt %g s, %lu calls: evaluations", dt, n);
+    for (j = 1; j <= PM_INVERT_NEAR_MAX_EVALS; j++)
+        if (hist[j])
+            printf(" %d: %lu", j, hist[j]);
+    printf("; worst %d (bound %d); not PM_OK (or no previous tick) %lu\n", worst,
+           PM_INVERT_TRACK_MAX_EVALS, bad);
+}
+
 int main(int argc, char **argv)
 {
+    if (argc >= 3 && !strcmp(argv[1], "track")) {
+        track_sample(atof(argv[2]), argc >= 4 ? atoi(argv[3]) : 2000,
+                     argc >= 5 ? strtoull(argv[4], 0, 10) : 1818);
+        return 0;
+    }
     if (argc >= 6 && !strcmp(argv[1], "float")) {
         float_sample(atof(argv[2]) * DEG, atof(argv[3]) * ARCSEC * 60, atof(argv[4]),
                      atof(argv[5]));
@@ -262,6 +324,6 @@ int main(int argc, char **argv)
         return 0;
     }
     fprintf(stderr, "usage: pmbench_inv_stress real [N] [SEED] [RHO_MAX] [RHO_MIN] | hard | "
-                    "float ISO_DEG ANISO_ARCMIN RHO0_DEG RHO1_DEG\n");
+                    "float ISO_DEG ANISO_ARCMIN RHO0_DEG RHO1_DEG | track DT [MODELS] [SEED]\n");
     return 2;
 }
