@@ -114,26 +114,30 @@ extern "C" {
 ** 12 -O2, the library at PM_MAX_L = 4:
 **   tracking beyond 0.5 deg of the mount's pole, 10 Hz or faster, terms
 **   within 10 deg / 10' (PM_INVERT_TRACK_MAX_EVALS): the Cortex-M7
-**   double inverse took at most 4,020 instructions, at its worst measured
-**   4 evaluations (stop 25; 3,595 at 3 before the anisotropic terms moved
+**   double inverse took at most 4,085 instructions, at its worst measured
+**   3 evaluations (stop 28; 4,020 at 4 at stop 25, 3,595 at 3 before the
+**   anisotropic terms moved
 **   to the mechanical position, 3,575 before the code moved with pm_model_track,
 **   3,565 before solve_branch was split into functions,
 **   3,640 before the typical iteration's lean loop, 3,870 before the
-**   Jacobian's sums were fused); PM_BUDGET_M7_TRACK_INSNS adds 5 more
-**   evaluations of PM_BUDGET_M7_INSNS_PER_EVAL each to 3,595, for the
-**   bound of 8 (16,095: above 4,020 + 4 x 2,500 as well).  The bench's
-**   situations hold no tick that needs Newton; the dearest measured at
-**   all ("make bench-track-worst": check_bounded's 8,000 steady-state
-**   ticks, half of them 0.5-5 deg from the pole) are 8,840 (invert_near)
-**   and 8,600 instructions (pm_model_track) at 6 evaluations, 0.504 deg
-**   from the pole, where the fixed point's matrix is singular and Newton
-**   finishes (~1,800 instructions a trial point there): two more
-**   evaluations of PM_BUDGET_M7_INSNS_PER_EVAL give 13,840, within it.
-**   pm_model_track's ticks, under the same conditions: at most 3,345
+**   Jacobian's sums were fused).  The bench's situations hold no tick
+**   that needs Newton; the dearest measured at all ("make
+**   bench-track-worst": check_bounded's 8,000 steady-state ticks, half of
+**   them 0.5-5 deg from the pole) are 7,360 (invert_near) and 7,640
+**   instructions (pm_model_track) at 3 and 4 evaluations, 0.555 deg from
+**   the pole, where the chord's matrix is singular and Newton on the
+**   forward model starts at once (~1,800 instructions a trial point
+**   there; 8,840 and 8,600 at 6 evaluations before stop 28, when plain
+**   steps came first).  As such a tick may spend every evaluation up to
+**   the bound of 8 on Newton's trial points, PM_BUDGET_M7_TRACK_INSNS is
+**   2,000 + 8 x PM_BUDGET_M7_INSNS_PER_EVAL = 22,000 (until stop 28
+**   16,095: the typical 3,595 and 5 evaluations more, which a tick with
+**   Newton from its first evaluation could pass).
+**   pm_model_track's ticks, under the bench's conditions: at most 3,370
 **   instructions measured (2 evaluations; 6,890 at 6 before the next
 **   evaluation took J afresh where a carried one converges slowly, Note 1
 **   of pm_model_track; its typical tick ~1,900 against
-**   invert_near's ~2,700), so PM_BUDGET_M7_TRACK_INSNS holds for it too.
+**   invert_near's ~2,700); its bound is invert_near's, and so its budget.
 **   PM_BUDGET_M7_INSNS_PER_EVAL: an evaluation of the Newton iteration
 **   (the displacement with its Jacobian, sin/cos of the point, the
 **   rotations and their first and second derivatives, the step's
@@ -152,7 +156,7 @@ extern "C" {
 **   degrees (its inverse fails to converge there more often:
 **   pm_model_invert_f Note 3). */
 #define PM_BUDGET_M7_INSNS_PER_EVAL 2500
-#define PM_BUDGET_M7_TRACK_INSNS (3595 + 5 * PM_BUDGET_M7_INSNS_PER_EVAL)
+#define PM_BUDGET_M7_TRACK_INSNS (2000 + PM_INVERT_TRACK_MAX_EVALS * PM_BUDGET_M7_INSNS_PER_EVAL)
 #define PM_BUDGET_M4F_F_INSNS_PER_EVAL 3000
 
 /* ---------------------------------------------------------------------- */
@@ -473,16 +477,27 @@ pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
 **     (1 kHz ticks); a third or fourth only where the step is long and
 **     the contraction weak (within a few degrees of the mount's pole,
 **     |F_D| ~ 1/cos of the distance, with 10' terms): hence
-**     PM_INVERT_TRACK_MAX_EVALS = 8 (measured worst 4 with ticks up to
-**     0.1 s, 6 with 1 s ticks within a degree of the pole).  At most
-**     PM_INVERT_MAX_FIXED (4) such steps (where Newton's steps on D do not
-**     contract -- a term that varies fast makes the first evaluation's J a
-**     poor guide -- plain fixed-point steps D^' = D(x) from the best point,
-**     within the same 4): where they have not converged by then (within
-**     about the anisotropic amplitude of the mount's pole, where the
-**     closed form's branch is ill-conditioned, or for displacements of
-**     degrees) Newton steps on the full forward model take over from the
-**     best point, with the evaluations the fixed point left: the residual
+**     PM_INVERT_TRACK_MAX_EVALS = 8 (measured worst 4 in
+**     tests/check_bounded.c's 16,000 tracking calls, 1 ms to 0.1 s ticks;
+**     5 once in 80,000 more at 0.1 s, 0.500 deg from the pole, and 8 with
+**     1 s ticks within a degree of it: bench/inv_stress.c).  Where a step
+**     contracts the miss by less than 1e-3 and the next point would still
+**     miss the tolerance at that rate, the next evaluation takes J afresh
+**     (within a few degrees of the mount's pole J goes stale within a
+**     step: |F_D| magnifies its change).  At most PM_INVERT_MAX_FIXED (4)
+**     such steps (where Newton's steps on D do not contract -- a term that
+**     varies fast makes the first evaluation's J a poor guide -- plain
+**     fixed-point steps D^' = D(x) from the best point, within the same
+**     4): where they have not converged by then (within about the
+**     anisotropic amplitude of the mount's pole, where the closed form's
+**     branch is ill-conditioned, or for displacements of degrees) Newton
+**     steps on the full forward model take over from the best point, with
+**     the evaluations the fixed point left; in a call from a start
+**     (pm_model_invert_near, pm_model_track) at once where I - J F_D is
+**     ill-conditioned (|det| < 0.2), from the point just evaluated (its
+**     evaluation reused where J was taken there; plain steps do not
+**     contract there either, and cost a tracking call one or two
+**     evaluations before): the residual
 **     is the tangent offset F of the model's position from the target, its
 **     Jacobian M analytic (the rotations' derivatives and J, every term
 **     kind differentiated), so each trial point costs one evaluation.  The
@@ -537,8 +552,11 @@ pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
 **     is returned.  PM_WARN_UNREACHABLE: no position on the requested side
 **     points at the target: it lies in the cap around the mount's pole
 **     that collimation, non-perpendicularity and the anisotropic terms
-**     make unreachable from that side; the nearest position found on that
-**     side is returned (where the miss is stationary: the fold's vertex or
+**     make unreachable from that side (for pm_model_invert_near, the side
+**     of the start: the closed form's reach says so, or, where Newton
+**     started at once, its last step to the fold's vertex); the nearest
+**     position found on that side is returned (where the miss is
+**     stationary: the fold's vertex or
 **     the edge's nearest point, within 1e-9 rad of a brute-force scan in
 **     tests/check_model.c).
 **  4) The round trip holds at the angles returned, as rounded to doubles.

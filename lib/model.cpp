@@ -319,11 +319,18 @@ struct NPoint {
 
 __attribute__((noinline)) void newton_point(const pm_model *m, const Iso<double> &k,
                                             const pm_context *ctx, const Frame &f, double t,
-                                            double d, NPoint *o)
+                                            double d, NPoint *o, const double *pre = 0)
 {
     const Trig<double> g = trig_of(t, d);
     double a, b, J[4], stp, ctp, sdp, cdp;
-    aniso_jac(m, k, g, ctx, &a, &b, J);
+    if (!pre) {
+        aniso_jac(m, k, g, ctx, &a, &b, J);
+    } else { /* (J and D taken at (t, d) already: newton's pre) */
+        for (int i = 0; i < 4; i++)
+            J[i] = pre[i];
+        a = pre[4];
+        b = pre[5];
+    }
     shifted<double>(k, g, &stp, &ctp, &sdp, &cdp);
     /* w = expmap(a, b) = (c, a s, b s), c and s functions of r^2 = a^2 +
     ** b^2; c1, s1 their derivatives by r^2 */
@@ -420,15 +427,15 @@ __attribute__((noinline)) double hess(const NPoint &c, const Curv &cv, const dou
 ** solutions at once: the one on side `want` is taken (+1/-1; 0: the
 ** nearer), and where the quadratic has no root (the target is beyond the
 ** fold: unreachable here) its vertex, the fold's point nearest the
-** target.  False where M is degenerate. */
-__attribute__((noinline)) bool fold_step(const pm_model *m, const NPoint &c, const Curv &cv, int want, double *ht,
-                      double *hd)
+** target.  0 where M is degenerate, else 1, or 2 for the vertex. */
+__attribute__((noinline)) int fold_step(const pm_model *m, const NPoint &c, const Curv &cv,
+                                        int want, double *ht, double *hd)
 {
     const double A = c.M[0], B = c.M[1], C = c.M[2], D = c.M[3];
     const double j00 = A * A + C * C, j01 = A * B + C * D, j11 = B * B + D * D;
     const double dif = j00 - j11, tr = j00 + j11;
     if (!(tr > 0) || !(tr < 1e300))
-        return false;
+        return 0;
     const double l1 = 0.5 * (tr + m_sqrt(dif * dif + 4 * j01 * j01));
     double v1[2] = {dif >= 0 ? l1 - j11 : j01, dif >= 0 ? j01 : l1 - j00};
     double n = m_sqrt(v1[0] * v1[0] + v1[1] * v1[1]);
@@ -473,7 +480,7 @@ __attribute__((noinline)) bool fold_step(const pm_model *m, const NPoint &c, con
     const double be = -(f1 + 0.5 * hess(c, cv, u1, hh, hh)) / s1;
     *ht = al * v2[0] + be * v1[0];
     *hd = al * v2[1] + be * v1[1];
-    return finite(*ht) && finite(*hd);
+    return !(finite(*ht) && finite(*hd)) ? 0 : disc < 0 ? 2 : 1;
 }
 
 /* The encoder declination on the edge of the mount's pole (dec - e' =
@@ -597,36 +604,47 @@ inline void secant_curvature(const NPoint &cur, const NPoint &trial, double nt, 
 ** form's fixed point does not contract (close to the mount's pole) and to
 ** check returned angles.  x = (t, d) encoder angles, updated in place.  At
 ** most `budget` evaluations (trial points), the first at x (or `first`,
-** already evaluated); a trial point that is not better shortens the step
-** to a quarter.  want = +1/-1: the side of the pole wanted (a trial
-** point beyond the pole from that side is moved back onto the pole's
-** edge: onto_edge); 0: any side, the nearer solution.  Trial points are
-** kept on the turn the result is returned on (turn, from turn_of), since
-** periodic terms of non-integer G read the raw angles and jump between
-** turns. */
+** already evaluated; or made from pre, J (pre[0..3]) and D (pre[4],
+** pre[5]) evaluated at x already, no evaluation); a trial point that is
+** not better shortens the step to a quarter.  want = +1/-1: the side of
+** the pole wanted (a trial point beyond the pole from that side is moved
+** back onto the pole's edge: onto_edge); 0: any side, the nearer
+** solution; 2: as 0, started at once where the fixed point had no chord
+** (no_chord), and then PM_WARN_UNREACHABLE where it ends without
+** converging after a step to the fold's vertex (the target beyond the
+** fold: what the closed form's reach said where the fixed point's steps
+** came first).  Trial points are kept on the turn the result is returned
+** on (turn, from turn_of), since periodic terms of non-integer G read the
+** raw angles and jump between turns. */
 __attribute__((noinline)) pm_status newton(const pm_model *m, const Iso<double> &k,
                                            const pm_context *ctx, const Aim &a,
                                            const double *turn, double *t, double *d,
                                            double *err, int want, int budget,
-                                           const NPoint *first = 0)
+                                           const NPoint *first = 0, const double *pre = 0)
 {
+    const bool at_once = want == 2; /* (finish_branch: Newton at once, no_chord) */
+    if (at_once)
+        want = 0;
     const Frame f = frame_of(k, a);
     NPoint cur, trial;
     int evals = 0;
     if (first) {
         cur = *first;
     } else {
-        newton_point(m, k, ctx, f, *t, *d, &cur);
-        evals = 1;
+        newton_point(m, k, ctx, f, *t, *d, &cur, pre);
+        evals = !pre;
     }
     double lam = 1;
     EdgeMemo edge = {0, 0, false};
+    bool beyond = false; /* the last step the fold's vertex: the target beyond it */
     Curv cv = {{0, 0}, {0, 0}};
     while (!(cur.err <= PM_INVERT_TOL && (!want || side_of(m, cur.d) == want)) &&
            evals < budget) {
         double ht, hd;
-        if (!fold_step(m, cur, cv, want, &ht, &hd))
+        const int fs = fold_step(m, cur, cv, want, &ht, &hd);
+        if (!fs)
             break;
+        beyond = fs == 2;
         trust_region(&ht, &hd);
         double nt = cur.t + lam * ht, nd = cur.d + lam * hd;
         if (want && side_of(m, nd) != want)
@@ -648,7 +666,9 @@ __attribute__((noinline)) pm_status newton(const pm_model *m, const Iso<double> 
     *t = cur.t;
     *d = cur.d;
     *err = cur.err;
-    return cur.err <= PM_INVERT_TOL ? PM_OK : PM_WARN_NOT_CONVERGED;
+    if (cur.err <= PM_INVERT_TOL)
+        return PM_OK;
+    return at_once && beyond ? PM_WARN_UNREACHABLE : PM_WARN_NOT_CONVERGED;
 }
 
 /* Does an evaluation of m read the raw axis angles, not only their sines
@@ -768,7 +788,7 @@ inline bool chord_matrix(double K00, double K01, double K10, double K11, double 
 {
     double A = 1 - K00, B = -K01, C = -K10, D = 1 - K11;
     double det = A * D - B * C;
-    if (!(m_fabs(det) >= 0.05))
+    if (!(m_fabs(det) >= 0.2))
         return false;
     double id = 1 / det;
     /* (I - K)^-1 */
@@ -890,7 +910,8 @@ struct Branch {
     double b_dt, b_dd, b_ht, b_hd, b_dist;
     bool converged, best_reachable;
     bool chord; /* Newton steps on D (else plain fixed-point steps) */
-    int it0;    /* the iteration the general loop starts at */
+    int it0;    /* the iteration the general loop starts at; ~it0 (< 0):
+                ** none, Newton at once (no_chord) */
 };
 
 /* The predicted stop (Note 1 of pm_model_invert in pm.h) needs the
@@ -980,6 +1001,25 @@ PM_HOT void fresh_j(Branch *s, const Trig<double> &g)
 PM_HOT bool stale_j(Branch *s, double hn)
 {
     if (!(s->carry && !s->carry->fresh && s->lip2 * s->dist_j * hn > 100 * PM_INVERT_TOL))
+        return false;
+    s->have_j = s->have_n = s->tried_n = false;
+    return true;
+}
+
+/* After a step the predicted stop did not certify: where the chord
+** contracted the miss by less than 1e-3 at the last evaluation (change,
+** from last) and the next point will miss by more than the tolerance all
+** the same (at that rate), the next evaluation takes J afresh and the
+** chord's matrix with it.  Within a few degrees of the mount's pole J goes
+** stale within a step (|F_D| ~ 1/cos of the distance magnifies its
+** change): a fresh J converges quadratically from the next point on. */
+__attribute__((noinline, cold)) bool slow_rate(double change, double last)
+{
+    return change > 1e-3 * last && change * change > 0.5 * PM_INVERT_TOL * last;
+}
+PM_HOT bool slow_chord(Branch *s, int it, double last)
+{
+    if (!(it > 0 && slow_rate(s->change, last)))
         return false;
     s->have_j = s->have_n = s->tried_n = false;
     return true;
@@ -1209,8 +1249,11 @@ PM_HOT void lean_advance(Branch *s, Lean *L, double dt, double dd, double nt, do
 ** Newton step, a step beyond the closed form's reach, an overflow) the
 ** general loop takes over at the start of that iteration, with the
 ** evaluation made (have_d) and the state it would have had; after a step
-** beyond 0.01 rad (small_step), at the start of the next one.  True where
-** the lean loop is done (the general loop is not needed). */
+** beyond 0.01 rad (small_step), at the start of the next one.  Where
+** there is no Newton step (the chord's matrix ill-conditioned) it0 says so
+** (~it: no_chord decides).  Where a step contracted slowly the next
+** evaluation takes J afresh (slow_chord).  True where the lean loop is
+** done (the general loop is not needed). */
 PM_HOT bool lean_loop(Branch *s)
 {
     Lean L;
@@ -1250,10 +1293,18 @@ PM_HOT bool lean_loop(Branch *s)
         }
         if (!s->tried_n) {
             s->tried_n = true;
-            s->have_n = s->start ? newton_prep(*s->k, *L.cur, s->dh_t, s->dh_d, s->J, s->Ni)
-                                 : newton_prep0(*s->k, *L.cur, s->J, s->Ni); /* (D^ = 0) */
+            /* (a cold call's first point: D^ = 0; J afresh later: D^ as found) */
+            s->have_n = s->start || L.it ? newton_prep(*s->k, *L.cur, s->dh_t, s->dh_d, s->J, s->Ni)
+                                         : newton_prep0(*s->k, *L.cur, s->J, s->Ni);
         }
         if (!(s->have_n && s->change <= 0.01)) {
+            if (!s->have_n) { /* (no_chord) */
+                hand_over(s, &L, LEAN_BAIL);
+                s->it0 = ~s->it0;
+                s->J[4] = dt;
+                s->J[5] = dd;
+                return false;
+            }
             end = LEAN_BAIL;
             break;
         }
@@ -1276,7 +1327,7 @@ PM_HOT bool lean_loop(Branch *s)
             lean_stop(s, L.nxt);
             return true;
         }
-        const bool rejac = stale_j(s, hn);
+        const bool rejac = stale_j(s, hn) || slow_chord(s, L.it, L.last);
         lean_advance(s, &L, dt, dd, nt, nd, hn);
         if (rejac) /* (the best point's distance from where J will be taken) */
             L.p_dist = hn;
@@ -1392,6 +1443,29 @@ PM_HOT void general_loop(Branch *s)
     }
 }
 
+/* Where the lean loop stopped at a point (*gp, D in J[4], J[5]) whose
+** chord's matrix I - J F_D is ill-conditioned (no Newton step on D: within
+** about the anisotropic amplitude of the mount's pole), it0 = ~it (the
+** general loop's state made, hand_over).  In a call from a start (want =
+** 0: invert_near, pm_model_track) Newton on the forward model starts there
+** at once, not after the general loop's plain fixed-point steps, which do
+** not contract there either (K = J F_D has an eigenvalue near 1) and spent
+** one or two evaluations first; the point is the best so far (the steps
+** before it contracted), and where J was taken there its evaluation is
+** Newton's first point (finish_branch).  A cold call (want = +-1) keeps
+** the general loop (it0 = it): its plain steps cost fewer instructions
+** than Newton's trial points near the pole.  True where Newton takes over. */
+PM_HOT bool no_chord(Branch *s, int want)
+{
+    if (want) {
+        s->it0 = ~s->it0;
+        return false;
+    }
+    s->bp = s->gp;
+    s->best_reachable = true;
+    return true;
+}
+
 /* Are the angles (t, d), the best point's rounded to doubles, safe to
 ** return without a check?  The fixed point judged the position before
 ** its angles were rounded (atan2, the turn), with PM_INVERT_TOL / 2 to
@@ -1442,8 +1516,9 @@ PM_HOT pm_status finish_branch(Branch *s, int want, const double *turn, double *
     if (s->carry)
         s->carry->out_trig = false;
     if (!converged || !reachable || (want && side_of(s->m, d) != want)) {
-        result = newton(s->m, *s->k, s->ctx, *s->a, turn, &t, &d, &err, want,
-                        PM_INVERT_MAX_FIXED + PM_INVERT_MAX_NEWTON - s->used);
+        result = newton(s->m, *s->k, s->ctx, *s->a, turn, &t, &d, &err, s->it0 < 0 ? 2 : want,
+                        PM_INVERT_MAX_FIXED + PM_INVERT_MAX_NEWTON - s->used, 0,
+                        s->it0 < 0 && s->dist_j == 0 ? s->J : 0);
         if (result != PM_OK && !reachable)
             result = PM_WARN_UNREACHABLE;
     } else if (s->carry) {
@@ -1486,7 +1561,7 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
 {
     const Target<double> tg = target_of(k, a.q);
     Trig<double> slot[3];
-    double J[4], Ni[4];
+    double J[6], Ni[4]; /* (J[4], J[5]: D where no_chord starts Newton) */
     Branch s;
     s.m = m;
     s.k = &k;
@@ -1523,8 +1598,10 @@ pm_status solve_branch(const pm_model *m, const Iso<double> &k,
         s.best_reachable = s.reachable;
         s.b_dt = s.b_dd = s.b_ht = s.b_hd = s.b_dist = 0;
     }
-    if (__builtin_expect(!lean_done, 0)) /* (the typical call is done) */
-        general_loop(&s);
+    if (__builtin_expect(!lean_done, 0)) { /* (the typical call is done) */
+        if (s.it0 >= 0 || !no_chord(&s, want))
+            general_loop(&s);
+    }
     return finish_branch(&s, want, turn, t_out, d_out, err_out);
 }
 

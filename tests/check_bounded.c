@@ -264,8 +264,9 @@ END_TEST
 ** +-10 deg, every harmonic term within +-10', orders 1 and 2, a
 ** quarter with an AUX term), targets 0.5..90 deg from the mount's pole on
 ** both sides, the start the solution of the target dt of sidereal motion
-** earlier (dt from 1 ms to 0.1 s: 1 kHz to 10 Hz ticks; at 1 s, within a
-** degree of the pole, 5 or 6 were seen).  Every call PM_OK within the bound; the
+** earlier (dt from 1 ms to 0.1 s: 1 kHz to 10 Hz ticks; with 1 s ticks
+** within a degree of the pole up to 8 are seen, "pmbench_inv_stress track
+** 1").  Every call PM_OK within the bound; the
 ** worst count is printed and must stay within 4 (the issue's goal; the
 ** header promises 8). */
 #define TRACK_SEEN_MAX 4
@@ -341,15 +342,18 @@ END_TEST
 ** three ticks before (J taken there), two ticks tracked, the third
 ** counted; half the targets 0.5..5 deg from the mount's pole, where the
 ** encoder hour angle moves up to ~1e-4 rad a tick.  Every tick PM_OK
-** within the header's bound, and never dearer than pm_model_invert_near
-** from the same position where that needs no more than 4: a J carried
-** from three ticks back contracts the chord slowly there (before the next
-** evaluation took J afresh, stale_j in lib/model.cpp, 6 were seen where
-** invert_near needed 3).  Within about a degree of the pole these models'
-** anisotropic terms (up to 48 of 10' each) turn the closed form's branch
-** as fast as the pole's distance does (the chord's matrix is singular:
-** Newton on the forward model takes over), and invert_near itself needs
-** up to 6 or 7: counted and printed, as forced by the geometry. */
+** within the header's bound, never dearer than pm_model_invert_near from
+** the same position where that needs no more than 4, and neither call
+** above 4 (the issue's goal): a J carried from three ticks back contracts
+** the chord slowly there (before the next evaluation took J afresh,
+** stale_j in lib/model.cpp, 6 were seen where invert_near needed 3).
+** Within about a degree of the pole these models' anisotropic terms (up
+** to 48 of 10' each) turn the closed form's branch as fast as the pole's
+** distance does: the chord's matrix is near singular, or J goes stale
+** within a step.  Before Newton on the forward model started at once
+** from such a point (no_chord in lib/model.cpp) and a slow chord took J
+** afresh (slow_chord), both calls needed up to 6 here (pm_model_track
+** above 4 in 3 of the 8,000 ticks, invert_near in 4). */
 START_TEST(test_bounded_track_state_beyond_half_degree)
 {
     tu_rng r;
@@ -396,6 +400,8 @@ START_TEST(test_bounded_track_state_beyond_half_degree)
            "%d); more than %d in %lu (invert_near %lu)\n", n, worst, worst_near,
            PM_INVERT_TRACK_MAX_EVALS, TRACK_SEEN_MAX, n_over, near_over);
     fflush(stdout);
+    ck_assert_uint_le(worst, TRACK_SEEN_MAX);
+    ck_assert_uint_le(worst_near, TRACK_SEEN_MAX);
 }
 END_TEST
 
