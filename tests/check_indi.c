@@ -426,7 +426,12 @@ static int indi_headers(void)
            access("/usr/include/libnova/sidereal_time.h", R_OK) == 0;
 }
 
-/* make indi in the plain build (the plugin is never built with sanitizers) */
+/* make indi in the plain build (the plugin is never built with sanitizers).
+** make sanitize's command-line SAN=... reaches this process's environment
+** (make exports command-line variables), where the Makefile's ifneq ($(SAN),)
+** would see it: a stale plain plugin was then rebuilt with the sanitizers
+** and no longer loaded (undefined __ubsan symbols); SAN= on the command
+** line overrides it. */
 static void make_indi(void)
 {
     char cmd[2048];
@@ -434,7 +439,9 @@ static void make_indi(void)
     unsetenv("MAKEFLAGS");
     unsetenv("MFLAGS");
     unsetenv("MAKELEVEL");
-    snprintf(cmd, sizeof cmd, "mkdir -p '%s/build/indi' && make -s -C '%s' indi > '%s/build/indi/make.log' 2>&1",
+    unsetenv("SAN");
+    snprintf(cmd, sizeof cmd,
+             "mkdir -p '%s/build/indi' && make -s -C '%s' SAN= indi > '%s/build/indi/make.log' 2>&1",
              top(), top(), top());
     st = system(cmd);
     ck_assert_msg(WIFEXITED(st) && WEXITSTATUS(st) == 0, "make indi failed; see build/indi/make.log");
