@@ -19,6 +19,7 @@
 // What that adds to the fitted model is the correction taken out here.
 
 #include "explain_internal.hpp"
+#include "hostutil.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -319,15 +320,6 @@ Run thinned(const Run &run, size_t most)
     for (size_t i = 0; i < run.obs.size(); i += k)
         t.obs.push_back(run.obs[i]);
     return t;
-}
-
-// Indices 0 .. n-1.
-std::vector<int> all_of(size_t n)
-{
-    std::vector<int> a(n);
-    for (size_t i = 0; i < n; i++)
-        a[i] = (int)i;
-    return a;
 }
 
 } // namespace

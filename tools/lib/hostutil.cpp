@@ -102,4 +102,12 @@ std::string xml_escape(const std::string &s)
     return o;
 }
 
+std::vector<int> all_of(size_t n)
+{
+    std::vector<int> v(n);
+    for (size_t i = 0; i < n; i++)
+        v[i] = (int)i;
+    return v;
+}
+
 } // namespace pmhost

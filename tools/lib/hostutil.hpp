@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <string>
+#include <vector>
 
 namespace pmhost {
 
@@ -28,6 +29,9 @@ std::string xml_escape(const std::string &s);
 
 // Copy msg into err (truncated, NUL-terminated) if err is not NULL.
 void set_err(char *err, size_t errlen, const std::string &msg);
+
+// The indices 0 .. n-1 (every observation of a run).
+std::vector<int> all_of(size_t n);
 
 } // namespace pmhost
 

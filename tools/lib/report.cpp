@@ -211,14 +211,6 @@ const char *status_words(pm_status s)
 
 // ------------------------------------------------------------ the stages
 
-std::vector<int> all_of(size_t n)
-{
-    std::vector<int> v(n);
-    for (size_t i = 0; i < n; i++)
-        v[i] = (int)i;
-    return v;
-}
-
 // The fit the page is about, and its predicted error map.
 void stage_fit(Data &d)
 {
