@@ -260,11 +260,7 @@ static void track_sample(double dt, int models, unsigned long long seed)
     tu_seed(&r, seed);
     for (i = 0; i < models; i++) {
         pm_model m;
-        if (pm_model_init(&m, PM_MOUNT_EQUATORIAL, 1 + i % 2) != PM_OK)
-            return;
-        for (j = 0; j < m.n_terms; j++)
-            m.coef[j] = (2 * tu_uniform(&r) - 1) * (j < 6 ? 10 * DEG : 10 * ARCSEC * 60);
-        if (pm_model_prepare(&m) != PM_OK)
+        if (hc_track_model(&m, &r, i) != 0)
             return;
         for (j = 0; j < 40; j++) {
             double rho = (0.5 + tu_uniform(&r) * (j % 2 ? 0.5 : 89.5)) * DEG;

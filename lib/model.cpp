@@ -988,6 +988,14 @@ PM_HOT void fresh_j(Branch *s, const Trig<double> &g)
     at[3] = g.cd;
 }
 
+/* The next evaluation takes J afresh, and the chord's matrix with it
+** (stale_j, slow_chord).  True. */
+PM_HOT bool retake_j(Branch *s)
+{
+    s->have_j = s->have_n = s->tried_n = false;
+    return true;
+}
+
 /* After a step h of length hn that the predicted stop did not certify:
 ** where J is pm_model_track's, carried from another tick, and its
 ** distance alone keeps the next point's bound above 100 PM_INVERT_TOL
@@ -1002,8 +1010,7 @@ PM_HOT bool stale_j(Branch *s, double hn)
 {
     if (!(s->carry && !s->carry->fresh && s->lip2 * s->dist_j * hn > 100 * PM_INVERT_TOL))
         return false;
-    s->have_j = s->have_n = s->tried_n = false;
-    return true;
+    return retake_j(s);
 }
 
 /* After a step the predicted stop did not certify: where the chord
@@ -1019,10 +1026,7 @@ __attribute__((noinline, cold)) bool slow_rate(double change, double last)
 }
 PM_HOT bool slow_chord(Branch *s, int it, double last)
 {
-    if (!(it > 0 && slow_rate(s->change, last)))
-        return false;
-    s->have_j = s->have_n = s->tried_n = false;
-    return true;
+    return it > 0 && slow_rate(s->change, last) && retake_j(s);
 }
 
 /* The first point, in slot 0: the closed form at D^ = 0 (a cold call), or
