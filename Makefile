@@ -17,7 +17,7 @@ OPT      ?= -O2
 CORE_FLAGS := -std=c++11 $(OPT) -g $(WARN) -ffreestanding -fno-exceptions -fno-rtti \
               -fno-threadsafe-statics -fno-asynchronous-unwind-tables -fbuiltin -fno-math-errno \
               -fPIC -Iinclude
-HOST_CXXFLAGS := -std=c++17 $(OPT) -g $(WARN) -Iinclude -Itools/lib
+HOST_CXXFLAGS := -std=c++17 $(OPT) -g $(WARN) -pthread -Iinclude -Itools/lib
 TEST_CFLAGS   := -std=c99 $(OPT) -g -Wall -Wextra -Iinclude -Itools/lib
 TEST_LIBS     := $(shell pkg-config --libs check 2>/dev/null || echo -lcheck -lsubunit -lrt -lpthread) \
                  -llapacke -llapack -lblas -lerfa -lstdc++ -lm

@@ -200,13 +200,19 @@ Null null_step(const Run &run, Gimbal &gm, const Null &nu, const double bound[N_
     const std::vector<double> r0 = refit_residuals(run, gm, nu, all, opt);
     if (r0.empty())
         return nu;
+    // the 2 N_NULL refits side by side (parallel_for; each its own Gimbal:
+    // predict() writes the Gimbal's scratch model)
+    std::vector<double> side[2 * N_NULL];
+    parallel_for(2 * N_NULL, [&](size_t w) {
+        const int q = (int)(w / 2);
+        Null a = nu;
+        a.v[q] += (w % 2 ? -eps[q] : eps[q]);
+        Gimbal own(gm.fitted);
+        side[w] = refit_residuals(run, own, a, all, opt);
+    });
     std::vector<double> jac[N_NULL];
     for (int q = 0; q < N_NULL; q++) {
-        Null p = nu, m = nu;
-        p.v[q] += eps[q];
-        m.v[q] -= eps[q];
-        std::vector<double> rp = refit_residuals(run, gm, p, all, opt),
-                            rm = refit_residuals(run, gm, m, all, opt);
+        const std::vector<double> &rp = side[2 * q], &rm = side[2 * q + 1];
         if (rp.size() != r0.size() || rm.size() != r0.size())
             return nu;
         for (size_t i = 0; i < r0.size(); i++)
@@ -311,14 +317,15 @@ bool determined(const Fit &f)
     return err < big;
 }
 
-// Every k-th observation of run, k the smallest that leaves at most `most`.
-Run thinned(const Run &run, size_t most)
+// The observations use of run, every k-th of them, k the smallest that
+// leaves at most `most`.
+Run thinned(const Run &run, const std::vector<int> &use, size_t most)
 {
-    const size_t k = (run.obs.size() + most - 1) / most;
+    const size_t k = (use.size() + most - 1) / most;
     Run t = run;
     t.obs.clear();
-    for (size_t i = 0; i < run.obs.size(); i += k)
-        t.obs.push_back(run.obs[i]);
+    for (size_t i = 0; i < use.size(); i += k)
+        t.obs.push_back(run.obs[(size_t)use[i]]);
     return t;
 }
 
@@ -337,13 +344,16 @@ Run thinned(const Run &run, size_t most)
 // composed reading is kept only where it fits better than the
 // first-order one (chi^2; the same terms, the reading the data prefer).
 // Else, and where the baseline does not fit, has no anisotropic terms or
-// does not determine them, the run as it is and *rms = 0.
-Run composed_run(const Run &run, const ExplainOptions &opt, double *rms)
+// does not determine them, the run as it is and *rms = 0.  The baseline is
+// opt's (order, adds) fitted to the observations use; every observation is
+// corrected.
+Run composed_run(const Run &run, const ExplainOptions &opt, const std::vector<int> &use,
+                 double *rms)
 {
     const double CHI2_3_AT_1PC = 11.34;
     const size_t NULL_FIT_MOST = 2000;
     *rms = 0;
-    const std::vector<int> all = all_of(run.obs.size());
+    const std::vector<int> &all = use;
     Null none, nu;
     Run plain = run;
     double chi2_first = 0, chi2_plain = 0, chi2_null = 0;
@@ -355,8 +365,8 @@ Run composed_run(const Run &run, const ExplainOptions &opt, double *rms)
         return run;
     const Run *best = &plain;
     double chi2_best = chi2_plain;
-    const Run est = thinned(run, NULL_FIT_MOST);
-    Run est_out = thinned(plain, NULL_FIT_MOST);
+    const Run est = thinned(run, all, NULL_FIT_MOST);
+    Run est_out = thinned(plain, all, NULL_FIT_MOST);
     double chi2_est = 0;
     int P_est = 0;
     Run with = plain;
@@ -372,10 +382,10 @@ Run composed_run(const Run &run, const ExplainOptions &opt, double *rms)
     if (!(chi2_best < chi2_first))
         return run;
     double ss = 0;
-    for (size_t i = 0; i < all.size(); i++) {
-        const double d1 = std::remainder(run.obs[i].ah - best->obs[i].ah, 2 * M_PI) *
-                          std::cos(run.obs[i].ad),
-                     d2 = run.obs[i].ad - best->obs[i].ad;
+    for (int i : all) {
+        const Obs &o = run.obs[(size_t)i], &b = best->obs[(size_t)i];
+        const double d1 = std::remainder(o.ah - b.ah, 2 * M_PI) * std::cos(o.ad),
+                     d2 = o.ad - b.ad;
         ss += d1 * d1 + d2 * d2;
     }
     *rms = all.empty() ? 0 : std::sqrt(ss / (2.0 * (double)all.size()));

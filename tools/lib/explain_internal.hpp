@@ -104,7 +104,8 @@ void period_range(const Run &run, const State &st, const ExplainOptions &opt, co
 // axis (radians).  The run as it is (*rms = 0) where the baseline does not
 // fit, has no anisotropic terms or does not determine them, or where the
 // composed reading does not fit better.
-Run composed_run(const Run &run, const ExplainOptions &opt, double *rms);
+Run composed_run(const Run &run, const ExplainOptions &opt, const std::vector<int> &use,
+                 double *rms);
 
 // Solve the small dense system A x = b (n x n, row-major; x returned in b)
 // by Gaussian elimination with partial pivoting; false where a pivot is not

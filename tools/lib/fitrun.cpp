@@ -291,7 +291,7 @@ void residuals(FitOut &f, const std::vector<Obs> &obs, const std::vector<int> &u
 FitOut do_fit(const std::vector<Obs> &obs, const std::vector<int> &use, const pm_model &start,
               int max_passes)
 {
-    static pm_fit fit; // large; not on the stack
+    thread_local static pm_fit fit; // large; not on the stack (one per thread: parallel_for)
     return do_fit(fit, obs, use, start, max_passes);
 }
 

@@ -4,7 +4,13 @@
 #include <cerrno>
 #include <cstdarg>
 #include <cstdio>
+#include <atomic>
+#include <cstdlib>
 #include <cstring>
+#include <exception>
+#include <mutex>
+#include <system_error>
+#include <thread>
 
 namespace pmhost {
 
@@ -108,6 +114,58 @@ std::vector<int> all_of(size_t n)
     for (size_t i = 0; i < n; i++)
         v[i] = (int)i;
     return v;
+}
+
+unsigned host_threads()
+{
+    const char *e = std::getenv("PMFIT_THREADS");
+    if (e && *e) {
+        char *end = nullptr;
+        long v = std::strtol(e, &end, 10);
+        if (end && *end == 0 && v >= 1 && v <= 64)
+            return (unsigned)v;
+    }
+    unsigned h = std::thread::hardware_concurrency();
+    return h < 1 ? 1 : h > 8 ? 8 : h;
+}
+
+void parallel_for(size_t n, const std::function<void(size_t)> &f)
+{
+    unsigned t = host_threads();
+    if (t > n)
+        t = (unsigned)n;
+    if (t <= 1) {
+        for (size_t i = 0; i < n; i++)
+            f(i);
+        return;
+    }
+    std::atomic<size_t> next(0);
+    std::exception_ptr first;
+    std::mutex m;
+    auto work = [&]() {
+        for (size_t i; (i = next++) < n;) {
+            try {
+                f(i);
+            } catch (...) {
+                std::lock_guard<std::mutex> g(m);
+                if (!first)
+                    first = std::current_exception();
+            }
+        }
+    };
+    std::vector<std::thread> pool;
+    for (unsigned k = 1; k < t; k++) {
+        try {
+            pool.emplace_back(work);
+        } catch (const std::system_error &) {
+            break; // no more threads: the ones there share the work
+        }
+    }
+    work();
+    for (std::thread &th : pool)
+        th.join();
+    if (first)
+        std::rethrow_exception(first);
 }
 
 } // namespace pmhost

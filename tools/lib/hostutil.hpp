@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <string>
+#include <functional>
 #include <vector>
 
 namespace pmhost {
@@ -32,6 +33,15 @@ void set_err(char *err, size_t errlen, const std::string &msg);
 
 // The indices 0 .. n-1 (every observation of a run).
 std::vector<int> all_of(size_t n);
+
+// f(0) ... f(n-1), each once, on up to host_threads() threads (the calls
+// must be independent: each writes only its own results).  The results do
+// not depend on the number of threads.  The first exception a call throws
+// is rethrown here once every thread has ended.
+void parallel_for(size_t n, const std::function<void(size_t)> &f);
+// How many threads parallel_for uses: PMFIT_THREADS where set (1: none),
+// else the machine's hardware threads, at most 8.
+unsigned host_threads();
 
 } // namespace pmhost
 
