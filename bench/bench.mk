@@ -140,6 +140,11 @@ bench-run: fw-toolchain $(BN)/pmbench $(BN)/pmbench_fit $(BN)/pmbench_explain $(
 	$(BN)/pmbench_fit --max-n $(BENCH_MAX_N) --out $(BN)/fit.jsonl
 	@echo "== pmfit explain on large runs"
 	$(BN)/pmbench_explain --out $(BN)/explain.jsonl
+	$(PYTHON) tests/ref/indep_gen.py $(BN)/indep10k.dat --mount gem --n 10000 --seed 5 \
+	  --noise 1 --index-deg 3 --geom 120 --aniso 600 --effect refraction=-3 \
+	  --effect ha_periodic=1.5:240
+	$(BN)/pmbench_explain --file $(BN)/indep10k.dat explain_indep10k_aniso600 \
+	  --out $(BN)/explain.jsonl
 	@$(PYTHON) bench/report.py --dir $(BN) --targets "$(BENCH_TARGETS)"
 
 .PHONY: bench-run
