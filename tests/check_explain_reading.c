@@ -470,6 +470,39 @@ START_TEST(test_generic_reading)
 }
 END_TEST
 
+/* The generic reading where the periodic family is partly inside order 2
+** (explain_campaign.py --seed 9's single_higher_order_gem_01; the command in
+** the file's first line): a degree-2 distortion of 2.1" on 97 points of a
+** German mount, 0.30" of noise.  A two-cycle declination term takes part of
+** it first (false-alarm 1e-10); its e' cos 2dec is a combination of the
+** degree-2 terms on this sky, so the joint fit with order 2 was singular
+** and the periodic reading was kept, with a pier-side flexure after it
+** (sigma 0.386").  Dropping what order 2 holds exactly, the periodic term
+** adds nothing to order 2, which fits to 0.323": higher_order, first and
+** alone. */
+START_TEST(test_generic_reading_inside)
+{
+    const double noise = 0.30394888917754725;
+    pmx_result r;
+    const pmx_finding *f;
+    int k;
+    explain_data("indep_ho_gem_dec2.dat", NULL, &r);
+    ck_assert_int_ge(r.n_findings, 1);
+    f = &r.findings[0];
+    printf("check_explain_reading: indep_ho_gem_dec2.dat: first finding %s, sigma %.3f\" -> "
+           "%.3f\" (noise %.3f\"), %d finding(s)\n", f->effect, r.base_sigma_arcsec,
+           f->sigma_after_arcsec, noise, r.n_findings);
+    ck_assert_str_eq(f->effect, "higher_order");
+    /* order 2 leaves the noise: within 2.5 / sqrt(2 dof), 148 degrees of
+    ** freedom */
+    ck_assert(fabs(f->sigma_after_arcsec / noise - 1) <= 2.5 / sqrt(2.0 * 148));
+    for (k = 1; k < r.n_findings; k++)
+        ck_assert_msg(strcmp(r.findings[k].effect, "dec_periodic") &&
+                      strcmp(r.findings[k].effect, "pier_side"),
+                      "%s came back as finding %d", r.findings[k].effect, k + 1);
+}
+END_TEST
+
 /* The case the generic reading does not take (tests/ref/generic_case.py):
 ** a degree-2 distortion whose declination part looks like 1.5 cycles of a
 ** 4-cycle term over the declinations sampled (the periodogram's peak; the
@@ -645,6 +678,7 @@ static Suite *suite(void)
     tcase_add_test(t, test_alternatives_confusable);
     tcase_add_test(t, test_backward_pass);
     tcase_add_loop_test(t, test_generic_reading, 0, 2);
+    tcase_add_test(t, test_generic_reading_inside);
     tcase_add_test(t, test_smooth_alternative);
     tcase_add_test(t, test_subcycle_not_periodic);
     tcase_add_test(t, test_step_k_counts_pairs);
