@@ -1415,8 +1415,6 @@ Explanation explain_rounds(const Run &run, const ExplainOptions &opt)
     return ex;
 }
 
-} // namespace
-
 // Whether the composition read again (b) moves the observed positions of
 // the points use from the first one (a) by more than the search can see:
 // by an RMS d per axis with 2n d^2 > sigma^2, a shift that could change a
@@ -1433,6 +1431,8 @@ bool moved(const Run &a, const Run &b, const std::vector<int> &use, double sigma
     }
     return !(ss < sigma * sigma);
 }
+
+} // namespace
 
 // Step 1's composition read from the baseline alone, the search on the
 // run it corrects; then, where the search added terms or dropped points,
