@@ -351,9 +351,9 @@ pm_status pm_fit_add(pm_fit *fit, const pm_context *ctx, double enc_ha,
     for (int i = 0; i < P; i++)
         if (!(fit->ata[pidx(i, i)] + (r0[i] * r0[i] + r1[i] * r1[i]) <= SUM_MAX))
             return PM_ERR_NONFINITE;
-    /* the row's outer product, two columns at a time (independent sums a
-    ** host compiler's SLP pass turns into one SIMD operation each; the
-    ** normal equations are most of a large run's fitting time) */
+    /* the row's outer product, two columns at a time (independent sums:
+    ** GCC's vectoriser makes the loop two-wide SIMD on the host; the normal
+    ** equations are most of a large run's fitting time) */
     for (int i = 0; i < P; i++) {
         double *ai = fit->ata + pidx(i, 0);
         double x0 = r0[i], x1 = r1[i];

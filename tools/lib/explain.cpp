@@ -1446,20 +1446,37 @@ bool moved(const Run &a, const Run &b, const std::vector<int> &use, double sigma
 // index moved them so that their "composition" came to 7.5" and took half
 // of the refraction, which was then found at 5.4" of 10.4" beside an
 // invented higher order (docs/explain.md, "Composed as a gimbal").
+// opt with adds as its baseline's added terms, and refraction beside them
+// where it is not one and the run determines it: the composition's
+// baseline only (what the composition corrects leaves it out).
+ExplainOptions composition_options(const Run &run, const ExplainOptions &opt,
+                                   const std::vector<std::string> &adds,
+                                   const std::vector<int> &use)
+{
+    ExplainOptions o = opt;
+    o.adds = adds;
+    if (has(adds, "refraction"))
+        return o;
+    std::vector<std::string> with = adds;
+    with.push_back("refraction");
+    if (fit_spec(run, use, opt.order, with).ok)
+        o.adds = with;
+    return o;
+}
+
 Explanation explain(const Run &given, const ExplainOptions &opt)
 {
     double comp = 0;
     std::vector<int> use = all_of(given.obs.size());
     if (!opt.compose)
         return explain_rounds(given, opt);
-    Run run = composed_run(given, opt, use, &comp);
+    Run run = composed_run(given, composition_options(given, opt, opt.adds, use), use, &comp);
     Explanation ex = explain_rounds(run, opt);
     for (int again = 0; again < 2; again++) {
         if (ex.final_adds == opt.adds && ex.kept == use)
             break;
-        ExplainOptions with = opt;
-        with.adds = ex.final_adds;
         use = ex.kept;
+        const ExplainOptions with = composition_options(given, opt, ex.final_adds, use);
         double comp2 = 0;
         const Run again_run = composed_run(given, with, use, &comp2);
         if (!moved(run, again_run, use, ex.final.res.sigma))
