@@ -169,31 +169,10 @@ int main(int argc, char **argv)
     }
     snprintf(path, sizeof path, "%s/run.dat", dir);
     for (k = 0; k < sizeof sizes / sizeof sizes[0] && sizes[k] <= max_n; k++) {
-        static pmx_result r;
-        char err[512], found[256] = "";
-        double best = 1e30;
-        int rep, reps = sizes[k] > 10000 ? 1 : 3, f;
-        if (make_run(sizes[k], path) != 0)
+        char name[32];
+        snprintf(name, sizeof name, "explain_N%ld", sizes[k]);
+        if (make_run(sizes[k], path) != 0 || time_file(path, name, sizes[k], out) != 0)
             return 1;
-        for (rep = 0; rep < reps; rep++) {
-            double t0 = now(), t;
-            if (pmx_explain(path, 1, 0.01, &r, err, sizeof err) != 0) {
-                fprintf(stderr, "pmbench_explain: %s\n", err);
-                return 1;
-            }
-            t = now() - t0;
-            if (t < best)
-                best = t;
-        }
-        for (f = 0; f < r.n_findings; f++)
-            snprintf(found + strlen(found), sizeof found - strlen(found), "%s\"%s\"", f ? ", " : "",
-                     r.findings[f].effect);
-        fprintf(out,
-                "{\"name\": \"explain_N%ld\", \"n_obs\": %ld, \"seconds\": %.4f, \"base_sigma_arcsec\": "
-                "%.4f, \"final_sigma_arcsec\": %.4f, \"findings\": [%s]}\n",
-                sizes[k], sizes[k], best, r.base_sigma_arcsec, r.final_sigma_arcsec, found);
-        fflush(out);
-        fprintf(stderr, "pmbench_explain: N = %ld: %.3f s, found %s\n", sizes[k], best, found);
     }
     unlink(path);
     rmdir(dir);
