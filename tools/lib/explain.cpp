@@ -1422,14 +1422,7 @@ Explanation explain_rounds(const Run &run, const ExplainOptions &opt)
 // terms).  Below that, the search on b would answer as on a.
 bool moved(const Run &a, const Run &b, const std::vector<int> &use, double sigma)
 {
-    double ss = 0;
-    for (int i : use) {
-        const Obs &p = a.obs[(size_t)i], &q = b.obs[(size_t)i];
-        const double d1 = std::remainder(p.ah - q.ah, 2 * M_PI) * std::cos(p.ad),
-                     d2 = p.ad - q.ad;
-        ss += d1 * d1 + d2 * d2;
-    }
-    return !(ss < sigma * sigma);
+    return !(shift_ss(a, b, use) < sigma * sigma);
 }
 
 } // namespace

@@ -347,6 +347,18 @@ Run thinned(const Run &run, const std::vector<int> &use, size_t most)
 // does not determine them, the run as it is and *rms = 0.  The baseline is
 // opt's (order, adds) fitted to the observations use; every observation is
 // corrected.
+double shift_ss(const Run &a, const Run &b, const std::vector<int> &use)
+{
+    double ss = 0;
+    for (int i : use) {
+        const Obs &p = a.obs[(size_t)i], &q = b.obs[(size_t)i];
+        const double d1 = std::remainder(p.ah - q.ah, 2 * M_PI) * std::cos(p.ad),
+                     d2 = p.ad - q.ad;
+        ss += d1 * d1 + d2 * d2;
+    }
+    return ss;
+}
+
 Run composed_run(const Run &run, const ExplainOptions &opt, const std::vector<int> &use,
                  double *rms)
 {
@@ -381,14 +393,7 @@ Run composed_run(const Run &run, const ExplainOptions &opt, const std::vector<in
     }
     if (!(chi2_best < chi2_first))
         return run;
-    double ss = 0;
-    for (int i : all) {
-        const Obs &o = run.obs[(size_t)i], &b = best->obs[(size_t)i];
-        const double d1 = std::remainder(o.ah - b.ah, 2 * M_PI) * std::cos(o.ad),
-                     d2 = o.ad - b.ad;
-        ss += d1 * d1 + d2 * d2;
-    }
-    *rms = all.empty() ? 0 : std::sqrt(ss / (2.0 * (double)all.size()));
+    *rms = all.empty() ? 0 : std::sqrt(shift_ss(run, *best, all) / (2.0 * (double)all.size()));
     return *best;
 }
 

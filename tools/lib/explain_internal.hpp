@@ -106,6 +106,9 @@ void period_range(const Run &run, const State &st, const ExplainOptions &opt, co
 // composed reading does not fit better.
 Run composed_run(const Run &run, const ExplainOptions &opt, const std::vector<int> &use,
                  double *rms);
+// The sum over the observations use of the squared shift (radians^2, both
+// axes, on the sky) between the observed positions of a and b.
+double shift_ss(const Run &a, const Run &b, const std::vector<int> &use);
 
 // Solve the small dense system A x = b (n x n, row-major; x returned in b)
 // by Gaussian elimination with partial pivoting; false where a pivot is not
