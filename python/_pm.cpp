@@ -977,8 +977,8 @@ std::string explain_run(const RunData &d, int order, std::vector<std::string> ad
         fail(K_ARGUMENT, "order " + std::to_string(order) + ": expected 0.." + std::to_string(PM_MAX_L));
     if (!(alpha > 0 && alpha < 1))
         fail(K_ARGUMENT, "alpha: expected a false-alarm probability in (0, 1)");
-    if (folds < 2 || folds > (int)d.run.obs.size())
-        fail(K_ARGUMENT, "folds: expected 2 .. the number of observations");
+    if (folds < 0 || folds == 1 || folds > (int)d.run.obs.size())
+        fail(K_ARGUMENT, "folds: expected 0 (leave-one-out) or 2 .. the number of observations");
     for (double g : gears_ha)
         if (!(g > 0 && g <= 1e6))
             fail(K_ARGUMENT, "gears_ha: a gear period must be in (0, 1e6] cycles per revolution");

@@ -1441,9 +1441,12 @@ START_TEST(test_badinput_cli_unwritable_output)
 END_TEST
 
 /* A run with a point 37 deg off (fuzz/regress/explain/cv_fold_does_not_fit,
-** found by fuzz_explain): a fold of the baseline's cross-validation does
-** not fit.  explain says the CV RMS is not available (no "nan"), the JSON
-** writes null, and the gross error is still found and the rest explained. */
+** found by fuzz_explain, when the cross-validation was 5-fold): a fold of
+** the baseline's cross-validation did not fit.  No "nan", the gross error
+** still found and the rest explained.  A point that alone fixes a term:
+** left out of the leave-one-out RMS and named (before, with 5 folds, the
+** fold without it could not be fitted and the CV RMS was "not available",
+** JSON null). */
 START_TEST(test_badinput_explain_cv_not_available)
 {
     char src[1024], path[1024], sim[1024];
@@ -1466,9 +1469,9 @@ START_TEST(test_badinput_explain_cv_not_available)
     ck_assert_msg(strstr(out, "nan") == NULL, "%.2000s", out);
     ck_assert_msg(strstr(out, "1. outlier:") != NULL && strstr(out, "at line 74") != NULL,
                   "%.2000s", out);
-    /* A fold that cannot fit: the baseline's temperature term is fixed by
-    ** the one point whose temperature differs, and the fold that holds it
-    ** out is singular -- the CV RMS is "not available", never nan. */
+    /* A point the others cannot predict: the baseline's temperature term
+    ** is fixed by the one point whose temperature differs, and the fit
+    ** without it is singular (its leverage is 1). */
     tmp_path(sim, sizeof sim, "sim.dat");
     ck_assert_int_eq(pmfit("simulate '%s' --n 60 --seed 3", sim), 0);
     bytes = read_all(sim, NULL);
@@ -1489,11 +1492,13 @@ START_TEST(test_badinput_explain_cv_not_available)
     fclose(f);
     free(bytes);
     ck_assert_int_eq(pmfit("explain '%s' --add temperature", path), 0);
-    ck_assert_msg(strstr(out, "cross-validated RMS not available (a fold of the "
-                              "cross-validation did not fit)") != NULL, "%.2000s", out);
+    /* line 36: the 31st observation, after 5 header lines */
+    ck_assert_msg(strstr(out, "cross-validated without line 36: the others cannot predict it")
+                  != NULL, "%.2000s", out);
     ck_assert_msg(strstr(out, "nan") == NULL, "%.2000s", out);
     ck_assert_int_eq(pmfit("explain '%s' --add temperature --json", path), 0);
-    ck_assert_msg(strstr(out, "\"cv_rms_arcsec\": null") != NULL, "%.800s", out);
+    ck_assert_msg(strstr(out, "\"cv_left_out_lines\": [36]") != NULL, "%.800s", out);
+    ck_assert_msg(strstr(out, "\"cv_rms_arcsec\": null") == NULL, "%.800s", out);
 }
 END_TEST
 

@@ -160,7 +160,7 @@ void usage(FILE *f)
         "  residuals are too large, names the physics left out (ha_periodic, dec_periodic,\n"
         "  pier_side, refraction, tube_flexure, temperature, time_drift, hysteresis,\n"
         "  higher_order, outlier), adds it and repeats while the false-alarm probability is\n"
-        "  below P (default 0.01) and the cross-validated RMS improves (docs/explain.md);\n"
+        "  below P (default 0.01) and the leave-one-out RMS improves (docs/explain.md);\n"
         "  --plots DIR writes SVG pictures: residuals on the sky before/after, residual vs the\n"
         "  located variable, periodograms, sigma per step; --robust: explain the points a\n"
         "  robust fit of the baseline keeps (the rejected ones are listed); --gear G: a known\n"

@@ -655,14 +655,16 @@ def fit(enc_ha, enc_dec, app_ha, app_dec, *, order=1, add=(), split=False, mount
 
 
 def explain(run, *, order=1, add=(), alpha=0.01, gears=(), gears_ha=(), gears_dec=(),
-            pairs=True, folds=5, compose=True):
+            pairs=True, folds=0, compose=True):
     """What did the model leave out? ``pmfit explain RUN --json`` as a dict
     (keys in docs/formats.md, "pmfit explain --json"; docs/explain.md for
     the method): the baseline, its physical reading, where the residuals are
     too large, the findings with their sizes and false-alarm probabilities,
     and the final model.  ``gears``: known gear periods (cycles per
     revolution) of both axes (--gear G), ``gears_ha``/``gears_dec`` of one;
-    ``compose=False``: the baseline read to first order (--no-compose)."""
+    ``compose=False``: the baseline read to first order (--no-compose);
+    ``folds``: 0 cross-validates leave-one-out (from each fit itself), k >= 2
+    k-fold (k more fits each)."""
     r = _run(run)
 
     def g(name, v):

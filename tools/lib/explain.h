@@ -53,9 +53,10 @@ typedef struct pmx_finding {
 } pmx_finding;
 
 typedef struct pmx_result {
-    /* (a cross-validated RMS is NaN where a fold of the cross-validation
-    ** did not fit, e.g. beside a gross error of tens of degrees; the
-    ** finding that removes such a point is an outlier, which needs none) */
+    /* (a cross-validated RMS is NaN where the model cannot be fitted
+    ** without some point -- alone it fixes a term -- or, k-fold, where a
+    ** fold did not fit; the finding that removes such a point is an
+    ** outlier, which needs none) */
     double base_sigma_arcsec, base_cv_rms_arcsec;
     int base_n_params;
     int n_findings;
@@ -68,6 +69,8 @@ typedef struct pmx_result {
     int n_withdrawn;                 /* found, then not needed once later findings were in */
     char withdrawn[PMX_MAX_FINDINGS][24];
     double compose_rms_arcsec;       /* the composition taken out, RMS per axis (0: none) */
+    int n_cv_left_out;               /* points the baseline cannot predict from the others, */
+    int cv_left_out_lines[16];       /* left out of every CV RMS: their file lines (first 16) */
 } pmx_result;
 
 /* Explain the run in file path from a baseline of the given order; alpha is
@@ -82,14 +85,15 @@ int pmx_explain_gears(const char *path, int order, double alpha, const double *g
                       int n_gears, pmx_result *out, char *err, size_t errlen);
 
 /* Every option (pmx_options_default: order 1, alpha 0.01, no gears,
-** pairs on, folds 5). */
+** pairs on, folds 0: leave-one-out). */
 typedef struct pmx_options {
     int order;                       /* baseline harmonic order */
     double alpha;                    /* false-alarm probability to beat */
     const double *gears;             /* known gear periods, both axes (may be NULL) */
     int n_gears;
     int pairs;                       /* 1: where no single family passes, try pairs */
-    int folds;                       /* k of the k-fold cross-validation */
+    int folds;                       /* cross-validation: 0 leave-one-out (PRESS),
+                                        k >= 2 k-fold */
     int compose;                     /* 1: the baseline composed as a gimbal
                                         (docs/explain.md, step 1); 0: --no-compose */
 } pmx_options;

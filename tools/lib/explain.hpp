@@ -4,8 +4,8 @@
 // large, name the left-out effect from a catalogue of candidates (each a set
 // of core terms), add it, refit, and repeat while something significant is
 // left; significance controls false alarms (F-test p-value times the number
-// of periods scanned and of candidates tried) and is confirmed by k-fold
-// cross-validated prediction error.  docs/explain.md describes the method.
+// of periods scanned and of candidates tried) and is confirmed by the
+// leave-one-out cross-validated prediction error.  docs/explain.md describes the method.
 #ifndef PM_EXPLAIN_HPP
 #define PM_EXPLAIN_HPP
 
@@ -20,14 +20,15 @@ struct ExplainOptions {
     int order = 1;                 // baseline harmonic order
     std::vector<std::string> adds; // baseline added terms (--add)
     double alpha = 0.01;           // false-alarm probability to accept a finding
-    int folds = 5;                 // k of the k-fold cross-validation
+    int folds = 0;                 // cross-validation: 0 leave-one-out (PRESS, from the
+                                   // fit itself), k >= 2 k-fold (k more fits)
     int max_findings = 8;
     double g_min = 2, g_max = 720; // periodogram range (cycles per revolution)
     // Known gear periods (cycles per revolution, e.g. the worm's tooth
     // count): when an axis has any, its periodic candidates are only these,
     // and the false-alarm correction counts only them (--gear).
     std::vector<double> gears_ha, gears_dec;
-    unsigned seed = 1;             // fold assignment
+    unsigned seed = 1;             // fold assignment (k-fold)
     bool pairs = true;             // where no single family passes, try pairs
     double close_delta_bic = 6;    // alternatives: Delta BIC below this (for readings of
                                    // as many terms: a likelihood ratio below 20)
@@ -111,6 +112,8 @@ struct Explanation {
     std::vector<std::string> final_adds;
     int final_order = 1;
     double compose_rms_arcsec = 0;       // the composition taken out (RMS per axis), 0 if none
+    std::vector<int> cv_left_out;        // points the baseline cannot predict from the others,
+                                         // left out of every cross-validated RMS (sorted)
 };
 
 // The pipeline: baseline -> locate -> candidates -> select (singles, then
@@ -131,10 +134,12 @@ void print_explain_text(const Run &run, const Explanation &ex, int order, bool a
 // k-fold cross-validated RMS per axis (radians) of a model spec on the
 // observations `use`; train_also are added to every training fold, never
 // predicted (to measure what outliers do to the others); warm: the spec's
-// fit on all of `use`, which starts each fold's (fit_spec).
+// fit on all of `use`, which starts each fold's (fit_spec); skip: sorted
+// indices trained on but never predicted (explain's unpredictable points).
 double cv_rms(const Run &run, const std::vector<int> &use, int order,
               const std::vector<std::string> &adds, int folds, unsigned seed,
-              const std::vector<int> &train_also = {}, const pm_model *warm = nullptr);
+              const std::vector<int> &train_also = {}, const pm_model *warm = nullptr,
+              const std::vector<int> *skip = nullptr);
 
 } // namespace pmhost
 

@@ -36,6 +36,16 @@ Fit fit_spec(const Run &run, const std::vector<int> &use, int order,
              const std::vector<std::string> &adds, const pm_model *warm = nullptr);
 // A fit's model as a warm start (fit_spec), or none where it did not fit.
 inline const pm_model *warm_of(const Fit &f) { return f.ok ? &f.f.model : nullptr; }
+// The leave-one-out RMS per axis (radians) of a fit (PRESS) over its
+// points but `skip`; the points it cannot predict (H_ii's larger eigenvalue
+// above LEVERAGE_MAX); the cross-validated RMS explain decides by
+// (explain.cpp).
+const double LEVERAGE_MAX = 0.99;
+double loo_rms(const Run &run, const Fit &fit, const std::vector<int> &skip = {});
+std::vector<int> unpredictable(const Run &run, const Fit &fit);
+double cv_of(const Run &run, const std::vector<int> &use, int order,
+             const std::vector<std::string> &adds, const ExplainOptions &opt, const Fit &fit,
+             const std::vector<int> &skip);
 
 // Where the search stands: the observations used and the current model.
 struct State {
@@ -44,6 +54,8 @@ struct State {
     std::vector<std::string> adds;
     Fit cur;
     double cur_cv = 0;
+    std::vector<int> cv_skip; // the baseline's unpredictable points (sorted), left out of
+                              // every cross-validated RMS of the search
 };
 
 // One candidate explanation: a family of terms (or a pair of families, or

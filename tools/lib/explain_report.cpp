@@ -77,6 +77,15 @@ std::string interpretation_json(const Explanation &ex)
     return j + "]";
 }
 
+// The file lines of observations (run indices) as a JSON array.
+std::string lines_json(const Run &run, const std::vector<int> &idx)
+{
+    std::string s = "[";
+    for (size_t k = 0; k < idx.size(); k++)
+        s += (k ? ", " : "") + std::to_string(run.obs[idx[k]].line);
+    return s + "]";
+}
+
 } // namespace
 
 std::string explain_json(const Run &run, const Explanation &ex, int order)
@@ -85,7 +94,8 @@ std::string explain_json(const Run &run, const Explanation &ex, int order)
                     ", \"sigma_arcsec\": " + num(ex.base_sigma_arcsec) +
                     ", \"cv_rms_arcsec\": " + num(ex.base_cv_rms_arcsec) +
                     ", \"n_params\": " + std::to_string(ex.base_n_params) +
-                    ", \"composition_rms_arcsec\": " + num(ex.compose_rms_arcsec) + "}, \"mount\": " +
+                    ", \"composition_rms_arcsec\": " + num(ex.compose_rms_arcsec) +
+                    ", \"cv_left_out_lines\": " + lines_json(run, ex.cv_left_out) + "}, \"mount\": " +
                     str(run.mount == PM_MOUNT_ALTAZ ? "altaz" : "equatorial") +
                     ", \"interpretation\": " + interpretation_json(ex) + ", \"physical_reading\": " +
                     (ex.physical_reading.empty() ? "null" : str(ex.physical_reading)) +
@@ -141,13 +151,13 @@ void print_located(const Explanation &ex, double alpha, bool gears_ha, bool gear
                     pg.peak_power, alpha, pg.threshold);
 }
 
-// A cross-validated RMS for the text: NaN where a fold of the
-// cross-validation did not fit (cv_rms; null in the JSON).
+// A cross-validated RMS for the text: NaN where the model cannot be
+// fitted without some point (loo_rms, cv_rms; null in the JSON).
 std::string cv_text(double x)
 {
     return std::isfinite(x) ? fmt("%.3f\"", x)
-                            : std::string("not available (a fold of the cross-validation did "
-                                          "not fit)");
+                            : std::string("not available (the model cannot be fitted without "
+                                          "some point: alone it fixes a term)");
 }
 
 std::string cv_cell(double x)
@@ -204,6 +214,16 @@ void print_explain_text(const Run &run, const Explanation &ex, int order, bool a
     std::printf("baseline: order %d%s, P = %d, unbiased sigma %.3f\", cross-validated RMS %s\n",
                 order, added ? " + added terms" : "", ex.base_n_params, ex.base_sigma_arcsec,
                 cv_text(ex.base_cv_rms_arcsec).c_str());
+    if (!ex.cv_left_out.empty()) {
+        std::string lines;
+        for (int i : ex.cv_left_out)
+            lines += (lines.empty() ? "" : ", ") + std::to_string(run.obs[i].line);
+        std::printf("  cross-validated without line%s %s: the others cannot predict %s (%s "
+                    "alone or nearly alone fixes a combination of the terms)\n",
+                    ex.cv_left_out.size() > 1 ? "s" : "", lines.c_str(),
+                    ex.cv_left_out.size() > 1 ? "them" : "it",
+                    ex.cv_left_out.size() > 1 ? "each" : "it");
+    }
     if (ex.compose_rms_arcsec >= 0.01)
         std::printf("  its anisotropic terms composed as the mount's gimbal composes them: "
                     "%.3f\" RMS of second order, taken out of the observed positions\n",
