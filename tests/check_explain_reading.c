@@ -735,6 +735,42 @@ START_TEST(test_cv_without_unpredictable)
 }
 END_TEST
 
+/* The reading without higher_order where it predicts as well with fewer
+** terms (docs/explain.md, step 4): the TPOINT generator's German run, half
+** the sky, a pier-side flexure of 105" and a refraction of -9.64" (python3
+** tests/ref/tpoint_gen.py OUT --seed 1300524 --mount gem --format tpoint
+** --sky half --aniso 120.0 --aniso-beyond 0.0 --aniso-frame encoder
+** --effect pier_flex:104.934:on=normal,psi=0.0 --effect pressure:-9.63887).
+** Order 2 won the first step on false-alarm probability, then the pier
+** side: 48 terms, sigma 1.933", CV 2.112".  Pier side and refraction: 25
+** terms, 1.922", 2.041" -- taken, higher_order withdrawn. */
+START_TEST(test_physical_instead_of_higher)
+{
+    pmx_result r;
+    int k, pier = -1, refr = -1, withdrawn = 0;
+    explain_data("tpoint_gem_half_pier_refr.dat", NULL, &r);
+    for (k = 0; k < r.n_findings; k++) {
+        if (!strcmp(r.findings[k].effect, "pier_side"))
+            pier = k;
+        if (!strcmp(r.findings[k].effect, "refraction"))
+            refr = k;
+    }
+    for (k = 0; k < r.n_withdrawn; k++)
+        withdrawn += !strcmp(r.withdrawn[k], "higher_order");
+    printf("check_explain_reading: tpoint_gem_half_pier_refr.dat: %d finding(s) (first %s), "
+           "refraction %.2f +- %.2f\" (true -9.64\"), P = %d, higher_order withdrawn %d\n",
+           r.n_findings, r.n_findings ? r.findings[0].effect : "-",
+           refr >= 0 ? r.findings[refr].amplitude_arcsec : 0.0,
+           refr >= 0 ? r.findings[refr].amplitude_err_arcsec : 0.0, r.final_n_params, withdrawn);
+    ck_assert_int_eq(r.n_findings, 2);
+    ck_assert(pier >= 0 && refr >= 0);
+    ck_assert(fabs(r.findings[refr].amplitude_arcsec - 9.63887) <
+              3 * r.findings[refr].amplitude_err_arcsec);
+    ck_assert_int_eq(withdrawn, 1);
+    ck_assert_int_eq(r.final_n_params, 25);
+}
+END_TEST
+
 /* The step's K counts the pairs it may try (docs/explain.md step 4): a
 ** single found with pairs on reports a false-alarm probability larger by
 ** K(singles + pairs) / K(singles) than with pairs off (before, the same:
@@ -786,6 +822,7 @@ static Suite *suite(void)
     tcase_add_test(t, test_nuisance_only_when_found);
     tcase_add_test(t, test_loo_cross_validation);
     tcase_add_test(t, test_cv_without_unpredictable);
+    tcase_add_test(t, test_physical_instead_of_higher);
     tcase_add_loop_test(t, test_pairs_curve, 0, (int)(sizeof PAIRS / sizeof PAIRS[0]));
     suite_add_tcase(s, t);
     return s;
