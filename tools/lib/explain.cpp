@@ -1516,24 +1516,21 @@ Explanation explain_pass(const Run &run, const ExplainOptions &opt)
     return ex;
 }
 
-// The pipeline, and again without any family the backward pass withdrew
-// (so that every finding is described in a model without it), until
-// nothing more is withdrawn.
 // The reading without higher_order where it predicts as well with fewer
 // terms.  The search is greedy: order h+1 can win a step on false-alarm
 // probability where two physical families together would have explained
 // the same with far fewer terms (a German half-sky run of the TPOINT
 // generator with a pier-side flexure of 105" and a refraction: order 2 then
 // the pier side, sigma 1.933" and CV 2.112" with 48 terms, where pier side +
-// refraction give 1.922" and 2.040" with 25).  So where higher_order was
+// refraction give 1.922" and 2.041" with 25).  So where higher_order was
 // found, the search is run again without it; its reading is taken if it
 // keeps the same points, has fewer terms and a cross-validated RMS no
 // larger, and none of its findings is a periodic shape the run cannot
 // show to repeat (a few cycles over the sampled range: a 2-cycle Dec term
 // for a German run's degree-2 distortion); higher_order is then listed as
-// withdrawn with the reason.  (The
-// search without it starts from the caller's options: a family the
-// backward pass withdrew because order h+1 held it may be found again.)
+// withdrawn with the reason.  (The search without it starts from the
+// caller's options: a family the backward pass withdrew because order h+1
+// held it may be found again.)
 Explanation explain_rounds(const Run &run, const ExplainOptions &opt);
 
 Explanation physical_instead(const Run &run, const ExplainOptions &opt, Explanation ex)
@@ -1570,6 +1567,9 @@ Explanation physical_instead(const Run &run, const ExplainOptions &opt, Explanat
     return alt;
 }
 
+// The pipeline, and again without any family the backward pass withdrew
+// (so that every finding is described in a model without it), until
+// nothing more is withdrawn; then the physical reading at the end.
 Explanation explain_rounds(const Run &run, const ExplainOptions &opt)
 {
     Explanation ex = explain_pass(run, opt);
