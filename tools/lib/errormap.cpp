@@ -18,18 +18,12 @@ const double DEG = PI / 180;
 // sqrt((J0 C J0 + J1 C J1) / 2), C the fit's covariance (rad^2).
 double predicted_sigma(const FitOut &f, const pm_context &ctx, double t, double d)
 {
-    const pm_model &m = f.model;
-    int P = m.n_terms;
-    double T, D, r[2];
-    std::vector<double> a(PM_MAX_TERMS), b(PM_MAX_TERMS);
-    if (pm_model_apply(&m, &ctx, t, d, &T, &D) != PM_OK ||
-        pm_fit_row(&m, &ctx, t, d, T, D, a.data(), b.data(), r) != PM_OK)
+    double T, D, v[3], r[2];
+    if (pm_model_apply(&f.model, &ctx, t, d, &T, &D) != PM_OK ||
+        !row_covariance(f, ctx, t, d, T, D, v, r))
         return NAN;
-    double v = 0;
-    for (int i = 0; i < P; i++)
-        for (int j = 0; j < P; j++)
-            v += f.cov[(size_t)(i * P + j)] * (a[(size_t)i] * a[(size_t)j] + b[(size_t)i] * b[(size_t)j]);
-    return v > 0 ? std::sqrt(v / 2) : 0.0;
+    const double tr = v[0] + v[2];
+    return tr > 0 ? std::sqrt(tr / 2) : 0.0;
 }
 
 namespace {

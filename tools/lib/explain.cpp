@@ -126,28 +126,13 @@ Fit fit_dropping(const Run &run, const std::vector<int> &use, int order,
 namespace {
 
 // One point's hat block H_ii = J_i (J^T J)^-1 J_i^T (h[0] h[1]; h[1] h[2])
-// and residual r (pm_fit_row's rows and r, in one frame, so |r| is the
-// sky's); (J^T J)^-1 is the fit's covariance over sigma^2 (s2 > 0).
-bool hat_block(const Run &run, const FitOut &f, int i, double s2, std::vector<double> &w,
-               double h[3], double r[2])
+// and residual r: (J^T J)^-1 is the fit's covariance over sigma^2 (s2 > 0),
+// so H_ii is row_covariance's J C J^T over s2.
+bool hat_block(const Run &run, const FitOut &f, int i, double s2, double h[3], double r[2])
 {
-    const int P = f.model.n_terms;
-    double *j0 = w.data(), *j1 = j0 + P;
     const Obs &o = run.obs[i];
-    if (pm_fit_row(&f.model, &o.ctx, o.eh, o.ed, o.ah, o.ad, j0, j1, r) != PM_OK)
+    if (!row_covariance(f, o.ctx, o.eh, o.ed, o.ah, o.ad, h, r))
         return false;
-    h[0] = h[1] = h[2] = 0;
-    for (int a = 0; a < P; a++) {
-        const double *c = &f.cov[(size_t)a * P];
-        double x0 = 0, x1 = 0;
-        for (int b = 0; b < P; b++) {
-            x0 += c[b] * j0[b];
-            x1 += c[b] * j1[b];
-        }
-        h[0] += j0[a] * x0;
-        h[1] += j0[a] * x1;
-        h[2] += j1[a] * x1;
-    }
     h[0] /= s2;
     h[1] /= s2;
     h[2] /= s2;
@@ -177,14 +162,13 @@ double loo_rms(const Run &run, const Fit &fit, const std::vector<int> &skip)
         return NAN;
     if (!(s2 > 0))
         return 0; // fitted exactly: every point is predicted by the others too
-    std::vector<double> w(2 * (size_t)f.model.n_terms);
     double ss = 0;
     long n = 0;
     for (int i : f.idx) {
         if (std::binary_search(skip.begin(), skip.end(), i))
             continue;
         double h[3], r[2];
-        if (!hat_block(run, f, i, s2, w, h, r))
+        if (!hat_block(run, f, i, s2, h, r))
             return NAN;
         const double a00 = 1 - h[0], a11 = 1 - h[2], a01 = -h[1];
         const double det = a00 * a11 - a01 * a01;
@@ -213,10 +197,9 @@ std::vector<int> unpredictable(const Run &run, const Fit &fit)
     const double s2 = fit.f.res.sigma * fit.f.res.sigma;
     if (!covariance_usable(fit) || !(s2 > 0))
         return out;
-    std::vector<double> w(2 * (size_t)fit.f.model.n_terms);
     for (int i : fit.f.idx) {
         double h[3], r[2];
-        if (!hat_block(run, fit.f, i, s2, w, h, r))
+        if (!hat_block(run, fit.f, i, s2, h, r))
             continue;
         const double half = (h[0] + h[2]) / 2, d = h[0] * h[2] - h[1] * h[1];
         if (half + std::sqrt(std::max(0.0, half * half - d)) > LEVERAGE_MAX)
@@ -808,20 +791,10 @@ bool deleted_residual(const Run &run, const State &st, int i, double &chi2, doub
     if (!g.ok)
         return false;
     const Obs &o = run.obs[i];
-    int P = g.f.model.n_terms;
-    std::vector<double> a(PM_MAX_TERMS), b(PM_MAX_TERMS);
-    double r[2];
-    if (pm_fit_row(&g.f.model, &o.ctx, o.eh, o.ed, o.ah, o.ad, a.data(), b.data(), r) != PM_OK ||
-        g.f.cov.size() != (size_t)(P * P))
+    double v[3], r[2];
+    if (!row_covariance(g.f, o.ctx, o.eh, o.ed, o.ah, o.ad, v, r))
         return false;
-    double s2 = g.f.res.sigma * g.f.res.sigma, v00 = s2, v01 = 0, v11 = s2;
-    for (int x = 0; x < P; x++)
-        for (int y = 0; y < P; y++) {
-            double c = g.f.cov[(size_t)(x * P + y)];
-            v00 += a[(size_t)x] * c * a[(size_t)y];
-            v01 += a[(size_t)x] * c * b[(size_t)y];
-            v11 += b[(size_t)x] * c * b[(size_t)y];
-        }
+    double s2 = g.f.res.sigma * g.f.res.sigma, v00 = s2 + v[0], v01 = v[1], v11 = s2 + v[2];
     double det = v00 * v11 - v01 * v01;
     if (!(det > 0))
         return false;

@@ -2,6 +2,7 @@
 // candidate in words, with its size and where on the sky it matters, in the
 // vocabulary of the mount (equatorial or alt-az).  docs/explain.md.
 #include "explain_internal.hpp"
+#include "hostutil.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -224,9 +225,7 @@ void describe_outlier(const Run &run, const State &st, const Candidate &c, Findi
     }
     std::sort(fd.lines.begin(), fd.lines.end());
     fd.amplitude_arcsec = arcsec(worst);
-    std::string lines;
-    for (int l : fd.lines)
-        lines += (lines.empty() ? "" : ", ") + std::to_string(l);
+    const std::string lines = joined(fd.lines);
     char buf[512];
     std::snprintf(buf, sizeof buf,
                   "%zu individual bad point%s (failed plate solve, wrong star?) at line%s %s; the "

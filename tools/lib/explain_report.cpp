@@ -53,10 +53,7 @@ std::string finding_json(const Finding &f)
         j += std::string(k ? ", " : "") + str(f.adds[k]);
     j += "]";
     if (!f.lines.empty()) {
-        j += ", \"lines\": [";
-        for (size_t k = 0; k < f.lines.size(); k++)
-            j += std::string(k ? ", " : "") + std::to_string(f.lines[k]);
-        j += "]";
+        j += ", \"lines\": [" + joined(f.lines) + "]";
     }
     j += ", \"step\": " + std::to_string(f.step);
     if (!f.with.empty())
@@ -77,13 +74,13 @@ std::string interpretation_json(const Explanation &ex)
     return j + "]";
 }
 
-// The file lines of observations (run indices) as a JSON array.
-std::string lines_json(const Run &run, const std::vector<int> &idx)
+// The file lines of the points left out of the cross-validation, "1, 2".
+std::string left_out_lines(const Run &run, const Explanation &ex)
 {
-    std::string s = "[";
-    for (size_t k = 0; k < idx.size(); k++)
-        s += (k ? ", " : "") + std::to_string(run.obs[idx[k]].line);
-    return s + "]";
+    std::vector<int> lines;
+    for (int i : ex.cv_left_out)
+        lines.push_back(run.obs[i].line);
+    return joined(lines);
 }
 
 } // namespace
@@ -95,7 +92,7 @@ std::string explain_json(const Run &run, const Explanation &ex, int order)
                     ", \"cv_rms_arcsec\": " + num(ex.base_cv_rms_arcsec) +
                     ", \"n_params\": " + std::to_string(ex.base_n_params) +
                     ", \"composition_rms_arcsec\": " + num(ex.compose_rms_arcsec) +
-                    ", \"cv_left_out_lines\": " + lines_json(run, ex.cv_left_out) + "}, \"mount\": " +
+                    ", \"cv_left_out_lines\": [" + left_out_lines(run, ex) + "]}, \"mount\": " +
                     str(run.mount == PM_MOUNT_ALTAZ ? "altaz" : "equatorial") +
                     ", \"interpretation\": " + interpretation_json(ex) + ", \"physical_reading\": " +
                     (ex.physical_reading.empty() ? "null" : str(ex.physical_reading)) +
@@ -215,9 +212,7 @@ void print_explain_text(const Run &run, const Explanation &ex, int order, bool a
                 order, added ? " + added terms" : "", ex.base_n_params, ex.base_sigma_arcsec,
                 cv_text(ex.base_cv_rms_arcsec).c_str());
     if (!ex.cv_left_out.empty()) {
-        std::string lines;
-        for (int i : ex.cv_left_out)
-            lines += (lines.empty() ? "" : ", ") + std::to_string(run.obs[i].line);
+        const std::string lines = left_out_lines(run, ex);
         std::printf("  cross-validated without line%s %s: the others cannot predict %s (%s "
                     "alone or nearly alone fixes a combination of the terms)\n",
                     ex.cv_left_out.size() > 1 ? "s" : "", lines.c_str(),

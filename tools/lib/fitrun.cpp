@@ -346,6 +346,29 @@ FitOut do_fit(pm_fit &fit, const std::vector<Obs> &obs, const std::vector<int> &
     return f;
 }
 
+bool row_covariance(const FitOut &f, const pm_context &ctx, double eh, double ed, double ah,
+                    double ad, double v[3], double r[2])
+{
+    const int P = f.model.n_terms;
+    double j0[PM_MAX_TERMS], j1[PM_MAX_TERMS];
+    if (f.cov.size() != (size_t)P * (size_t)P ||
+        pm_fit_row(&f.model, &ctx, eh, ed, ah, ad, j0, j1, r) != PM_OK)
+        return false;
+    v[0] = v[1] = v[2] = 0;
+    for (int a = 0; a < P; a++) {
+        const double *c = &f.cov[(size_t)a * P];
+        double x0 = 0, x1 = 0;
+        for (int b = 0; b < P; b++) {
+            x0 += c[b] * j0[b];
+            x1 += c[b] * j1[b];
+        }
+        v[0] += j0[a] * x0;
+        v[1] += j0[a] * x1;
+        v[2] += j1[a] * x1;
+    }
+    return true;
+}
+
 // Base vectors named in a list like "c',e',i" (default: def).
 std::vector<int> parse_bases(const std::string &spec, const std::string &list,
                              const std::vector<int> &def)

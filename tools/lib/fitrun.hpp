@@ -95,6 +95,14 @@ FitOut do_fit(const std::vector<Obs> &obs, const std::vector<int> &use, const pm
 FitOut do_fit(pm_fit &work, const std::vector<Obs> &obs, const std::vector<int> &use,
               const pm_model &start, int max_passes);
 void residuals(FitOut &f, const std::vector<Obs> &obs, const std::vector<int> &use);
+// J C J^T at one position: J its two design rows at the fitted model
+// (pm_fit_row with the observed place ah, ad; the model's own prediction
+// for a place not observed), C the fit's coefficient covariance (rad^2):
+// v = (v00, v01, v11) in rad^2, and r observed minus model (pm_fit_row's
+// frame, so |r| is the sky's).  False where the rows cannot be made or the
+// fit has no covariance.
+bool row_covariance(const FitOut &f, const pm_context &ctx, double eh, double ed, double ah,
+                    double ad, double v[3], double r[2]);
 
 // The F distribution's upper tail (and its natural log, which does not
 // underflow for huge F), and the nested-model F-test.

@@ -81,6 +81,14 @@ std::string fmt(const char *f, ...)
     return out;
 }
 
+std::string joined(const std::vector<int> &v)
+{
+    std::string s;
+    for (size_t k = 0; k < v.size(); k++)
+        s += (k ? ", " : "") + std::to_string(v[k]);
+    return s;
+}
+
 std::string xml_escape(const std::string &s)
 {
     std::string o;

@@ -28,6 +28,10 @@ std::string fmt(const char *f, ...) __attribute__((format(printf, 1, 2)));
 // (valid UTF-8 passes through).
 std::string xml_escape(const std::string &s);
 
+// The numbers of v as "1, 2, 3" (file lines in a report: text, or a JSON
+// array between brackets).
+std::string joined(const std::vector<int> &v);
+
 // Copy msg into err (truncated, NUL-terminated) if err is not NULL.
 void set_err(char *err, size_t errlen, const std::string &msg);
 
