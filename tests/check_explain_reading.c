@@ -771,6 +771,41 @@ START_TEST(test_physical_instead_of_higher)
 }
 END_TEST
 
+/* The rival in the final model (docs/explain.md, "Confusable effects"):
+** a fork run of 72 points from one side of the sky (campaign seed 2,
+** tests/ref/indep_gen.py) hides a drift of 7.36"/h and one gross error
+** (line 15).  The search found temperature first, with the bad point
+** still in; with it left out, the drift fits better (sigma 2.016" against
+** 2.101").  The reading is now the drift and the outlier, temperature
+** withdrawn.  Before: temperature 5.58" +- 0.71" and the outlier. */
+START_TEST(test_rival_in_final_model)
+{
+    pmx_result r;
+    int k, drift = -1, outlier = -1, temp = 0, withdrawn = 0;
+    explain_data("indep_fork_drift_outlier.dat", NULL, &r);
+    for (k = 0; k < r.n_findings; k++) {
+        if (!strcmp(r.findings[k].effect, "time_drift"))
+            drift = k;
+        if (!strcmp(r.findings[k].effect, "outlier"))
+            outlier = k;
+        temp += !strcmp(r.findings[k].effect, "temperature");
+    }
+    for (k = 0; k < r.n_withdrawn; k++)
+        withdrawn += !strcmp(r.withdrawn[k], "temperature");
+    printf("check_explain_reading: indep_fork_drift_outlier.dat: %d finding(s), drift %.2f +- "
+           "%.2f\"/h (true 7.36), temperature found %d, withdrawn %d\n", r.n_findings,
+           drift >= 0 ? r.findings[drift].amplitude_arcsec : 0.0,
+           drift >= 0 ? r.findings[drift].amplitude_err_arcsec : 0.0, temp, withdrawn);
+    ck_assert_int_eq(r.n_findings, 2);
+    ck_assert(drift >= 0 && outlier >= 0 && temp == 0);
+    ck_assert_int_eq(r.findings[outlier].n_lines, 1);
+    ck_assert_int_eq(r.findings[outlier].lines[0], 15);
+    ck_assert(fabs(r.findings[drift].amplitude_arcsec - 7.35689) <
+              3 * r.findings[drift].amplitude_err_arcsec);
+    ck_assert_int_eq(withdrawn, 1);
+}
+END_TEST
+
 /* The step's K counts the pairs it may try (docs/explain.md step 4): a
 ** single found with pairs on reports a false-alarm probability larger by
 ** K(singles + pairs) / K(singles) than with pairs off (before, the same:
@@ -823,6 +858,7 @@ static Suite *suite(void)
     tcase_add_test(t, test_loo_cross_validation);
     tcase_add_test(t, test_cv_without_unpredictable);
     tcase_add_test(t, test_physical_instead_of_higher);
+    tcase_add_test(t, test_rival_in_final_model);
     tcase_add_loop_test(t, test_pairs_curve, 0, (int)(sizeof PAIRS / sizeof PAIRS[0]));
     suite_add_tcase(s, t);
     return s;

@@ -1540,6 +1540,81 @@ Explanation physical_instead(const Run &run, const ExplainOptions &opt, Explanat
     return alt;
 }
 
+// Families of the same terms on different inputs, which a night that cools
+// steadily confounds (temperature follows the clock): the search chooses
+// between them at the step it finds one, before the later findings are in.
+const char *const RIVALS[][2] = {{"temperature", "time_drift"}, {"time_drift", "temperature"}};
+
+// The rival of finding f in the final model: f's terms replaced by its
+// rival's (the same number), both fitted on the kept points; the rival's
+// chi^2 over f's, or NaN where it does not apply (no rival, the rival
+// found or excluded too, a fit that fails).
+double rival_ratio(const Run &run, const ExplainOptions &opt, const Explanation &ex,
+                   const Finding &f, std::string *rival)
+{
+    for (const auto &r : RIVALS) {
+        if (f.effect != r[0] || f.adds.size() != 1 || has(opt.exclude, r[1]) ||
+            std::any_of(ex.findings.begin(), ex.findings.end(),
+                        [&](const Finding &g) { return g.effect == r[1]; }))
+            continue;
+        std::vector<std::string> adds = ex.final_adds;
+        std::replace(adds.begin(), adds.end(), f.adds[0], std::string(r[1]));
+        Fit mine = fit_spec(run, ex.kept, ex.final_order, ex.final_adds, nullptr),
+            theirs = fit_spec(run, ex.kept, ex.final_order, adds, nullptr);
+        *rival = r[1];
+        if (mine.ok && theirs.ok && theirs.P == mine.P && mine.chi2 > 0)
+            return theirs.chi2 / mine.chi2;
+    }
+    return std::nan("");
+}
+
+// The rival reading where the final model prefers it.  A temperature term
+// found at step 1 is chosen against a drift with the other effects still
+// in the residuals; once they are fitted, the drift may fit better (the
+// project's campaign, seeds 1, 2, 3 and 9: 8 of the 22 runs of two or
+// three hidden effects that named temperature for a drift or the other way
+// round now name the hidden one; no other run changed).
+// So where the rival of a finding fits the final model better, the search
+// is run again without the finding's family, and its reading taken if it
+// keeps the same points, ends with the same families but the rival in the
+// finding's place, and fits with a smaller sigma and a cross-validated RMS
+// no larger; the finding is then listed as withdrawn with the reason.
+Explanation rival_instead(const Run &run, const ExplainOptions &opt, Explanation ex)
+{
+    for (size_t k = 0; k < ex.findings.size(); k++) {
+        const Finding f = ex.findings[k];
+        std::string rival;
+        double ratio = rival_ratio(run, opt, ex, f, &rival);
+        if (!(ratio < 1))
+            continue;
+        ExplainOptions o = opt;
+        o.exclude.push_back(f.effect);
+        Explanation alt = explain_rounds(run, o);
+        std::vector<std::string> want, got;
+        for (const Finding &g : ex.findings)
+            want.push_back(g.effect == f.effect ? rival : g.effect);
+        for (const Finding &g : alt.findings)
+            got.push_back(g.effect);
+        std::sort(want.begin(), want.end());
+        std::sort(got.begin(), got.end());
+        if (alt.kept != ex.kept || got != want ||
+            !(alt.final_sigma_arcsec < ex.final_sigma_arcsec) ||
+            !(alt.final_cv_rms_arcsec <= ex.final_cv_rms_arcsec))
+            continue;
+        char why[400];
+        std::snprintf(why, sizeof why,
+                      "%s (finding %d) is replaced: with the other findings in, %s fits better "
+                      "(sigma %.3f\" against %.3f\", CV RMS %.3f\" against %.3f\"); the two are "
+                      "confusable where the temperature follows the clock",
+                      f.effect.c_str(), (int)k + 1, rival.c_str(), alt.final_sigma_arcsec,
+                      ex.final_sigma_arcsec, alt.final_cv_rms_arcsec, ex.final_cv_rms_arcsec);
+        alt.withdrawn.push_back(f);
+        alt.withdrawn_why.push_back(why);
+        return alt;
+    }
+    return ex;
+}
+
 // The pipeline, and again without any family the backward pass withdrew
 // (so that every finding is described in a model without it), until
 // nothing more is withdrawn; then the physical reading at the end.
@@ -1559,7 +1634,8 @@ Explanation explain_rounds(const Run &run, const ExplainOptions &opt)
         if (!more)
             break;
     }
-    return physical_instead(run, opt, ex); // the families withdrawn beside order h+1 may return
+    // the families withdrawn beside order h+1 may return
+    return rival_instead(run, opt, physical_instead(run, opt, ex));
 }
 
 // Whether the composition read again (b) moves the observed positions of
