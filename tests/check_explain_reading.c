@@ -806,6 +806,39 @@ START_TEST(test_rival_in_final_model)
 }
 END_TEST
 
+/* The sizes are the final model's (docs/explain.md step 5): a fork run of
+** 259 points (campaign seed 1, tests/ref/indep_gen.py, an order-0
+** baseline) hides a temperature of 4.96"/C, a drift of 1.50"/h (c' +1.50,
+** e' +1.50) and a sag of 10.7".  The drift is found at step 1, where it
+** takes part of the temperature: e'*time 3.60 +- 0.11, 19 of its sigmas
+** from the truth.  In the final model, with the temperature in, it is 2.00
+** +- 0.36 (the larger of its two coefficients, the amplitude). */
+START_TEST(test_sizes_of_final_model)
+{
+    pmx_options o;
+    pmx_result r;
+    int k, drift = -1, temp = -1;
+    pmx_options_default(&o);
+    o.order = 0;
+    explain_data("indep_fork_temp_drift_sag.dat", &o, &r);
+    for (k = 0; k < r.n_findings; k++) {
+        if (!strcmp(r.findings[k].effect, "time_drift"))
+            drift = k;
+        if (!strcmp(r.findings[k].effect, "temperature"))
+            temp = k;
+    }
+    ck_assert(drift >= 0 && temp >= 0);
+    printf("check_explain_reading: indep_fork_temp_drift_sag.dat: drift %.2f +- %.2f\"/h "
+           "(true 1.50), temperature %.2f +- %.2f\"/C (true 4.96)\n",
+           r.findings[drift].amplitude_arcsec, r.findings[drift].amplitude_err_arcsec,
+           r.findings[temp].amplitude_arcsec, r.findings[temp].amplitude_err_arcsec);
+    ck_assert(fabs(r.findings[drift].amplitude_arcsec - 1.49954) <
+              3 * r.findings[drift].amplitude_err_arcsec);
+    ck_assert(fabs(r.findings[temp].amplitude_arcsec - 4.95928) <
+              3 * r.findings[temp].amplitude_err_arcsec);
+}
+END_TEST
+
 /* The step's K counts the pairs it may try (docs/explain.md step 4): a
 ** single found with pairs on reports a false-alarm probability larger by
 ** K(singles + pairs) / K(singles) than with pairs off (before, the same:
@@ -859,6 +892,7 @@ static Suite *suite(void)
     tcase_add_test(t, test_cv_without_unpredictable);
     tcase_add_test(t, test_physical_instead_of_higher);
     tcase_add_test(t, test_rival_in_final_model);
+    tcase_add_test(t, test_sizes_of_final_model);
     tcase_add_loop_test(t, test_pairs_curve, 0, (int)(sizeof PAIRS / sizeof PAIRS[0]));
     suite_add_tcase(s, t);
     return s;

@@ -1220,10 +1220,14 @@ void record(const Run &run, State &st, const Candidate &c, const std::vector<Can
     for (double &x : d)
         x = arcsec(x);
     std::vector<Alternative> alts = alternatives(run, st, c, cands, opt);
+    int step_no = 1; // one step for both members of a pair
+    for (const std::vector<Finding> *v : {&ex.findings, &ex.withdrawn})
+        for (const Finding &f : *v)
+            step_no = std::max(step_no, f.step + 1);
     for (Finding &fd : describe(run, st, c, opt)) {
         fd.adds = c.new_adds;
         fd.trials = c.trials;
-        fd.step = (int)(ex.findings.size() + ex.withdrawn.size()) + 1;
+        fd.step = step_no;
         fd.false_alarm_probability = std::exp(c.log_fap);
         fd.log10_p = c.log_fap / LN10;
         fd.sigma_after_arcsec = arcsec(c.fit.f.res.sigma);
@@ -1479,6 +1483,8 @@ Explanation explain_pass(const Run &run, const ExplainOptions &opt)
     while ((int)ex.findings.size() < opt.max_findings && step(run, st, opt, ex)) {
     }
     prune(run, st, opt, ex);
+    for (Finding &f : ex.findings)
+        describe_final(run, st, f);
     ex.final = st.cur.f;
     ex.kept = st.use;
     ex.final_sigma_arcsec = arcsec(st.cur.f.res.sigma);

@@ -81,6 +81,7 @@ struct Finding {
     std::string text;         // what it is, in plain words, with its size
     std::string where;        // where on the sky (or when) it matters
     std::vector<std::string> adds; // the terms added (pmfit --add syntax)
+    std::vector<std::string> term_names; // those terms' names in the model (term_name)
     double cycles_per_rev = 0, amplitude_arcsec = 0, amplitude_err_arcsec = 0, phase_deg = 0;
     double cycles_lo = 0, cycles_hi = 0; // periodic: the periods that fit as well (lo..hi)
     double sampled_deg = 0;               // periodic: the extent of the axis the run samples

@@ -138,6 +138,10 @@ inline bool pairable(const Candidate &c)
 // The finding(s) one accepted candidate makes: one per member family.
 std::vector<Finding> describe(const Run &run, const State &st, const Candidate &c,
                               const ExplainOptions &opt);
+// A finding's size, error, phase and text from the final model (st.cur:
+// every finding in, the outliers left out) instead of its step's; outliers
+// and higher_order keep their step's.
+void describe_final(const Run &run, const State &st, Finding &fd);
 
 } // namespace xdetail
 } // namespace pmhost

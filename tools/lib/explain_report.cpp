@@ -175,10 +175,11 @@ void print_findings(const Explanation &ex, double alpha)
         if (!f.with.empty())
             std::printf("     found together with %s: neither alone passed, the pair does\n",
                         f.with.c_str());
-        std::printf("     where: %s\n     false-alarm probability %.2g (10^%.1f); with it sigma "
-                    "%.3f\", CV RMS %s, P = %d\n",
-                    f.where.c_str(), f.false_alarm_probability, f.log10_p, f.sigma_after_arcsec,
-                    cv_text(f.cv_rms_after_arcsec).c_str(), f.n_params_after);
+        // the sizes above are the final model's, these the step's (docs/explain.md step 5)
+        std::printf("     where: %s\n     step %d: false-alarm probability %.2g (10^%.1f); with "
+                    "it sigma %.3f\", CV RMS %s, P = %d\n",
+                    f.where.c_str(), f.step, f.false_alarm_probability, f.log10_p,
+                    f.sigma_after_arcsec, cv_text(f.cv_rms_after_arcsec).c_str(), f.n_params_after);
         for (const Alternative &a : f.alternatives) {
             if (a.smooth)
                 std::printf("     or a smooth shape: %s (false-alarm 10^%.1f) holds all that the "
