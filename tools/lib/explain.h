@@ -41,8 +41,9 @@ typedef struct pmx_finding {
     double cycles_per_rev;           /* periodic effects, else 0 */
     double cycles_lo, cycles_hi;     /* periodic: the periods that fit as well (95%),
                                         cycles_per_rev itself where the run fixes it */
-    double amplitude_arcsec, amplitude_err_arcsec, phase_deg;
-    double false_alarm_probability;
+    double amplitude_arcsec, amplitude_err_arcsec, phase_deg; /* in the final model (every
+                                        finding in); higher_order, outliers: at their step */
+    double false_alarm_probability;  /* these four: at the step that found it */
     double sigma_after_arcsec, cv_rms_after_arcsec;
     int n_params_after;
     int n_lines;                     /* outliers: how many points */
