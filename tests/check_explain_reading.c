@@ -56,6 +56,25 @@ static const pmx_reading *reading(const pmx_result *r, const char *what)
     return NULL;
 }
 
+/* The index of the (last) finding of this effect, -1 if none. */
+static int finding_index(const pmx_result *r, const char *effect)
+{
+    int k, at = -1;
+    for (k = 0; k < r->n_findings; k++)
+        if (!strcmp(r->findings[k].effect, effect))
+            at = k;
+    return at;
+}
+
+/* How many of the withdrawn findings are of this effect. */
+static int withdrawn_count(const pmx_result *r, const char *effect)
+{
+    int k, n = 0;
+    for (k = 0; k < r->n_withdrawn; k++)
+        n += !strcmp(r->withdrawn[k], effect);
+    return n;
+}
+
 static void check_reading(const pmx_result *r, const char *what, double truth)
 {
     const pmx_reading *x = reading(r, what);
@@ -397,19 +416,15 @@ START_TEST(test_backward_pass)
 {
     pmx_options o;
     pmx_result r;
-    int k, sag = -1, temp = -1;
+    int sag, temp;
     pmx_options_default(&o);
     o.order = 0;
     explain_data("indep_temp_sag_fork.dat", &o, &r);
     ck_assert_int_eq(r.n_withdrawn, 1);
     ck_assert_str_eq(r.withdrawn[0], "time_drift");
-    for (k = 0; k < r.n_findings; k++) {
-        ck_assert_str_ne(r.findings[k].effect, "time_drift");
-        if (!strcmp(r.findings[k].effect, "tube_flexure"))
-            sag = k;
-        if (!strcmp(r.findings[k].effect, "temperature"))
-            temp = k;
-    }
+    ck_assert_int_eq(finding_index(&r, "time_drift"), -1);
+    sag = finding_index(&r, "tube_flexure");
+    temp = finding_index(&r, "temperature");
     ck_assert_int_eq(r.n_findings, 2);
     ck_assert(sag >= 0 && temp >= 0);
     printf("check_explain_reading: backward pass: time_drift withdrawn; sag %.2f\" (truth 10.00\"), "
@@ -426,14 +441,9 @@ START_TEST(test_backward_pass)
     explain_data("indep_temp_sag_gem.dat", &o, &r);
     ck_assert_int_eq(r.n_withdrawn, 1);
     ck_assert_str_eq(r.withdrawn[0], "higher_order");
-    sag = temp = -1;
-    for (k = 0; k < r.n_findings; k++) {
-        ck_assert_str_ne(r.findings[k].effect, "higher_order");
-        if (!strcmp(r.findings[k].effect, "tube_flexure"))
-            sag = k;
-        if (!strcmp(r.findings[k].effect, "temperature"))
-            temp = k;
-    }
+    ck_assert_int_eq(finding_index(&r, "higher_order"), -1);
+    sag = finding_index(&r, "tube_flexure");
+    temp = finding_index(&r, "temperature");
     ck_assert(sag >= 0 && temp >= 0);
     printf("check_explain_reading: backward pass: higher_order withdrawn for tube flexure; sag "
            "%.2f\" (truth 2.80\")\n", r.findings[sag].amplitude_arcsec);
@@ -747,16 +757,11 @@ END_TEST
 START_TEST(test_physical_instead_of_higher)
 {
     pmx_result r;
-    int k, pier = -1, refr = -1, withdrawn = 0;
+    int pier, refr, withdrawn;
     explain_data("tpoint_gem_half_pier_refr.dat", NULL, &r);
-    for (k = 0; k < r.n_findings; k++) {
-        if (!strcmp(r.findings[k].effect, "pier_side"))
-            pier = k;
-        if (!strcmp(r.findings[k].effect, "refraction"))
-            refr = k;
-    }
-    for (k = 0; k < r.n_withdrawn; k++)
-        withdrawn += !strcmp(r.withdrawn[k], "higher_order");
+    pier = finding_index(&r, "pier_side");
+    refr = finding_index(&r, "refraction");
+    withdrawn = withdrawn_count(&r, "higher_order");
     printf("check_explain_reading: tpoint_gem_half_pier_refr.dat: %d finding(s) (first %s), "
            "refraction %.2f +- %.2f\" (true -9.64\"), P = %d, higher_order withdrawn %d\n",
            r.n_findings, r.n_findings ? r.findings[0].effect : "-",
@@ -781,17 +786,12 @@ END_TEST
 START_TEST(test_rival_in_final_model)
 {
     pmx_result r;
-    int k, drift = -1, outlier = -1, temp = 0, withdrawn = 0;
+    int drift, outlier, temp, withdrawn;
     explain_data("indep_fork_drift_outlier.dat", NULL, &r);
-    for (k = 0; k < r.n_findings; k++) {
-        if (!strcmp(r.findings[k].effect, "time_drift"))
-            drift = k;
-        if (!strcmp(r.findings[k].effect, "outlier"))
-            outlier = k;
-        temp += !strcmp(r.findings[k].effect, "temperature");
-    }
-    for (k = 0; k < r.n_withdrawn; k++)
-        withdrawn += !strcmp(r.withdrawn[k], "temperature");
+    drift = finding_index(&r, "time_drift");
+    outlier = finding_index(&r, "outlier");
+    temp = finding_index(&r, "temperature") >= 0;
+    withdrawn = withdrawn_count(&r, "temperature");
     printf("check_explain_reading: indep_fork_drift_outlier.dat: %d finding(s), drift %.2f +- "
            "%.2f\"/h (true 7.36), temperature found %d, withdrawn %d\n", r.n_findings,
            drift >= 0 ? r.findings[drift].amplitude_arcsec : 0.0,
@@ -817,16 +817,12 @@ START_TEST(test_sizes_of_final_model)
 {
     pmx_options o;
     pmx_result r;
-    int k, drift = -1, temp = -1;
+    int drift, temp;
     pmx_options_default(&o);
     o.order = 0;
     explain_data("indep_fork_temp_drift_sag.dat", &o, &r);
-    for (k = 0; k < r.n_findings; k++) {
-        if (!strcmp(r.findings[k].effect, "time_drift"))
-            drift = k;
-        if (!strcmp(r.findings[k].effect, "temperature"))
-            temp = k;
-    }
+    drift = finding_index(&r, "time_drift");
+    temp = finding_index(&r, "temperature");
     ck_assert(drift >= 0 && temp >= 0);
     printf("check_explain_reading: indep_fork_temp_drift_sag.dat: drift %.2f +- %.2f\"/h "
            "(true 1.50), temperature %.2f +- %.2f\"/C (true 4.96)\n",
