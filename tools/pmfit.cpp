@@ -1331,10 +1331,7 @@ int cmd_simulate(const Options &o, int argc, char **argv)
             m.coef[i] = o.random_aniso / RAD2AS * g(rng);
     }
     for (const auto &t : o.terms) {
-        int found = -1;
-        for (int i = 0; i < m.n_terms; i++)
-            if (term_name(m, i) == t.first)
-                found = i;
+        int found = term_index(m, t.first);
         if (found < 0)
             die("--term: no term '" + t.first + "' in an order-" + std::to_string(o.order) +
                 " model (names as pmfit fit prints them, e.g. c' or d*Y(1,-1))");

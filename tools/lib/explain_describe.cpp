@@ -375,10 +375,8 @@ void describe_final(const Run &run, const State &st, Finding &fd)
     const pm_model &m = st.cur.f.model;
     std::vector<int> newi;
     for (const std::string &n : fd.term_names) {
-        int i = 0;
-        while (i < m.n_terms && term_name(m, i) != n)
-            i++;
-        if (i == m.n_terms)
+        int i = term_index(m, n);
+        if (i < 0)
             return;
         newi.push_back(i);
     }

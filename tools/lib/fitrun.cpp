@@ -145,6 +145,15 @@ std::string term_name(const pm_model &m, int i)
     return buf;
 }
 
+int term_index(const pm_model &m, const std::string &name, int n)
+{
+    int found = -1;
+    for (int i = 0; i < (n < 0 ? m.n_terms : n); i++)
+        if (term_name(m, i) == name)
+            found = i;
+    return found;
+}
+
 // Physical meaning of a term, for the table.
 std::string meaning(const pm_model &m, int i)
 {
@@ -564,10 +573,7 @@ static void add_aux(ModelBuilder &b, const AddSpec &a, pm_term t, const std::vec
 // A harmonic term of the model by name (c'*Y(1,0)@E ...), for one pier side.
 static void add_side_harmonic(ModelBuilder &b, const AddSpec &a)
 {
-    int found = -1;
-    for (int i = 0; i < b.m.n_base; i++)
-        if (term_name(b.m, i) == a.body)
-            found = i;
+    int found = term_index(b.m, a.body, b.m.n_base);
     if (found < 0)
         throw std::runtime_error("--add " + a.spec + ": unknown effect or term (see pmfit --help)");
     if (!a.side)

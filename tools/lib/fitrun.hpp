@@ -67,6 +67,9 @@ double widest_gap(const std::vector<double> &ang, double *middle = nullptr);
 
 // Name and physical meaning of a model term.
 std::string term_name(const pm_model &m, int i);
+// The index of the term named `name` (term_name) among the first n terms
+// of m (all of them where n < 0), -1 if none.
+int term_index(const pm_model &m, const std::string &name, int n = -1);
 std::string meaning(const pm_model &m, int i);
 std::string json_escape(const std::string &s);
 
