@@ -1504,7 +1504,9 @@ PM_HOT bool rounding_safe(const Branch *s, const Trig<double> &gb, double t, dou
 /* The result from the best point: its angles, checked by Newton (newton)
 ** where the iteration did not converge, the closed form did not reach
 ** the target, the point is not on the side wanted or rounding could
-** matter (rounding_safe). */
+** matter (rounding_safe).  *err_out: Newton's measured miss, or -1 where
+** the point is returned without Newton (PM_OK, and on the side wanted
+** where want is given: invert need not ask side_of again). */
 PM_HOT pm_status finish_branch(Branch *s, int want, const double *turn, double *t_out,
                                double *d_out, double *err_out)
 {
@@ -1516,7 +1518,7 @@ PM_HOT pm_status finish_branch(Branch *s, int want, const double *turn, double *
     double d = gb.d;
     bool converged = s->converged && rounding_safe(s, gb, t, d);
     pm_status result = PM_OK;
-    double err = 0;
+    double err = -1; /* (no Newton: see above) */
     if (s->carry)
         s->carry->out_trig = false;
     if (!converged || !reachable || (want && side_of(s->m, d) != want)) {
@@ -1862,7 +1864,8 @@ pm_status invert(const pm_model *m, const pm_context *ctx, double app_ha,
         TRACK ? solve_branch<true>(m, k, ctx, a, side, 0, start, carry, turn, &t, &d, &err)
               : solve_branch<false>(m, k, ctx, a, side, start ? 0 : side, start, 0, turn, &t,
                                     &d, &err);
-    if (!TRACK && !start && (result != PM_OK || side_of(m, d) != side)) {
+    /* (err < 0: PM_OK on the side asked for, finish_branch checked it) */
+    if (!TRACK && !start && (result != PM_OK || (err >= 0 && side_of(m, d) != side))) {
         /* Within the anisotropic amplitude of the mount's pole the closed
         ** form's branches (sign of cos(dec - e' + displacement angle)) and
         ** the sides of the pole (sign of cos(dec - e')) differ: the other
