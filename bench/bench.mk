@@ -149,6 +149,14 @@ bench-run: fw-toolchain $(BN)/pmbench $(BN)/pmbench_fit $(BN)/pmbench_explain $(
 
 .PHONY: bench-run
 
+# The numbers behind the stateless inverse's floor (docs/performance.md,
+# stop 32): the bounds it certifies with, |D| and the real |J|.
+$(BN)/pminv_floor: bench/inv_floor.c bench/bench_common.c $(BN)/host/naive.o $(BENCH_SRC_H) \
+                   $(B)/libpm.a
+	@mkdir -p $(@D)
+	$(CC) $(BENCH_CFLAGS) bench/inv_floor.c bench/bench_common.c $(BN)/host/naive.o \
+	  $(B)/libpm.a -lstdc++ -lm -o $@
+
 # The double inverse's outcomes on large samples (issue 18, round 3):
 # pmbench_inv_stress real [N] [SEED] | hard (bench/inv_stress.c).
 $(BN)/pmbench_inv_stress: bench/inv_stress.c tests/hard_cases.h tests/testutil.h tests/probe.h \
