@@ -27,7 +27,11 @@ the final run is scored:
                the injected noise; the others: amplitude within 25%
   extra        runs with a finding besides the hidden effect
   (notes: "first or its close alternative" counts runs whose first finding
-  offers the hidden effect as the reading of close evidence, item 3 of issue 15)
+  offers the hidden effect as the reading of close evidence, item 3 of issue 15;
+  "params ok where its own +- <= 12.5%" counts params ok among the runs whose
+  reported amplitude sigma is at most 12.5% of the true size, where 25% is
+  within 2 sigma: the runs that can tell their amplitude to 25%; a line after
+  the table sums that over every amplitude, and over the runs that cannot)
 
 Null runs (nothing hidden) count runs with no finding; the calibration
 baselines of every case are null runs too and are tallied as such.  Two and
@@ -249,6 +253,9 @@ def score_single(effect, d, truth, cfg):
         if effect not in ("outlier", "higher_order") and f.get("amplitude_error_arcsec"):
             info["amp_pull"] = (amp - te["explain_amplitude_arcsec"]) / f["amplitude_error_arcsec"]
             info["amp_in_2sigma"] = bool(abs(info["amp_pull"]) <= 2)
+            # the run's own precision: its reported sigma over the true size
+            # (25% is within 2 of its sigmas where this is <= 0.125)
+            info["amp_rel_sigma"] = f["amplitude_error_arcsec"] / te["explain_amplitude_arcsec"]
         if effect in ("ha_periodic", "dec_periodic"):
             G = te["G"]
             g_ok = abs(f.get("cycles_per_rev", -1) - G) < 1e-6
@@ -514,6 +521,10 @@ def main():
                 if miss:
                     notes.append("of the params misses %d/%d" % (
                         sum(x["score"]["amp_in_2sigma"] for x in miss), len(miss)))
+                fine = [x for x in a2 if x["score"]["amp_rel_sigma"] <= 0.125]
+                if len(fine) != len(a2):
+                    notes.append("params ok where its own +- <= 12.5%% %d/%d" % (
+                        sum(x["score"]["params_ok"] for x in fine), len(fine)))
             fa = sum(x["score"].get("first_or_alt", False) for x in good)
             if fa != nf:
                 notes.append("first or its close alternative %d/%d" % (fa, len(good)))
@@ -537,6 +548,19 @@ def main():
               "mean %.2f, std %.2f, within 2 sigma %s; largest %.1f (%s)" % (
                   len(pa), pa.mean(), pa.std(), pct(int((abs(pa) <= 2).sum()), len(pa)),
                   worst["score"]["amp_pull"], worst["tag"]))
+
+    if pulled:
+        # how far 25% is what the runs themselves can tell: the parameters
+        # within 25% among the runs whose own reported sigma is at most 12.5%
+        # of the true size (25% within 2 sigma), and among the others
+        fine = [x for x in pulled if x["score"]["amp_rel_sigma"] <= 0.125]
+        coarse = [x for x in pulled if x["score"]["amp_rel_sigma"] > 0.125]
+        print("parameters within 25%%, by the run's own precision (reported sigma / true size): "
+              "<= 12.5%%: %d/%d (%s); above: %d/%d (%s)" % (
+                  sum(x["score"]["params_ok"] for x in fine), len(fine),
+                  pct(sum(x["score"]["params_ok"] for x in fine), len(fine)),
+                  sum(x["score"]["params_ok"] for x in coarse), len(coarse),
+                  pct(sum(x["score"]["params_ok"] for x in coarse), len(coarse))))
 
     print("\nnothing hidden")
     print("%-32s %-6s %5s  %s" % ("runs", "mount", "n", "no finding  (found instead)"))
