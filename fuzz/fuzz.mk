@@ -16,8 +16,9 @@ FUZZ_SECONDS ?= 60
 FUZZ_FLAGS   ?= -rss_limit_mb=2048
 # Seconds one input may run (a hang detector; slower ones are also written
 # out as slow units, which fail the run): 10, but 60 for explain, whose
-# whole pipeline takes 0.4-0.6 s on a 75-140-point run in the release build
-# and 25-40 times that instrumented (ASan + UBSan at -O1: 12-15 s seen).
+# whole pipeline takes 0.4-0.6 s on a run of 75-140 lines in the release
+# build and 25-40 times that instrumented (ASan + UBSan at -O1: 12-38 s
+# seen; fuzz/README.md).
 FUZZ_TIMEOUT ?= 10
 FUZZ_TIMEOUT_explain ?= 60
 FUZZ_TARGETS := runfile modelfile capi fit explain plan
