@@ -237,6 +237,16 @@ def calibrate(rn, base_path, cfg, order0, sigma0, spec, trial, extra, target):
     return min(roots, key=lambda r: abs(r - s2)), None
 
 
+# A run can tell its amplitude to 25% where its reported sigma is at most
+# this fraction of the true size (25% is then within 2 sigma).
+TELLS_25 = 0.125
+
+
+def tells_25(x):
+    """Does this scored single run's own sigma allow 25%?"""
+    return x["score"]["amp_rel_sigma"] <= TELLS_25
+
+
 def score_single(effect, d, truth, cfg):
     fnd = d["findings"]
     names = [f["effect"] for f in fnd]
@@ -254,7 +264,7 @@ def score_single(effect, d, truth, cfg):
             info["amp_pull"] = (amp - te["explain_amplitude_arcsec"]) / f["amplitude_error_arcsec"]
             info["amp_in_2sigma"] = bool(abs(info["amp_pull"]) <= 2)
             # the run's own precision: its reported sigma over the true size
-            # (25% is within 2 of its sigmas where this is <= 0.125)
+            # (25% is within 2 of its sigmas where this is <= TELLS_25)
             info["amp_rel_sigma"] = f["amplitude_error_arcsec"] / te["explain_amplitude_arcsec"]
         if effect in ("ha_periodic", "dec_periodic"):
             G = te["G"]
@@ -521,7 +531,7 @@ def main():
                 if miss:
                     notes.append("of the params misses %d/%d" % (
                         sum(x["score"]["amp_in_2sigma"] for x in miss), len(miss)))
-                fine = [x for x in a2 if x["score"]["amp_rel_sigma"] <= 0.125]
+                fine = [x for x in a2 if tells_25(x)]
                 if len(fine) != len(a2):
                     notes.append("params ok where its own +- <= 12.5%% %d/%d" % (
                         sum(x["score"]["params_ok"] for x in fine), len(fine)))
@@ -553,8 +563,8 @@ def main():
         # how far 25% is what the runs themselves can tell: the parameters
         # within 25% among the runs whose own reported sigma is at most 12.5%
         # of the true size (25% within 2 sigma), and among the others
-        fine = [x for x in pulled if x["score"]["amp_rel_sigma"] <= 0.125]
-        coarse = [x for x in pulled if x["score"]["amp_rel_sigma"] > 0.125]
+        fine = [x for x in pulled if tells_25(x)]
+        coarse = [x for x in pulled if not tells_25(x)]
         print("parameters within 25%%, by the run's own precision (reported sigma / true size): "
               "<= 12.5%%: %d/%d (%s); above: %d/%d (%s)" % (
                   sum(x["score"]["params_ok"] for x in fine), len(fine),
