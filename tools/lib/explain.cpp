@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 #include <map>
 #include <numeric>
 #include <random>
@@ -647,14 +648,47 @@ bool opt_is_scan(const ExplainOptions &opt, int comp)
 // The periodogram decides integer vs non-integer G on the baseline's
 // residuals; a term correlated with the model's own terms can tip it.  The
 // full fits decide: an integer G moves to a whole-number neighbour that
-// fits better; a non-integer G becomes the better of the two integers
-// beside it (a worm has whole teeth) unless its chi^2 exceeds the
-// non-integer's by more than INTEGER_REJECT_CHI2 sigma^2.  *chosen: the
-// fit of the period G ends at (the candidate's, score need not make it).
+// fits better; a non-integer G becomes the best whole number found so
+// (a worm has whole teeth, a track or bearing turns with its axis) unless
+// its chi^2 exceeds the non-integer's by more than INTEGER_REJECT_CHI2
+// sigma^2.  *chosen: the fit of the period G ends at (the candidate's,
+// score need not make it).
+using FitAt = std::function<Fit(double)>;
+
+// From the whole number G (its fit `here`), up to three moves to the
+// better of its neighbours within [g_lo, g_hi] while one fits better.
+// below / above: the neighbours' fits where made already (not ok: made
+// here, side by side).
+void walk_integers(const FitAt &fit_at, double g_lo, double g_hi, double &G, Fit &here,
+                   Fit below = Fit(), Fit above = Fit())
+{
+    for (int moves = 0; here.ok && moves < 3; moves++) {
+        parallel_for(2, [&](size_t q) {
+            if (q == 0 && !below.ok && G - 1 >= g_lo)
+                below = fit_at(G - 1);
+            if (q == 1 && !above.ok && G + 1 <= g_hi)
+                above = fit_at(G + 1);
+        });
+        if (below.ok && below.chi2 < here.chi2 && !(above.ok && above.chi2 < below.chi2)) {
+            above = here; // (the neighbours of G - 1: G, known, and G - 2)
+            here = below;
+            below = Fit();
+            G -= 1;
+        } else if (above.ok && above.chi2 < here.chi2) {
+            below = here;
+            here = above;
+            above = Fit();
+            G += 1;
+        } else {
+            break;
+        }
+    }
+}
+
 void prefer_integer(const Run &run, const State &st, const char *prefix, double g_lo,
                     double g_hi, double &G, Fit *chosen)
 {
-    auto fit_at = [&](double g) {
+    const FitAt fit_at = [&](double g) {
         char a[64];
         std::snprintf(a, sizeof a, "%s%.6g", prefix, g);
         std::vector<std::string> ai = st.adds;
@@ -666,29 +700,7 @@ void prefer_integer(const Run &run, const State &st, const char *prefix, double 
         // its circle the baseline's periodogram can tip to a neighbour
         // (310 for 309) that the full fit does not prefer
         Fit here = fit_at(G);
-        for (int moves = 0; here.ok && moves < 3; moves++) {
-            Fit below, above; // fitted side by side (parallel_for)
-            parallel_for(2, [&](size_t q) {
-                if (q == 0 && G - 1 >= g_lo)
-                    below = fit_at(G - 1);
-                if (q == 1 && G + 1 <= g_hi)
-                    above = fit_at(G + 1);
-            });
-            double next = G;
-            Fit best = here;
-            if (below.ok && below.chi2 < best.chi2) {
-                best = below;
-                next = G - 1;
-            }
-            if (above.ok && above.chi2 < best.chi2) {
-                best = above;
-                next = G + 1;
-            }
-            if (next == G)
-                break;
-            G = next;
-            here = best;
-        }
+        walk_integers(fit_at, g_lo, g_hi, G, here);
         *chosen = here;
         return;
     }
@@ -707,11 +719,20 @@ void prefer_integer(const Run &run, const State &st, const char *prefix, double 
     *chosen = fg;
     if (!fg.ok || (!f0.ok && !f1.ok))
         return;
+    // and from the better of them on, as for a whole G: where the axis is
+    // sampled over a cycle or two, the order-1 baseline takes up part of a
+    // low G and moves the periodogram's peak (a three-cycle azimuth runout
+    // on half the circle peaked at 4.2, and 3 fits better than 4.2)
     bool take1 = f1.ok && (!f0.ok || f1.chi2 < f0.chi2);
-    const Fit &fi = take1 ? f1 : f0;
+    double gi = take1 ? g1 : g0;
+    Fit fi = take1 ? f1 : f0;
+    if (take1)
+        walk_integers(fit_at, g_lo, g_hi, gi, fi, f0, Fit());
+    else
+        walk_integers(fit_at, g_lo, g_hi, gi, fi, Fit(), f1);
     double s2 = fg.chi2 / (double)std::max(1L, 2 * fg.N - fg.P);
     if ((fi.chi2 - fg.chi2) / s2 <= INTEGER_REJECT_CHI2) {
-        G = take1 ? g1 : g0;
+        G = gi;
         *chosen = fi;
     }
 }
