@@ -806,6 +806,46 @@ START_TEST(test_rival_in_final_model)
 }
 END_TEST
 
+/* The rival offered in the final model (docs/explain.md, "Confusable
+** effects"): a German run of 117 points (campaign seed 11, tests/ref/
+** indep_gen.py, the parameters in its first line) hides a pier-side
+** flexure of 36" and a drift of 5.1"/h.  Step 1, with the pier side still
+** in the residuals, takes temperature (the night cools, and the west side
+** was observed later); in the final model, beside the pier side, the drift
+** fits as well (sigma 2.551" against 2.560", likelihood ratio 2 for it),
+** but the search without temperature did not end with the same families,
+** so temperature stays.  It was named with no alternative; the drift is now
+** offered beside it (kind "final", Delta BIC below 6).  A drift named
+** outright would pass too. */
+START_TEST(test_rival_offered_in_final_model)
+{
+    pmx_result r;
+    int drift, temp, pier, k, offered = 0;
+    explain_data("indep_gem_pier_drift.dat", NULL, &r);
+    drift = finding_index(&r, "time_drift");
+    temp = finding_index(&r, "temperature");
+    pier = finding_index(&r, "pier_side");
+    ck_assert(pier >= 0);
+    ck_assert(drift >= 0 || temp >= 0);
+    if (temp >= 0) {
+        for (k = 0; k < r.findings[temp].n_alternatives; k++) {
+            const pmx_alternative *a = &r.findings[temp].alternatives[k];
+            if (strcmp(a->effect, "time_drift") == 0) {
+                printf("check_explain_reading: indep_gem_pier_drift.dat: temperature, with "
+                       "time_drift beside it (final %d, Delta BIC %+.2f, false alarm 10^%.1f): "
+                       "%s\n", a->final_model, a->delta_bic, a->log10_fap, a->separate_by);
+                ck_assert_int_eq(a->final_model, 1);
+                ck_assert(a->delta_bic < 6);
+                ck_assert(a->log10_fap < -2);
+                offered = 1;
+            }
+        }
+        ck_assert_msg(offered || drift >= 0, "temperature named, the drift neither named nor "
+                                             "offered");
+    }
+}
+END_TEST
+
 /* The sizes are the final model's (docs/explain.md step 5): a fork run of
 ** 259 points (campaign seed 1, tests/ref/indep_gen.py, an order-0
 ** baseline) hides a temperature of 4.96"/C, a drift of 1.50"/h (c' +1.50,
@@ -888,6 +928,7 @@ static Suite *suite(void)
     tcase_add_test(t, test_cv_without_unpredictable);
     tcase_add_test(t, test_physical_instead_of_higher);
     tcase_add_test(t, test_rival_in_final_model);
+    tcase_add_test(t, test_rival_offered_in_final_model);
     tcase_add_test(t, test_sizes_of_final_model);
     tcase_add_loop_test(t, test_pairs_curve, 0, (int)(sizeof PAIRS / sizeof PAIRS[0]));
     suite_add_tcase(s, t);

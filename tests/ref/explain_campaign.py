@@ -247,6 +247,13 @@ def tells_25(x):
     return x["score"]["amp_rel_sigma"] <= TELLS_25
 
 
+def is_close(a):
+    """An alternative offered for close evidence (Delta BIC < 6): kind "close"
+    at the finding's step, or "final" in the final model (a temperature's or
+    drift's rival); not "smooth" (offered whatever its Delta BIC)."""
+    return a.get("kind", "close") in ("close", "final")
+
+
 def score_single(effect, d, truth, cfg):
     fnd = d["findings"]
     names = [f["effect"] for f in fnd]
@@ -306,8 +313,7 @@ def score_single(effect, d, truth, cfg):
     extra = [n for n in names if n != effect]
     # the first finding offers the hidden effect as its close alternative
     alts0 = fnd[0].get("alternatives", []) if fnd else []
-    first_alt = first or any(a["effect"] == effect and a.get("kind", "close") == "close"
-                             for a in alts0)
+    first_alt = first or any(a["effect"] == effect and is_close(a) for a in alts0)
     # ... or as the smooth reading of a periodic shape the run does not see
     # repeat (kind "smooth", offered whatever its Delta BIC)
     first_smooth = first or any(a["effect"] == effect and a.get("kind") == "smooth"
@@ -337,8 +343,8 @@ def score_multi(effects, d, truth):
     invented = sorted(set(n for n in names if n not in effects))
     # the honest answer to confusable readings (issue 15, item 3): a finding
     # whose close alternative is a hidden effect names both
-    alts = {f["effect"]: [a["effect"] for a in f.get("alternatives", [])
-                          if a.get("kind", "close") == "close"] for f in fnd}
+    alts = {f["effect"]: [a["effect"] for a in f.get("alternatives", []) if is_close(a)]
+            for f in fnd}
     named_or_alt = [e for e in effects if e in names or any(e in a for a in alts.values())]
     invented_no_alt = sorted(set(n for n in names if n not in effects and
                                  not any(e in alts.get(n, []) for e in effects)))

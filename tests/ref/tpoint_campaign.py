@@ -374,13 +374,19 @@ def summarise_findings(ex):
     return out
 
 
+def close_kind(a):
+    """Offered for close evidence (Delta BIC < 6): kind "close" at the
+    finding's step or "final" in the final model, not "smooth"."""
+    return (a.get('kind') or 'close') in ('close', 'final')
+
+
 def hidden_named(findings, e, with_alt):
     for f in findings:
         if finding_matches(f, e):
             return True
         if with_alt:
             for a in f.get('alternatives', []):
-                if a['effect'] == EXPECT[e['name']] and (a.get('kind') or 'close') == 'close':
+                if a['effect'] == EXPECT[e['name']] and close_kind(a):
                     return True
     return False
 
@@ -390,7 +396,7 @@ def invented(findings, effs):
     for f in findings:
         if any(finding_matches(f, e) for e in effs):
             continue
-        alts = [a['effect'] for a in f.get('alternatives', []) if (a.get('kind') or 'close') == 'close']
+        alts = [a['effect'] for a in f.get('alternatives', []) if close_kind(a)]
         if any(EXPECT[e['name']] in alts for e in effs):
             inv_alt.append(f['effect'])
         else:

@@ -1088,32 +1088,38 @@ std::vector<Candidate> pairs(const Run &run, const State &st, const std::vector<
 
 // -------------------------------------------------------- stage: alternatives
 
-// The observation that would tell two readings apart: physics where it is
-// known, and always where the two fitted models differ most on this run.
-std::string separate_by(const Run &run, const State &st, const Candidate &a, const Candidate &b)
+// The observation that would tell readings a and b (effects) apart: the
+// physics where it is known.
+std::string separating(const std::string &a, const std::string &b)
 {
     auto pair_is = [&](const char *x, const char *y) {
-        return (a.effect == x && b.effect == y) || (a.effect == y && b.effect == x);
+        return (a == x && b == y) || (a == y && b == x);
     };
-    auto one_is = [&](const char *x) { return a.effect == x || b.effect == x; };
+    auto one_is = [&](const char *x) { return a == x || b == x; };
     bool elev = one_is("refraction") || one_is("tube_flexure");
-    std::string s;
     if (pair_is("refraction", "tube_flexure"))
-        s = "points below 20 deg elevation (cot el grows there while cos el levels off)";
-    else if (elev && one_is("higher_order"))
-        s = "low points spread over every azimuth (an elevation effect is the same at all of them)";
-    else if (elev && one_is("temperature"))
-        s = "one star followed at fixed elevation while the temperature changes";
-    else if (pair_is("temperature", "time_drift"))
-        s = "a night whose temperature does not follow the clock, or a second night";
-    else if (one_is("hysteresis"))
-        s = "the same places approached from both directions";
-    else if (one_is("ha_periodic") || one_is("dec_periodic"))
-        s = "a denser sample along the drive's axis, a few points per period";
-    else
-        s = "more points where the two readings differ most";
-    std::vector<double> d = model_difference(run, st.use, a.fit.f.model, b.fit.f.model);
-    std::string bin = largest_bin(run, st.use, d);
+        return "points below 20 deg elevation (cot el grows there while cos el levels off)";
+    if (elev && one_is("higher_order"))
+        return "low points spread over every azimuth (an elevation effect is the same at all of them)";
+    if (elev && one_is("temperature"))
+        return "one star followed at fixed elevation while the temperature changes";
+    if (pair_is("temperature", "time_drift"))
+        return "a night whose temperature does not follow the clock, or a second night";
+    if (one_is("hysteresis"))
+        return "the same places approached from both directions";
+    if (one_is("ha_periodic") || one_is("dec_periodic"))
+        return "a denser sample along the drive's axis, a few points per period";
+    return "more points where the two readings differ most";
+}
+
+// The observation that would tell two readings apart: separating(), and
+// always where the two fitted models (ma, mb) differ most on this run.
+std::string separate_by(const Run &run, const std::vector<int> &use, const std::string &ea,
+                        const pm_model &ma, const std::string &eb, const pm_model &mb)
+{
+    std::string s = separating(ea, eb);
+    std::vector<double> d = model_difference(run, use, ma, mb);
+    std::string bin = largest_bin(run, use, d);
     if (!bin.empty())
         s += "; on this run they differ most at " + bin;
     return s;
@@ -1177,7 +1183,7 @@ std::vector<Alternative> alternatives(const Run &run, const State &st, const Can
         al.log10_fap = a.log_fap / LN10;
         al.delta_bic = dbic;
         al.log10_lr = log10_lr;
-        al.separate_by = separate_by(run, st, c, a);
+        al.separate_by = separate_by(run, st.use, c.effect, c.fit.f.model, a.effect, a.fit.f.model);
         if (smooth) {
             al.smooth = true;
             std::vector<double> d = model_difference(run, st.use, c.fit.f.model, a.fit.f.model);
@@ -1573,12 +1579,18 @@ Explanation physical_instead(const Run &run, const ExplainOptions &opt, Explanat
 const char *const RIVALS[][2] = {{"temperature", "time_drift"}, {"time_drift", "temperature"}};
 
 // The rival of finding f in the final model: f's terms replaced by its
-// rival's (the same number), both fitted on the kept points; the rival's
-// chi^2 over f's, or NaN where it does not apply (no rival, the rival
-// found or excluded too, a fit that fails).
-double rival_ratio(const Run &run, const ExplainOptions &opt, const Explanation &ex,
-                   const Finding &f, std::string *rival)
+// rival's (the same number), both fitted on the kept points (mine,
+// theirs); ratio, the rival's chi^2 over f's, is NaN where it does not
+// apply (no rival, the rival found or excluded too, a fit that fails).
+struct Rival {
+    std::string effect;
+    Fit mine, theirs;
+    double ratio = std::nan("");
+};
+
+Rival rival_of(const Run &run, const ExplainOptions &opt, const Explanation &ex, const Finding &f)
 {
+    Rival rv;
     for (const auto &r : RIVALS) {
         if (f.effect != r[0] || f.adds.size() != 1 || has(opt.exclude, r[1]) ||
             std::any_of(ex.findings.begin(), ex.findings.end(),
@@ -1586,13 +1598,48 @@ double rival_ratio(const Run &run, const ExplainOptions &opt, const Explanation 
             continue;
         std::vector<std::string> adds = ex.final_adds;
         std::replace(adds.begin(), adds.end(), f.adds[0], std::string(r[1]));
-        Fit mine = fit_spec(run, ex.kept, ex.final_order, ex.final_adds, nullptr),
-            theirs = fit_spec(run, ex.kept, ex.final_order, adds, nullptr);
-        *rival = r[1];
-        if (mine.ok && theirs.ok && theirs.P == mine.P && mine.chi2 > 0)
-            return theirs.chi2 / mine.chi2;
+        rv.mine = fit_spec(run, ex.kept, ex.final_order, ex.final_adds, nullptr);
+        rv.theirs = fit_spec(run, ex.kept, ex.final_order, adds, nullptr);
+        rv.effect = r[1];
+        if (rv.mine.ok && rv.theirs.ok && rv.theirs.P == rv.mine.P && rv.mine.chi2 > 0)
+            rv.ratio = rv.theirs.chi2 / rv.mine.chi2;
+        break;
     }
-    return std::nan("");
+    return rv;
+}
+
+// The rival offered beside finding f where the final model cannot tell
+// them apart (item 3 of the issue: name both).  The step that chose f
+// compared the two with the later findings still in the residuals (a pier
+// side that the clock follows, a sag that the temperature follows), so the
+// step's alternatives may not hold it: here Delta BIC in the final model
+// (as many terms: Delta chi^2 over its sigma^2) below opt.close_delta_bic,
+// and the rival significant on its own there (F-test against the final
+// model without f's family, below alpha).  False where not.
+bool final_rival(const Run &run, const ExplainOptions &opt, const Explanation &ex,
+                 const Finding &f, const Rival &rv, Alternative *al)
+{
+    if (!(rv.ratio > 0) || std::any_of(f.alternatives.begin(), f.alternatives.end(),
+                                       [&](const Alternative &a) { return a.effect == rv.effect; }))
+        return false;
+    const Fit &mi = rv.mine, &th = rv.theirs;
+    const double dbic = (th.chi2 - mi.chi2) / (mi.chi2 / (double)(2 * mi.N - mi.P));
+    if (!(dbic < opt.close_delta_bic))
+        return false;
+    Fit without = fit_spec(run, ex.kept, ex.final_order, minus(ex.final_adds, f.adds), nullptr);
+    if (!without.ok || !(th.P > without.P))
+        return false;
+    const double dc = th.P - without.P, d2 = (double)(2 * th.N - th.P);
+    const double lf = log_f_tail(((without.chi2 - th.chi2) / dc) / (th.chi2 / d2), dc, d2);
+    if (!(lf < std::log(opt.alpha)))
+        return false;
+    al->effect = rv.effect;
+    al->log10_fap = lf / LN10;
+    al->delta_bic = dbic;
+    al->log10_lr = dbic / 2 / LN10;
+    al->final_model = true;
+    al->separate_by = separate_by(run, ex.kept, f.effect, mi.f.model, rv.effect, th.f.model);
+    return true;
 }
 
 // The rival reading where the final model prefers it.  A temperature term
@@ -1606,34 +1653,42 @@ double rival_ratio(const Run &run, const ExplainOptions &opt, const Explanation 
 // keeps the same points, ends with the same families but the rival in the
 // finding's place, and fits with a smaller sigma and a cross-validated RMS
 // no larger; the finding is then listed as withdrawn with the reason.
+// Where it is not taken and the two are as good in the final model, the
+// rival is offered beside the finding (final_rival).
 Explanation rival_instead(const Run &run, const ExplainOptions &opt, Explanation ex)
 {
     for (size_t k = 0; k < ex.findings.size(); k++) {
         const Finding f = ex.findings[k];
-        std::string rival;
-        double ratio = rival_ratio(run, opt, ex, f, &rival);
-        if (!(ratio < 1))
+        const Rival rv = rival_of(run, opt, ex, f);
+        Alternative al;
+        if (!(rv.ratio < 1)) {
+            if (final_rival(run, opt, ex, f, rv, &al))
+                ex.findings[k].alternatives.push_back(al);
             continue;
+        }
         ExplainOptions o = opt;
         o.exclude.push_back(f.effect);
         Explanation alt = explain_rounds(run, o);
         std::vector<std::string> want, got;
         for (const Finding &g : ex.findings)
-            want.push_back(g.effect == f.effect ? rival : g.effect);
+            want.push_back(g.effect == f.effect ? rv.effect : g.effect);
         for (const Finding &g : alt.findings)
             got.push_back(g.effect);
         std::sort(want.begin(), want.end());
         std::sort(got.begin(), got.end());
         if (alt.kept != ex.kept || got != want ||
             !(alt.final_sigma_arcsec < ex.final_sigma_arcsec) ||
-            !(alt.final_cv_rms_arcsec <= ex.final_cv_rms_arcsec))
+            !(alt.final_cv_rms_arcsec <= ex.final_cv_rms_arcsec)) {
+            if (final_rival(run, opt, ex, f, rv, &al))
+                ex.findings[k].alternatives.push_back(al);
             continue;
+        }
         char why[400];
         std::snprintf(why, sizeof why,
                       "%s (finding %d) is replaced: with the other findings in, %s fits better "
                       "(sigma %.3f\" against %.3f\", CV RMS %.3f\" against %.3f\"); the two are "
                       "confusable where the temperature follows the clock",
-                      f.effect.c_str(), (int)k + 1, rival.c_str(), alt.final_sigma_arcsec,
+                      f.effect.c_str(), (int)k + 1, rv.effect.c_str(), alt.final_sigma_arcsec,
                       ex.final_sigma_arcsec, alt.final_cv_rms_arcsec, ex.final_cv_rms_arcsec);
         alt.withdrawn.push_back(f);
         alt.withdrawn_why.push_back(why);
@@ -1806,6 +1861,7 @@ void finding_to_c(const pmhost::Finding &f, pmx_finding &g)
         std::snprintf(b.effect, sizeof b.effect, "%s", a.effect.c_str());
         std::snprintf(b.separate_by, sizeof b.separate_by, "%s", a.separate_by.c_str());
         b.smooth = a.smooth ? 1 : 0;
+        b.final_model = a.final_model ? 1 : 0;
         b.delta_bic = a.delta_bic;
         b.log10_lr = a.log10_lr;
         b.log10_fap = a.log10_fap;

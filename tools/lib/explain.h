@@ -27,6 +27,8 @@ typedef struct pmx_alternative {
     int smooth;                      /* 1: offered because the run cannot show the chosen
                                         periodic shape repeats (any Delta BIC); 0: Delta BIC
                                         below 6 (docs/explain.md, "Confusable effects") */
+    int final_model;                 /* 1: a temperature's or drift's rival, Delta BIC below 6
+                                        in the final model (JSON kind "final") */
 } pmx_alternative;
 
 /* One item of the physical reading of the baseline. */

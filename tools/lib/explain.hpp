@@ -63,6 +63,10 @@ struct Alternative {
     bool smooth = false;       // kind "smooth": offered because the run cannot show the
                                // chosen periodic shape repeats (explain.cpp, smooth_alternative),
                                // not for a Delta BIC below close_delta_bic (kind "close")
+    bool final_model = false;  // kind "final": the rival family (temperature, time_drift)
+                               // as good in the final model, where the step that chose the
+                               // finding had the later findings still in its residuals
+                               // (explain.cpp, final_rival)
 };
 
 // One physical reading of the fitted baseline (docs/explain.md,

@@ -29,7 +29,8 @@ std::string alternatives_json(const std::vector<Alternative> &alts)
         j += std::string(k ? ", " : "") + "{\"effect\": " + str(a.effect) +
              ", \"log10_false_alarm_probability\": " + num(a.log10_fap) +
              ", \"delta_bic\": " + num(a.delta_bic) + ", \"log10_likelihood_ratio\": " +
-             num(a.log10_lr) + ", \"kind\": " + str(a.smooth ? "smooth" : "close") +
+             num(a.log10_lr) + ", \"kind\": " +
+             str(a.smooth ? "smooth" : a.final_model ? "final" : "close") +
              ", \"separate_by\": " + str(a.separate_by) + "}";
     }
     return j + "]";
@@ -188,6 +189,14 @@ void print_findings(const Explanation &ex, double alpha)
                             "terms); to separate them: %s\n",
                             a.effect.c_str(), a.log10_fap, a.delta_bic, f.effect.c_str(),
                             a.separate_by.c_str());
+            else if (a.final_model)
+                std::printf("     as good a reading in the final model: %s (false-alarm 10^%.1f "
+                            "there, Delta BIC %+.1f with as many terms, likelihood ratio 10^%.2f "
+                            "in favour of %s; the step that found %s had the later findings "
+                            "still in its residuals); to separate them: %s\n",
+                            a.effect.c_str(), a.log10_fap, a.delta_bic, std::fabs(a.log10_lr),
+                            a.log10_lr >= 0 ? f.effect.c_str() : a.effect.c_str(),
+                            f.effect.c_str(), a.separate_by.c_str());
             else
                 std::printf("     as good a reading: %s (false-alarm 10^%.1f, Delta BIC %+.1f%s, "
                             "likelihood ratio 10^%.2f in favour of %s); to separate them: %s\n",
