@@ -189,12 +189,13 @@ void print_findings(const Explanation &ex, double alpha)
                             "terms); to separate them: %s\n",
                             a.effect.c_str(), a.log10_fap, a.delta_bic, f.effect.c_str(),
                             a.separate_by.c_str());
-            else if (a.final_model)
-                std::printf("     as good a reading in the final model: %s (false-alarm 10^%.1f "
+            else if (a.final_model) // (a better one where the evidence is clear for it)
+                std::printf("     %s reading in the final model: %s (false-alarm 10^%.1f "
                             "there, Delta BIC %+.1f with as many terms, likelihood ratio 10^%.2f "
                             "in favour of %s; the step that found %s had the later findings "
                             "still in its residuals); to separate them: %s\n",
-                            a.effect.c_str(), a.log10_fap, a.delta_bic, std::fabs(a.log10_lr),
+                            a.delta_bic <= -6 ? "a better" : "as good a", a.effect.c_str(),
+                            a.log10_fap, a.delta_bic, std::fabs(a.log10_lr),
                             a.log10_lr >= 0 ? f.effect.c_str() : a.effect.c_str(),
                             f.effect.c_str(), a.separate_by.c_str());
             else

@@ -646,7 +646,9 @@ void explain_findings(Page &p, const Data &d)
             extra += "<li>Found together with " + h(f.with) + ": neither alone passed, the pair does.</li>";
         for (const Alternative &a : f.alternatives)
             extra += std::string(a.smooth        ? "<li>Or a smooth shape: <b>"
-                                 : a.final_model ? "<li>As good a reading in the final model: <b>"
+                                 : a.final_model ? (a.delta_bic <= -6
+                                                        ? "<li>A better reading in the final model: <b>"
+                                                        : "<li>As good a reading in the final model: <b>")
                                                  : "<li>As good a reading: <b>") +
                      h(a.effect) +
                      fmt("</b> (false-alarm 10<sup>%.1f</sup>, &Delta;BIC %+.1f%s); to separate them: ",
