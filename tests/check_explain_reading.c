@@ -846,6 +846,29 @@ START_TEST(test_rival_offered_in_final_model)
 }
 END_TEST
 
+/* A gross error's neighbours (docs/explain.md step 3, outliers): an
+** alt-az run of 113 points (campaign seed 11, tests/ref/indep_gen.py, the
+** parameters in its first line) with one gross error of 41" at elevation
+** 87 deg (line 113).  Each point's deleted residual was taken with the
+** others in, and the error pulled the fit near the zenith: lines 106 and
+** 112, 5 and 7 deg from it, were flagged beside it, though without line
+** 113 explain finds nothing at all.  Each point is now tested without the
+** points flagged before it: line 113 alone. */
+START_TEST(test_outlier_neighbours)
+{
+    pmx_result r;
+    int out;
+    explain_data("indep_altaz_outlier_zenith.dat", NULL, &r);
+    out = finding_index(&r, "outlier");
+    ck_assert(out >= 0);
+    printf("check_explain_reading: indep_altaz_outlier_zenith.dat: %d finding(s), outlier lines "
+           "%d (first %d)\n", r.n_findings, r.findings[out].n_lines, r.findings[out].lines[0]);
+    ck_assert_int_eq(r.n_findings, 1);
+    ck_assert_int_eq(r.findings[out].n_lines, 1);
+    ck_assert_int_eq(r.findings[out].lines[0], 113);
+}
+END_TEST
+
 /* The sizes are the final model's (docs/explain.md step 5): a fork run of
 ** 259 points (campaign seed 1, tests/ref/indep_gen.py, an order-0
 ** baseline) hides a temperature of 4.96"/C, a drift of 1.50"/h (c' +1.50,
@@ -929,6 +952,7 @@ static Suite *suite(void)
     tcase_add_test(t, test_physical_instead_of_higher);
     tcase_add_test(t, test_rival_in_final_model);
     tcase_add_test(t, test_rival_offered_in_final_model);
+    tcase_add_test(t, test_outlier_neighbours);
     tcase_add_test(t, test_sizes_of_final_model);
     tcase_add_loop_test(t, test_pairs_curve, 0, (int)(sizeof PAIRS / sizeof PAIRS[0]));
     suite_add_tcase(s, t);
