@@ -648,10 +648,10 @@ bool opt_is_scan(const ExplainOptions &opt, int comp)
 // The periodogram decides integer vs non-integer G on the baseline's
 // residuals; a term correlated with the model's own terms can tip it.  The
 // full fits decide: an integer G moves to a whole-number neighbour that
-// fits better; a non-integer G becomes the best whole number found so
-// (a worm has whole teeth, a track or bearing turns with its axis) unless
-// its chi^2 exceeds the non-integer's by more than INTEGER_REJECT_CHI2
-// sigma^2.  *chosen: the fit of the period G ends at (the candidate's,
+// fits better; a non-integer G becomes the best whole number the same walk
+// finds from the better of its two neighbours (a worm has whole teeth, a
+// track or bearing turns with its axis) unless that one's chi^2 exceeds
+// the non-integer's by more than INTEGER_REJECT_CHI2 sigma^2.  *chosen: the fit of the period G ends at (the candidate's,
 // score need not make it).
 using FitAt = std::function<Fit(double)>;
 
