@@ -651,8 +651,9 @@ bool opt_is_scan(const ExplainOptions &opt, int comp)
 // fits better; a non-integer G becomes the best whole number the same walk
 // finds from the better of its two neighbours (a worm has whole teeth, a
 // track or bearing turns with its axis) unless that one's chi^2 exceeds
-// the non-integer's by more than INTEGER_REJECT_CHI2 sigma^2.  *chosen: the fit of the period G ends at (the candidate's,
-// score need not make it).
+// the non-integer's by more than INTEGER_REJECT_CHI2 sigma^2.  *chosen:
+// the fit of the period G ends at (the candidate's, score need not make
+// it).
 using FitAt = std::function<Fit(double)>;
 
 // From the whole number G (its fit `here`), up to three moves to the
@@ -790,6 +791,16 @@ void physical_candidates(const Run &run, const State &st, std::vector<Candidate>
         add_candidate(cands, st, "hysteresis", h);
 }
 
+// The observations of `use` not in `drop`.
+std::vector<int> without(const std::vector<int> &use, const std::vector<int> &drop)
+{
+    std::vector<int> keep;
+    for (int i : use)
+        if (std::find(drop.begin(), drop.end(), i) == drop.end())
+            keep.push_back(i);
+    return keep;
+}
+
 // Outliers: the points beyond the Bonferroni-corrected tail of their
 // deleted residual.  The deleted residual of observation i: predicted by
 // the model fitted without it, chi^2 with the prediction's covariance
@@ -805,11 +816,9 @@ void physical_candidates(const Run &run, const State &st, std::vector<Candidate>
 bool deleted_residual(const Run &run, const State &st, int i, const std::vector<int> &out,
                       double &chi2, double &miss, double &nu)
 {
-    std::vector<int> rest;
-    for (int k : st.use)
-        if (k != i && std::find(out.begin(), out.end(), k) == out.end())
-            rest.push_back(k);
-    Fit g = fit_spec(run, rest, st.order, st.adds, warm_of(st.cur));
+    std::vector<int> drop = out;
+    drop.push_back(i);
+    Fit g = fit_spec(run, without(st.use, drop), st.order, st.adds, warm_of(st.cur));
     if (!g.ok)
         return false;
     const Obs &o = run.obs[i];
@@ -892,15 +901,6 @@ std::vector<Candidate> candidates(const Run &run, const State &st, const Explain
 }
 
 // ------------------------------------------------------------ stage: select
-
-std::vector<int> without(const std::vector<int> &use, const std::vector<int> &drop)
-{
-    std::vector<int> keep;
-    for (int i : use)
-        if (std::find(drop.begin(), drop.end(), i) == drop.end())
-            keep.push_back(i);
-    return keep;
-}
 
 // Fit each candidate; its false-alarm probability is the nested F-test's p
 // times the periods scanned times K, the number of candidates of the step.
@@ -1117,12 +1117,13 @@ std::string separating(const std::string &a, const std::string &b)
     return "more points where the two readings differ most";
 }
 
-// The observation that would tell two readings apart: separating(), and
-// always where the two fitted models (ma, mb) differ most on this run.
-std::string separate_by(const Run &run, const std::vector<int> &use, const std::string &ea,
-                        const pm_model &ma, const std::string &eb, const pm_model &mb)
+// The observation that would tell two readings apart: `what` (separating(),
+// or the smooth reading's words), and always where the two fitted models
+// (ma, mb) differ most on this run.
+std::string separate_by(const Run &run, const std::vector<int> &use, std::string what,
+                        const pm_model &ma, const pm_model &mb)
 {
-    std::string s = separating(ea, eb);
+    std::string s = std::move(what);
     std::vector<double> d = model_difference(run, use, ma, mb);
     std::string bin = largest_bin(run, use, d);
     if (!bin.empty())
@@ -1188,13 +1189,11 @@ std::vector<Alternative> alternatives(const Run &run, const State &st, const Can
         al.log10_fap = a.log_fap / LN10;
         al.delta_bic = dbic;
         al.log10_lr = log10_lr;
-        al.separate_by = separate_by(run, st.use, c.effect, c.fit.f.model, a.effect, a.fit.f.model);
+        std::string what = separating(c.effect, a.effect);
         if (smooth) {
             al.smooth = true;
-            std::vector<double> d = model_difference(run, st.use, c.fit.f.model, a.fit.f.model);
-            std::string bin = largest_bin(run, st.use, d);
             bool dec = c.effect == "dec_periodic", full = cycles / c.peak_g > 0.8;
-            al.separate_by =
+            what =
                 full ? fmt("points over more of the %s axis's range: this run samples %.1f cycles "
                            "of the period, nearly all of the %s axis, and a term of the axis angle "
                            "and a smooth distortion change differently along the other axis",
@@ -1202,9 +1201,8 @@ std::vector<Alternative> alternatives(const Run &run, const State &st, const Can
                      : fmt("the %s axis over more of its range: this run samples %.1f cycles of "
                            "the period (a gear error repeats, a smooth distortion does not)",
                            dec ? "second" : "first", cycles);
-            if (!bin.empty())
-                al.separate_by += "; on this run they differ most at " + bin;
         }
+        al.separate_by = separate_by(run, st.use, what, c.fit.f.model, a.fit.f.model);
         out.push_back(al);
     }
     return out;
@@ -1643,7 +1641,8 @@ bool final_rival(const Run &run, const ExplainOptions &opt, const Explanation &e
     al->delta_bic = dbic;
     al->log10_lr = dbic / 2 / LN10;
     al->final_model = true;
-    al->separate_by = separate_by(run, ex.kept, f.effect, mi.f.model, rv.effect, th.f.model);
+    al->separate_by = separate_by(run, ex.kept, separating(f.effect, rv.effect), mi.f.model,
+                                  th.f.model);
     return true;
 }
 
@@ -1653,51 +1652,58 @@ bool final_rival(const Run &run, const ExplainOptions &opt, const Explanation &e
 // project's campaign, seeds 1, 2, 3 and 9: 8 of the 22 runs of two or
 // three hidden effects that named temperature for a drift or the other way
 // round now name the hidden one; no other run changed).
-// So where the rival of a finding fits the final model better, the search
+// So where the rival of finding k fits the final model better, the search
 // is run again without the finding's family, and its reading taken if it
 // keeps the same points, ends with the same families but the rival in the
 // finding's place, and fits with a smaller sigma and a cross-validated RMS
 // no larger; the finding is then listed as withdrawn with the reason.
-// Where it is not taken and the two are as good in the final model, the
-// rival is offered beside the finding (final_rival).
+// True with that reading in *alt.
+bool rival_reading(const Run &run, const ExplainOptions &opt, const Explanation &ex, size_t k,
+                   const Rival &rv, Explanation *alt)
+{
+    const Finding &f = ex.findings[k];
+    if (!(rv.ratio < 1))
+        return false;
+    ExplainOptions o = opt;
+    o.exclude.push_back(f.effect);
+    *alt = explain_rounds(run, o);
+    std::vector<std::string> want, got;
+    for (const Finding &g : ex.findings)
+        want.push_back(g.effect == f.effect ? rv.effect : g.effect);
+    for (const Finding &g : alt->findings)
+        got.push_back(g.effect);
+    std::sort(want.begin(), want.end());
+    std::sort(got.begin(), got.end());
+    if (alt->kept != ex.kept || got != want ||
+        !(alt->final_sigma_arcsec < ex.final_sigma_arcsec) ||
+        !(alt->final_cv_rms_arcsec <= ex.final_cv_rms_arcsec))
+        return false;
+    char why[400];
+    std::snprintf(why, sizeof why,
+                  "%s (finding %d) is replaced: with the other findings in, %s fits better "
+                  "(sigma %.3f\" against %.3f\", CV RMS %.3f\" against %.3f\"); the two are "
+                  "confusable where the temperature follows the clock",
+                  f.effect.c_str(), (int)k + 1, rv.effect.c_str(), alt->final_sigma_arcsec,
+                  ex.final_sigma_arcsec, alt->final_cv_rms_arcsec, ex.final_cv_rms_arcsec);
+    alt->withdrawn.push_back(f);
+    alt->withdrawn_why.push_back(why);
+    return true;
+}
+
+// Each finding's rival in the final model: its reading where the final
+// model prefers it and the search agrees (rival_reading); else, where the
+// two are as good in the final model, the rival offered beside the finding
+// (final_rival).
 Explanation rival_instead(const Run &run, const ExplainOptions &opt, Explanation ex)
 {
     for (size_t k = 0; k < ex.findings.size(); k++) {
-        const Finding f = ex.findings[k];
-        const Rival rv = rival_of(run, opt, ex, f);
+        const Rival rv = rival_of(run, opt, ex, ex.findings[k]);
+        Explanation alt;
+        if (rival_reading(run, opt, ex, k, rv, &alt))
+            return alt;
         Alternative al;
-        if (!(rv.ratio < 1)) {
-            if (final_rival(run, opt, ex, f, rv, &al))
-                ex.findings[k].alternatives.push_back(al);
-            continue;
-        }
-        ExplainOptions o = opt;
-        o.exclude.push_back(f.effect);
-        Explanation alt = explain_rounds(run, o);
-        std::vector<std::string> want, got;
-        for (const Finding &g : ex.findings)
-            want.push_back(g.effect == f.effect ? rv.effect : g.effect);
-        for (const Finding &g : alt.findings)
-            got.push_back(g.effect);
-        std::sort(want.begin(), want.end());
-        std::sort(got.begin(), got.end());
-        if (alt.kept != ex.kept || got != want ||
-            !(alt.final_sigma_arcsec < ex.final_sigma_arcsec) ||
-            !(alt.final_cv_rms_arcsec <= ex.final_cv_rms_arcsec)) {
-            if (final_rival(run, opt, ex, f, rv, &al))
-                ex.findings[k].alternatives.push_back(al);
-            continue;
-        }
-        char why[400];
-        std::snprintf(why, sizeof why,
-                      "%s (finding %d) is replaced: with the other findings in, %s fits better "
-                      "(sigma %.3f\" against %.3f\", CV RMS %.3f\" against %.3f\"); the two are "
-                      "confusable where the temperature follows the clock",
-                      f.effect.c_str(), (int)k + 1, rv.effect.c_str(), alt.final_sigma_arcsec,
-                      ex.final_sigma_arcsec, alt.final_cv_rms_arcsec, ex.final_cv_rms_arcsec);
-        alt.withdrawn.push_back(f);
-        alt.withdrawn_why.push_back(why);
-        return alt;
+        if (final_rival(run, opt, ex, ex.findings[k], rv, &al))
+            ex.findings[k].alternatives.push_back(al);
     }
     return ex;
 }
