@@ -27,6 +27,7 @@
 #include "runfile.h"
 #include "simulate.h"
 #include "testutil.h"
+#include "tu_tool.h"
 
 #define RUNS 20             /* qualifying runs per effect */
 #define MAX_SEEDS 40        /* seeds tried to get them */
@@ -41,8 +42,7 @@ static void make_dir(void)
 {
     if (g_dir[0])
         return;
-    strcpy(g_dir, "/tmp/pm_explain_XXXXXX");
-    ck_assert_ptr_nonnull(mkdtemp(g_dir));
+    tu_tmpdir(g_dir, "pm_explain_");
 }
 
 static void base_spec(pmsim_spec *s, unsigned long long seed, int order)

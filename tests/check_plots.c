@@ -13,13 +13,13 @@
 #include <unistd.h>
 
 #include "plots.h"
+#include "tu_tool.h"
 
 static char tmpdir[256];
 
 static void make_tmpdir(void)
 {
-    strcpy(tmpdir, "/tmp/pm_plots_XXXXXX");
-    ck_assert_ptr_nonnull(mkdtemp(tmpdir));
+    tu_tmpdir(tmpdir, "pm_plots_");
 }
 
 static void path_in(char *buf, size_t len, const char *name)

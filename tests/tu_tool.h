@@ -1,7 +1,7 @@
 /*
 **  tu_tool.h - helpers for the suites that run build/pmfit: the program's
 **  path, running a command with its output captured, a number from JSON
-**  output, a temporary directory.  Include after defining
+**  output, a temporary directory removed at exit.  Include after defining
 **  _POSIX_C_SOURCE 200809L (popen, mkdtemp).
 */
 #ifndef PM_TU_TOOL_H
@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 /* pmfit of the tree under test: $PM_TOP/$PM_BUILD/pmfit (both set by make
 ** test; PM_BUILD is the build directory, "build" unless make sanitize). */
@@ -67,11 +68,42 @@ static inline double tu_term_value(const char *json, const char *name)
     return tu_number_after(json, pat, name);
 }
 
-/* A fresh directory /tmp/<prefix>XXXXXX into dir (at least 64 bytes). */
+/* The directories tu_tmpdir made, and the process that made each: removed
+** with their contents when that process exits (Check runs each test in a
+** child that exits, also on a failed assertion; a child never removes the
+** directory of the parent it was forked from).  A test killed by a signal
+** (a timeout) leaves its directory behind. */
+#define TU_MAX_TMPDIRS 64
+static char tu_tmpdirs[TU_MAX_TMPDIRS][64];
+static pid_t tu_tmpdir_pid[TU_MAX_TMPDIRS];
+static int tu_n_tmpdirs;
+
+static inline void tu_remove_tmpdirs(void)
+{
+    char cmd[128];
+    int i;
+    for (i = 0; i < tu_n_tmpdirs; i++) {
+        if (tu_tmpdir_pid[i] != getpid())
+            continue;
+        snprintf(cmd, sizeof cmd, "rm -rf '%s'", tu_tmpdirs[i]);
+        if (system(cmd) != 0)
+            fprintf(stderr, "could not remove %s\n", tu_tmpdirs[i]);
+    }
+}
+
+/* A fresh directory /tmp/<prefix>XXXXXX into dir (at least 64 bytes),
+** removed with its contents when this process exits. */
 static inline void tu_tmpdir(char *dir, const char *prefix)
 {
+    static int registered;
     snprintf(dir, 64, "/tmp/%sXXXXXX", prefix);
     ck_assert_ptr_nonnull(mkdtemp(dir));
+    if (tu_n_tmpdirs < TU_MAX_TMPDIRS) {
+        snprintf(tu_tmpdirs[tu_n_tmpdirs], 64, "%.63s", dir);
+        tu_tmpdir_pid[tu_n_tmpdirs++] = getpid();
+    }
+    if (!registered && atexit(tu_remove_tmpdirs) == 0)
+        registered = 1;
 }
 
 #endif
