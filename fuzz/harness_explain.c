@@ -123,6 +123,14 @@ static int ex_result_ok(const pmx_result *r, int n_lines_file)
     for (i = 0; i < r->n_withdrawn; i++)
         if (!ex_name_ok(r->withdrawn[i], sizeof r->withdrawn[i]))
             return ex_fail("a withdrawn finding without a name");
+    /* significant, not modelled: significant (below alpha) and predicting
+    ** no better than the model it was tried on */
+    if (r->unmodelled[0] &&
+        (!ex_name_ok(r->unmodelled, sizeof r->unmodelled) ||
+         !(r->unmodelled_log10_fap < 0) || !ex_nonneg(r->unmodelled_sigma_arcsec) ||
+         !ex_nonneg(r->unmodelled_cv_rms_arcsec) || !ex_nonneg(r->unmodelled_cv_before_arcsec) ||
+         !(r->unmodelled_cv_rms_arcsec >= r->unmodelled_cv_before_arcsec)))
+        return ex_fail("an unmodelled family unnamed, not significant or predicting better");
     return 0;
 }
 

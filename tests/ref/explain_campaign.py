@@ -318,7 +318,12 @@ def score_single(effect, d, truth, cfg):
     # repeat (kind "smooth", offered whatever its Delta BIC)
     first_smooth = first or any(a["effect"] == effect and a.get("kind") == "smooth"
                                 for a in alts0)
+    # nothing named, but the hidden effect is the one the search ended on
+    # as significant and not predictive ("unmodelled": too few points)
+    unm = [u["effect"] for u in d.get("unmodelled", [])]
+    first_flag = first or (not fnd and unm == [effect])
     return {"named_first": first, "first_or_alt": first_alt, "first_or_smooth": first_smooth,
+            "first_or_flagged": first_flag, "unmodelled": unm,
             "named": bool(mine),
             "params_ok": ok, "extra": extra,
             "findings": names, "note": note, **info}
@@ -378,7 +383,8 @@ def one_task(task):
             return rec
         rec.update(cfg=cfg, order=0 if order0 else 1, attempts=attempt + 1, sigma0=sigma0,
                    index_deg_true=[truth0["geometry"]["index1_deg"], truth0["geometry"]["index2_deg"]],
-                   base_findings=[f["effect"] for f in d0["findings"]])
+                   base_findings=[f["effect"] for f in d0["findings"]],
+                   base_unmodelled=[u["effect"] for u in d0.get("unmodelled", [])])
         sizes, extras, specs = {}, {}, []
         targets = {}
         for e in effects:
@@ -407,7 +413,8 @@ def one_task(task):
             rec["score"] = score_single(effects[0], d, truth, cfg)
         elif kind == "null":
             rec["score"] = {"no_findings": not d["findings"],
-                            "findings": [f["effect"] for f in d["findings"]]}
+                            "findings": [f["effect"] for f in d["findings"]],
+                            "unmodelled": [u["effect"] for u in d.get("unmodelled", [])]}
         else:
             rec["score"] = score_multi(effects, d, truth)
         rec["findings_detail"] = [{k: f.get(k) for k in ("effect", "amplitude_arcsec",
@@ -547,6 +554,9 @@ def main():
             fs = sum(x["score"].get("first_or_smooth", False) for x in good)
             if fs != nf:
                 notes.append("first or its smooth alternative %d/%d" % (fs, len(good)))
+            ff = sum(x["score"].get("first_or_flagged", False) for x in good)
+            if ff != nf:
+                notes.append("first or flagged significant, not modelled %d/%d" % (ff, len(good)))
             row = {"effect": e, "mount": m, "runs": len(good), "named_first": nf, "params_ok": po,
                    "extra": ex, "failed": len(fail),
                    "inflation": [min(infl), max(infl)] if infl else None}
@@ -584,9 +594,11 @@ def main():
     for m in MOUNTS:
         rs = [x for x in recs if x["kind"] == "null" and x["mount"] == m and "score" in x]
         cal = [x for x in recs if x["kind"] != "null" and x["mount"] == m and "base_findings" in x]
-        for label, lst, get in (("null runs", rs, lambda x: x["score"]["findings"]),
-                                ("calibration baselines (all cases)", cal,
-                                 lambda x: x["base_findings"])):
+        for label, lst, get, getu in (("null runs", rs, lambda x: x["score"]["findings"],
+                                       lambda x: x["score"].get("unmodelled", [])),
+                                      ("calibration baselines (all cases)", cal,
+                                       lambda x: x["base_findings"],
+                                       lambda x: x.get("base_unmodelled", []))):
             if not lst:
                 continue
             clean = sum(not get(x) for x in lst)
@@ -594,10 +606,13 @@ def main():
             for x in lst:
                 for f in get(x):
                     found[f] = found.get(f, 0) + 1
+            flagged = sum(bool(getu(x)) and not get(x) for x in lst)
             null_rows.append({"what": label, "mount": m, "runs": len(lst), "no_findings": clean,
-                              "found": found})
-            print("%-32s %-6s %5d  %-11s %s" % (label, m, len(lst), pct(clean, len(lst)),
-                                                ", ".join("%s %d" % kv for kv in sorted(found.items()))))
+                              "found": found, "flagged_unmodelled": flagged})
+            print("%-32s %-6s %5d  %-11s %s%s" % (
+                label, m, len(lst), pct(clean, len(lst)),
+                ", ".join("%s %d" % kv for kv in sorted(found.items())),
+                "; flagged significant, not modelled %d" % flagged if flagged else ""))
 
     base = [x for x in recs if "base_findings" in x]
     if base:

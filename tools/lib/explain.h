@@ -74,6 +74,13 @@ typedef struct pmx_result {
     double compose_rms_arcsec;       /* the composition taken out, RMS per axis (0: none) */
     int n_cv_left_out;               /* points the baseline cannot predict from the others, */
     int cv_left_out_lines[16];       /* left out of every CV RMS: their file lines (first 16) */
+    /* where the search ended, the most significant family that does not
+    ** predict better ("significant, not modelled": the residuals hold it,
+    ** the run's points cannot fit it usefully); "" if none */
+    char unmodelled[48];
+    double unmodelled_log10_fap;     /* its false-alarm probability (log10) */
+    double unmodelled_sigma_arcsec, unmodelled_cv_rms_arcsec; /* with it */
+    double unmodelled_cv_before_arcsec; /* the CV RMS of the model it was tried on */
 } pmx_result;
 
 /* Explain the run in file path from a baseline of the given order; alpha is

@@ -99,6 +99,20 @@ struct Finding {
     std::vector<Alternative> alternatives; // readings with close evidence
 };
 
+// A family significant at alpha where the search ended that does not
+// predict better (its cross-validated RMS no smaller than the model's): the
+// residuals hold it, but the run's points cannot fit it usefully
+// (docs/explain.md, "Significant, not modelled").
+struct Unmodelled {
+    std::string effect;        // as Finding::effect ("a+b" for a pair)
+    double log10_fap = 0;      // its false-alarm probability (log10), as a finding's
+    double sigma_arcsec = 0, cv_rms_arcsec = 0; // with it
+    double sigma_before_arcsec = 0, cv_before_arcsec = 0; // the model it was tried on
+    int n_params = 0;          // the model's terms with it
+    int n_obs = 0;             // the points it was fitted to
+    double cycles_per_rev = 0; // periodic: its period, else 0
+};
+
 struct Explanation {
     double base_sigma_arcsec = 0, base_cv_rms_arcsec = 0;
     int base_n_params = 0;
@@ -119,6 +133,8 @@ struct Explanation {
     double compose_rms_arcsec = 0;       // the composition taken out (RMS per axis), 0 if none
     std::vector<int> cv_left_out;        // points the baseline cannot predict from the others,
                                          // left out of every cross-validated RMS (sorted)
+    std::vector<Unmodelled> unmodelled;  // where the search ended: the most significant
+                                         // family that does not predict better (0 or 1)
 };
 
 // The pipeline: baseline -> locate -> candidates -> select (singles, then
@@ -133,6 +149,8 @@ std::vector<Interpretation> interpret(const Run &run, const FitOut &f);
 // The report (explain_report.cpp): one JSON object (docs/formats.md), or
 // text on stdout.
 std::string explain_json(const Run &run, const Explanation &ex, int order);
+// "significant, not modelled" in words: its sizes and what would fit it.
+std::string unmodelled_text(const Unmodelled &u);
 void print_explain_text(const Run &run, const Explanation &ex, int order, bool added,
                         double alpha, bool gears_ha, bool gears_dec);
 

@@ -116,6 +116,17 @@ std::string explain_json(const Run &run, const Explanation &ex, int order)
         j += std::string(i ? ", " : "") + "{\"effect\": " + str(ex.withdrawn[i].effect) +
              ", \"step\": " + std::to_string(ex.withdrawn[i].step) + ", \"why\": " +
              str(ex.withdrawn_why[i]) + "}";
+    j += "], \"unmodelled\": [";
+    for (size_t i = 0; i < ex.unmodelled.size(); i++) {
+        const Unmodelled &u = ex.unmodelled[i];
+        j += std::string(i ? ", " : "") + "{\"effect\": " + str(u.effect) +
+             ", \"cycles_per_rev\": " + num(u.cycles_per_rev) + ", \"log10_fap\": " +
+             num(u.log10_fap) + ", \"sigma_arcsec\": " + num(u.sigma_arcsec) +
+             ", \"cv_rms_arcsec\": " + num(u.cv_rms_arcsec) + ", \"n_params\": " +
+             std::to_string(u.n_params) + ", \"sigma_before_arcsec\": " +
+             num(u.sigma_before_arcsec) + ", \"cv_before_arcsec\": " +
+             num(u.cv_before_arcsec) + "}";
+    }
     return j + "], \"final\": {\"sigma_arcsec\": " + num(ex.final_sigma_arcsec) +
            ", \"cv_rms_arcsec\": " + num(ex.final_cv_rms_arcsec) +
            ", \"n_params\": " + std::to_string(ex.final_n_params) + "}";
@@ -166,9 +177,13 @@ std::string cv_cell(double x)
 void print_findings(const Explanation &ex, double alpha)
 {
     std::printf("\nfindings:\n");
-    if (ex.findings.empty())
+    if (ex.findings.empty() && ex.unmodelled.empty())
         std::printf("  none: nothing significant is left out (false-alarm probability below %g "
                     "and a better cross-validated RMS were required)\n",
+                    alpha);
+    else if (ex.findings.empty())
+        std::printf("  none that this run can model (false-alarm probability below %g and a "
+                    "better cross-validated RMS were required); but see below\n",
                     alpha);
     for (size_t i = 0; i < ex.findings.size(); i++) {
         const Finding &f = ex.findings[i];
@@ -212,9 +227,22 @@ void print_findings(const Explanation &ex, double alpha)
     for (size_t i = 0; i < ex.withdrawn.size(); i++)
         std::printf("  withdrawn: %s; the findings above are those of the search without it\n",
                     ex.withdrawn_why[i].c_str());
+    for (const Unmodelled &u : ex.unmodelled)
+        std::printf("  significant, not modelled: %s\n", unmodelled_text(u).c_str());
 }
 
 } // namespace
+
+std::string unmodelled_text(const Unmodelled &u)
+{
+    const std::string g = u.cycles_per_rev > 0 ? fmt(" (%g cycles/rev)", u.cycles_per_rev) : "";
+    return fmt("%s%s (false-alarm 10^%.1f): with it sigma %.3f\" against %.3f\", but its model "
+               "of %d terms predicts no better (CV RMS %.3f\" against %.3f\"): the residuals "
+               "hold it, the run's %d points cannot fit it usefully; more points, spread over "
+               "the sky, would",
+               u.effect.c_str(), g.c_str(), u.log10_fap, u.sigma_arcsec, u.sigma_before_arcsec,
+               u.n_params, u.cv_rms_arcsec, u.cv_before_arcsec, u.n_obs);
+}
 
 void print_explain_text(const Run &run, const Explanation &ex, int order, bool added,
                         double alpha, bool gears_ha, bool gears_dec)

@@ -664,6 +664,8 @@ void explain_findings(Page &p, const Data &d)
     }
     for (const std::string &w : ex.withdrawn_why)
         para(p, "Withdrawn: " + h(w) + "; the findings above are those of the search without it.");
+    for (const Unmodelled &u : ex.unmodelled)
+        para(p, "<b>Significant, not modelled:</b> " + h(unmodelled_text(u)) + ".");
 }
 
 void section_explain(Page &p, const Data &d)
@@ -674,8 +676,9 @@ void section_explain(Page &p, const Data &d)
                 d.o.adds.empty() ? "" : " with the added terms", ex.base_n_params,
                 arcsec_text(ex.base_sigma_arcsec).c_str(), arcsec_text(ex.base_cv_rms_arcsec).c_str()) +
                 (ex.findings.empty()
-                     ? fmt("nothing significant is left out (false-alarm probability below %g and a better "
-                           "cross-validated RMS were required).", d.o.alpha)
+                     ? fmt("nothing %s is left out (false-alarm probability below %g and a better "
+                           "cross-validated RMS were required).",
+                           ex.unmodelled.empty() ? "significant" : "that this run can model", d.o.alpha)
                      : fmt("after %zu finding%s &sigma; = <b>%s</b>, cross-validated RMS %s with P = %d terms "
                            "(docs/explain.md).", ex.findings.size(), ex.findings.size() == 1 ? "" : "s",
                            arcsec_text(ex.final_sigma_arcsec).c_str(),
