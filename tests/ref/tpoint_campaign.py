@@ -481,6 +481,7 @@ def run_case(arg):
         F = summarise_findings(ex)
         rec['findings'] = F
         rec['withdrawn'] = ex.get('withdrawn')
+        rec['unmodelled'] = [u['effect'] for u in ex.get('unmodelled', [])]
         rec['baseline'] = ex.get('baseline')
         rec['final'] = ex.get('final')
         rec['interpretation'] = {i['what']: (i['value'], i['error']) for i in ex.get('interpretation', [])}
@@ -729,6 +730,11 @@ def report(results, red, fh=sys.stdout):
                                                                          r.get('floor_excess_chi2') or -1) for r in fa)))
     P('null runs: %d; a finding without real structure (false alarm): %d; a finding where the noise-free run'
       ' has real structure (floor chi2 > 20): %d' % tuple(tot))
+    flg = [r for r in results if r['kind'] == 'null' and 'score' in r and r.get('unmodelled')
+           and not r['score']['false_alarm']]
+    P('null runs without a finding that flag a family significant, not modelled: %d%s' % (
+        len(flg), ''.join(' (%s %s, floor chi2 %.0f)' % (r['mount'], '+'.join(r['unmodelled']),
+                                                          r.get('floor_excess_chi2') or -1) for r in flg)))
     zs = [r['score']['amp_z'] for r in results if r['kind'] == 'single' and 'score' in r and 'amp_z' in r['score']]
     if zs:
         zs = np.array(zs)
