@@ -283,6 +283,27 @@ START_TEST(test_report_altaz)
 }
 END_TEST
 
+/* A run whose residuals hold order 2 that its 90 points cannot fit
+** (tests/data/indep_ho_altaz_n90_unmodelled.dat, check_explain_reading's
+** test_unmodelled): the explain section says nothing it can model is left
+** out, and names what is there. */
+START_TEST(test_report_unmodelled)
+{
+    char path[512];
+    char *html;
+    snprintf(path, sizeof path, "%s/tests/data/indep_ho_altaz_n90_unmodelled.dat", top());
+    ck_assert_msg(report(path, "--next 3", "unmodelled.html") == 0, "pmfit report failed: %s", out);
+    snprintf(path, sizeof path, "%s/unmodelled.html", tmp);
+    html = slurp(path);
+    ck_assert_ptr_nonnull(html);
+    check_page(html, "unmodelled page", 8, 0);
+    ck_assert_msg(strstr(html, "nothing that this run can model is left out") != NULL, "summary");
+    ck_assert_msg(strstr(html, "<b>Significant, not modelled:</b> higher_order (false-alarm 10^") != NULL,
+                  "the unmodelled family not named");
+    free(html);
+}
+END_TEST
+
 /* An equatorial run without a latitude: no azimuth, elevation or targets,
 ** each said on the page; the rest drawn. */
 START_TEST(test_report_no_latitude)
@@ -601,6 +622,7 @@ static Suite *suite(void)
     tcase_add_test(t, test_report_example);
     tcase_add_test(t, test_report_altaz);
     tcase_add_test(t, test_report_no_latitude);
+    tcase_add_test(t, test_report_unmodelled);
     tcase_add_test(t, test_report_compare);
     suite_add_tcase(s, t);
     t = tcase_create("errors");
