@@ -1391,8 +1391,10 @@ double step_tests(const std::vector<Candidate> &cands, const ExplainOptions &opt
 // ex.unmodelled.  The residuals hold it (the same false-alarm control as a
 // finding's), but the run cannot fit it usefully: with its terms the
 // leave-one-out prediction is no better (a run of 90 points whose order-2
-// distortion is significant at 10^-11.9: sigma 0.426" -> 0.318", yet its
-// 24 terms predict at 0.530" against 0.454").
+// distortion is significant at 10^-10.5, the step's candidates counted:
+// sigma 0.426" -> 0.318", yet its 24 terms predict at 0.530" against
+// 0.454").  Prune may withdraw a finding after it; it was tried on the model
+// the forward search ended with (cv_before).
 void note_unmodelled(const State &st, const std::vector<Candidate> &cands,
                      const ExplainOptions &opt, Explanation &ex)
 {
