@@ -196,18 +196,10 @@ END_TEST
 ** parameters than the L=2 model (46); reference: L=1 + cot(el) 0.623". */
 START_TEST(test_pmx_explain_mmt)
 {
-    const char *d = tu_data_dir();
     char path[512], err[512];
     pmx_result r;
-    if (!d) {
-        printf("skipped: ../shared/data absent\n");
+    if (!tu_real_run("mmt/k_and_e.dat", path, sizeof path))
         return;
-    }
-    snprintf(path, sizeof path, "%s/mmt/k_and_e.dat", d);
-    if (access(path, R_OK) != 0) {
-        printf("skipped: %s absent\n", path);
-        return;
-    }
     ck_assert_msg(pmx_explain(path, 1, ALPHA, &r, err, sizeof err) == 0, "%s", err);
     ck_assert_int_ge(r.n_findings, 1);
     ck_assert_str_eq(r.findings[0].effect, "refraction");
@@ -230,18 +222,10 @@ END_TEST
 ** "The two amateur German equatorial mounts"). */
 START_TEST(test_pmx_explain_cgxl_unmodelled)
 {
-    const char *d = tu_data_dir();
     char path[512], err[512];
     pmx_result r;
-    if (!d) {
-        printf("skipped: ../shared/data absent\n");
+    if (!tu_real_run("celestial/cgx-l-data.dat", path, sizeof path))
         return;
-    }
-    snprintf(path, sizeof path, "%s/celestial/cgx-l-data.dat", d);
-    if (access(path, R_OK) != 0) {
-        printf("skipped: %s absent\n", path);
-        return;
-    }
     ck_assert_msg(pmx_explain(path, 1, ALPHA, &r, err, sizeof err) == 0, "%s", err);
     printf("check_explain: CGX-L: %d finding(s), first %s; unmodelled '%s' (10^%.2f), CV RMS "
            "%.3f\" against %.3f\"\n",
@@ -310,18 +294,10 @@ static int mmt_injected(const char *path, int axis, double amp_arcsec, double ge
 
 START_TEST(test_pmx_explain_mmt_hidden_periodic)
 {
-    const char *d = tu_data_dir();
     char path[512];
     int wrong = 0, at1, at15, known, el;
-    if (!d) {
-        printf("skipped: ../shared/data absent\n");
+    if (!tu_real_run("mmt/k_and_e.dat", path, sizeof path))
         return;
-    }
-    snprintf(path, sizeof path, "%s/mmt/k_and_e.dat", d);
-    if (access(path, R_OK) != 0) {
-        printf("skipped: %s absent\n", path);
-        return;
-    }
     at1 = mmt_injected(path, 0, 0.747, 0, &wrong);
     at15 = mmt_injected(path, 0, 1.12, 0, &wrong);
     known = mmt_injected(path, 0, 0.747, 60, &wrong);

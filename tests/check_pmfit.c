@@ -36,25 +36,12 @@ static int run(const char *fmt, const char *a, const char *b)
     return tu_capture(cmd, out, sizeof out);
 }
 
-static int have_data(const char *rel, char *path, size_t len)
-{
-    const char *d = tu_data_dir();
-    if (!d)
-        return 0;
-    snprintf(path, len, "%s/%s", d, rel);
-    if (access(path, R_OK) != 0)
-        return 0;
-    return 1;
-}
-
 START_TEST(test_pmfit_mmt_sigma)
 {
     char path[512];
     double s1, s2;
-    if (!have_data("mmt/k_and_e.dat", path, sizeof path)) {
-        printf("skipped: ../shared/data/mmt/k_and_e.dat absent\n");
+    if (!tu_real_run("mmt/k_and_e.dat", path, sizeof path))
         return;
-    }
     ck_assert_int_eq(run("%s fit %s --order 1 --json", path, NULL), 0);
     s1 = tu_json_num(out, "sigma_arcsec");
     ck_assert_int_eq((int)tu_json_num(out, "n_obs"), 80);
@@ -77,10 +64,8 @@ START_TEST(test_pmfit_gem_converges)
     int f, L;
     for (f = 0; f < 2; f++) {
         char path[512];
-        if (!have_data(files[f], path, sizeof path)) {
-            printf("skipped: ../shared/data/%s absent\n", files[f]);
+        if (!tu_real_run(files[f], path, sizeof path))
             continue;
-        }
         for (L = 0; L <= 2; L++) {
             char opt[64];
             const char *p;

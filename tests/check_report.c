@@ -192,6 +192,21 @@ static void check_page(const char *html, const char *what, int min_figures, int 
     ck_assert_msg(strstr(html, "<th scope=\"col\">value</th>") == NULL, "%s: a column without its unit", what);
 }
 
+/* pmfit report RUN ARGS -o tmp/NAME, which must succeed, and its page,
+** checked by check_page (what, min_figures, compare); the caller frees it. */
+static char *checked_report(const char *run, const char *args, const char *name, const char *what,
+                            int min_figures, int compare)
+{
+    char path[512];
+    char *html;
+    ck_assert_msg(report(run, args, name) == 0, "pmfit report %s failed: %s", args, out);
+    snprintf(path, sizeof path, "%s/%s", tmp, name);
+    html = slurp(path);
+    ck_assert_ptr_nonnull(html);
+    check_page(html, what, min_figures, compare);
+    return html;
+}
+
 /* The number after `key` in text (fails if absent). */
 static double after(const char *text, const char *key, const char *what)
 {
@@ -209,11 +224,7 @@ START_TEST(test_report_example)
     const char *p;
     int n = 0;
     snprintf(run, sizeof run, "%s/examples/sim_gem.dat", top());
-    ck_assert_msg(report(run, "", "sim.html") == 0, "pmfit report failed: %s", out);
-    snprintf(path, sizeof path, "%s/sim.html", tmp);
-    html = slurp(path);
-    ck_assert_ptr_nonnull(html);
-    check_page(html, "sim_gem page", 14, 0);
+    html = checked_report(run, "", "sim.html", "sim_gem page", 14, 0);
     /* the numbers are pmfit's own: sigma of the fit */
     snprintf(cmd, sizeof cmd, "'%s' fit '%s' --json", tu_pmfit_path(), run);
     ck_assert_int_eq(tu_capture(cmd, out, sizeof out), 0);
@@ -270,11 +281,7 @@ START_TEST(test_report_altaz)
     snprintf(cmd, sizeof cmd, "'%s' simulate '%s' --mount altaz --n 150 --seed 7 --lat 31.7 --noise 0.8",
              tu_pmfit_path(), path);
     ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "simulate: %s", out);
-    ck_assert_msg(report(path, "--next 3", "altaz.html") == 0, "pmfit report failed: %s", out);
-    snprintf(path, sizeof path, "%s/altaz.html", tmp);
-    html = slurp(path);
-    ck_assert_ptr_nonnull(html);
-    check_page(html, "alt-az page", 10, 0);
+    html = checked_report(path, "--next 3", "altaz.html", "alt-az page", 10, 0);
     ck_assert_msg(strstr(html, "alt-az, site latitude +31.7000&deg;") != NULL, "alt-az summary");
     ck_assert_msg(strstr(html, "class=\"axis-label x\">azimuth (deg)</text>") != NULL, "azimuth axis");
     ck_assert_msg(strstr(html, "<th scope=\"col\">azimuth (deg)</th>") != NULL, "targets in azimuth");
@@ -292,11 +299,7 @@ START_TEST(test_report_unmodelled)
     char path[512];
     char *html;
     snprintf(path, sizeof path, "%s/tests/data/indep_ho_altaz_n90_unmodelled.dat", top());
-    ck_assert_msg(report(path, "--next 3", "unmodelled.html") == 0, "pmfit report failed: %s", out);
-    snprintf(path, sizeof path, "%s/unmodelled.html", tmp);
-    html = slurp(path);
-    ck_assert_ptr_nonnull(html);
-    check_page(html, "unmodelled page", 8, 0);
+    html = checked_report(path, "--next 3", "unmodelled.html", "unmodelled page", 8, 0);
     ck_assert_msg(strstr(html, "nothing that this run can model is left out") != NULL, "summary");
     ck_assert_msg(strstr(html, "<b>Significant, not modelled:</b> higher_order (false-alarm 10^") != NULL,
                   "the unmodelled family not named");
@@ -313,11 +316,7 @@ START_TEST(test_report_no_latitude)
     snprintf(path, sizeof path, "%s/nolat.dat", tmp);
     snprintf(cmd, sizeof cmd, "grep -v '^# latitude:' '%s/examples/sim_gem.dat' > '%s'", top(), path);
     ck_assert_int_eq(system(cmd), 0);
-    ck_assert_msg(report(path, "", "nolat.html") == 0, "pmfit report failed: %s", out);
-    snprintf(path, sizeof path, "%s/nolat.html", tmp);
-    html = slurp(path);
-    ck_assert_ptr_nonnull(html);
-    check_page(html, "page without a latitude", 12, 0);
+    html = checked_report(path, "", "nolat.html", "page without a latitude", 12, 0);
     ck_assert_msg(strstr(html, "site latitude not given") != NULL, "summary");
     ck_assert_msg(strstr(html, "Not drawn: the residuals against elevation") != NULL, "no elevation");
     ck_assert_msg(strstr(html, "Not available for this run: plan: an equatorial mount needs the site latitude"),
@@ -329,7 +328,7 @@ END_TEST
 /* --compare OLD: a saved model, and a run; the numbers of pmfit compare. */
 START_TEST(test_report_compare)
 {
-    char run[512], old[512], path[512], cmd[4096], args[1024];
+    char run[512], old[512], cmd[4096], args[1024];
     char *html;
     int k;
     snprintf(run, sizeof run, "%s/examples/sim_gem.dat", top());
@@ -340,11 +339,7 @@ START_TEST(test_report_compare)
     ck_assert_int_eq(system(cmd), 0);
     for (k = 0; k < 2; k++) {
         snprintf(args, sizeof args, "--compare '%s%s'", k ? old : tmp, k ? "" : "/old.pm");
-        ck_assert_msg(report(run, args, "cmp.html") == 0, "pmfit report %s failed: %s", args, out);
-        snprintf(path, sizeof path, "%s/cmp.html", tmp);
-        html = slurp(path);
-        ck_assert_ptr_nonnull(html);
-        check_page(html, k ? "compare with a run" : "compare with a model", 14, 1);
+        html = checked_report(run, args, "cmp.html", k ? "compare with a run" : "compare with a model", 14, 1);
         snprintf(cmd, sizeof cmd, "'%s' compare %s '%s' --json", tu_pmfit_path(), args + 10, run);
         ck_assert_int_eq(tu_capture(cmd, out, sizeof out), 0);
         ck_assert_double_eq_tol(after(html, "the old model as it is</td><td>", "compare table"),

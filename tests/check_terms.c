@@ -1378,17 +1378,9 @@ END_TEST
 ** fit runs and the table shows the periodic and refraction terms. */
 START_TEST(test_pmfit_add_real_gem)
 {
-    const char *d = tu_data_dir();
     char path[512], args[1024];
-    if (!d) {
-        printf("skipped: PM_DATA_DIR not set (../shared/data absent)\n");
+    if (!tu_real_run("celestial/gem-28.dat", path, sizeof path))
         return;
-    }
-    snprintf(path, sizeof path, "%s/celestial/gem-28.dat", d);
-    if (access(path, R_OK) != 0) {
-        printf("skipped: %s absent\n", path);
-        return;
-    }
     snprintf(args, sizeof args, "fit %s --add ha_periodic:240 --add refraction --pier joint",
              path);
     ck_assert_msg(pmfit(args) == 0, "pmfit %s:\n%s", args, out);
@@ -1409,19 +1401,11 @@ END_TEST
 #define TOL_REFRACTION_AS 3.0
 START_TEST(test_pmfit_refraction_term_is_refraction)
 {
-    const char *d = tu_data_dir();
     char path[512], args[1024];
     double refa, refb, c[2][2];
     int L, nr;
-    if (!d) {
-        printf("skipped: PM_DATA_DIR not set (../shared/data absent)\n");
+    if (!tu_real_run("celestial/gem-28.dat", path, sizeof path))
         return;
-    }
-    snprintf(path, sizeof path, "%s/celestial/gem-28.dat", d);
-    if (access(path, R_OK) != 0) {
-        printf("skipped: %s absent\n", path);
-        return;
-    }
     eraRefco(992.0, 21.7, 0.96, 0.55, &refa, &refb);
     for (L = 0; L <= 1; L++) {
         for (nr = 0; nr < 2; nr++) {

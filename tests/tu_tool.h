@@ -68,6 +68,25 @@ static inline double tu_term_value(const char *json, const char *name)
     return tu_number_after(json, pat, name);
 }
 
+/* The real run rel under ../shared/data ($PM_DATA_DIR) into path (len
+** bytes): 1 if it is there, else 0 with "skipped: ..." printed (the tests
+** that need the real runs skip cleanly without them; PM_DATA_DIR unset or
+** empty is absent, as for testutil.h's tu_data_dir). */
+static inline int tu_real_run(const char *rel, char *path, size_t len)
+{
+    const char *d = getenv("PM_DATA_DIR");
+    if (!d || !*d) {
+        printf("skipped: ../shared/data absent\n");
+        return 0;
+    }
+    snprintf(path, len, "%s/%s", d, rel);
+    if (access(path, R_OK) != 0) {
+        printf("skipped: %s absent\n", path);
+        return 0;
+    }
+    return 1;
+}
+
 /* The directories tu_tmpdir made, and the process that made each: removed
 ** with their contents when that process exits (Check runs each test in a
 ** child that exits, also on a failed assertion; a child never removes the
