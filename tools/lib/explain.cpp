@@ -1210,6 +1210,20 @@ std::vector<Alternative> alternatives(const Run &run, const State &st, const Can
 
 // ------------------------------------------------------------- the pipeline
 
+// Where the baseline has too few observations: the highest lower order
+// whose terms the run can fit (2N > P), as the option that would, or
+// that no order can.
+std::string lower_order_hint(const Run &run, const State &st)
+{
+    for (int k = st.order - 1; k >= 0; k--) {
+        pm_model m = build_model(k, st.adds, run.obs, run.mount, run.latitude, run.aux_names);
+        if ((long)st.use.size() > m.n_terms / 2)
+            return "; --order " + std::to_string(k) + " (P = " + std::to_string(m.n_terms) +
+                   ") fits this run";
+    }
+    return "; add observations";
+}
+
 // The baseline fit, or an exception that says why it failed.
 State baseline(const Run &run, const ExplainOptions &opt)
 {
@@ -1231,7 +1245,7 @@ State baseline(const Run &run, const ExplainOptions &opt)
     if (f.status == PM_ERR_TOO_FEW)
         why = "too few observations (P = " + std::to_string(f.model.n_terms) +
               " terms need at least " + std::to_string(f.model.n_terms / 2 + 1) + ", there are " +
-              std::to_string(st.use.size()) + ")";
+              std::to_string(st.use.size()) + ")" + lower_order_hint(run, st);
     else if (f.status == PM_ERR_SINGULAR && f.bad_term >= 0)
         why = "term " + term_name(f.model, f.bad_term) + " cannot be determined from these observations";
     else if (f.status == PM_ERR_DIVERGED)
