@@ -86,6 +86,13 @@ struct Finding {
     std::string where;        // where on the sky (or when) it matters
     std::vector<std::string> adds; // the terms added (pmfit --add syntax)
     std::vector<std::string> term_names; // those terms' names in the model (term_name)
+    // those terms' values and 1-sigma errors, arcsec, in the final model
+    // (as pmfit fit --json lists its terms); none for outliers, higher_order
+    struct Coefficient {
+        std::string name;
+        double value_arcsec = 0, error_arcsec = 0;
+    };
+    std::vector<Coefficient> coefficients;
     double cycles_per_rev = 0, amplitude_arcsec = 0, amplitude_err_arcsec = 0, phase_deg = 0;
     double cycles_lo = 0, cycles_hi = 0; // periodic: the periods that fit as well (lo..hi)
     double sampled_deg = 0;               // periodic: the extent of the axis the run samples

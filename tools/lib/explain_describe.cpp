@@ -169,6 +169,21 @@ std::string values_of(const Run &run, const pm_model &m, const pm_fit_result &re
     return vals;
 }
 
+// The terms newi of a finding's fit, as the finding's coefficients (the
+// values its text gives, to JSON's precision).
+void set_coefficients(const pm_model &m, const pm_fit_result &res, const std::vector<int> &newi,
+                      Finding &fd)
+{
+    fd.coefficients.clear();
+    for (int i : newi) {
+        Finding::Coefficient c;
+        c.name = term_name(m, i);
+        c.value_arcsec = arcsec(m.coef[i]);
+        c.error_arcsec = arcsec(res.err[i]);
+        fd.coefficients.push_back(c);
+    }
+}
+
 double rms_of(const std::vector<double> &d)
 {
     double ss = 0;
@@ -186,6 +201,7 @@ void describe_periodic(const Run &run, const Candidate &c, const std::vector<int
     double ec = res.err[newi[0]], es = res.err[newi[1]];
     double A = std::hypot(cc, ss);
     int axis = effect == "ha_periodic" ? 1 : 2;
+    set_coefficients(m, res, newi, fd);
     fd.cycles_per_rev = G;
     fd.amplitude_arcsec = arcsec(A);
     fd.amplitude_err_arcsec = arcsec(A > 0 ? std::hypot(cc * ec, ss * es) / A : std::hypot(ec, es));
@@ -261,6 +277,7 @@ void describe_pier(const Run &run, const State &st, const Candidate &c,
         if (run.obs[i].pier < 0)
             west.push_back(i);
     fd.amplitude_arcsec = arcsec(rms_of(model_difference(run, west, z, m)));
+    set_coefficients(m, c.fit.f.res, newi, fd);
     char buf[700];
     std::snprintf(buf, sizeof buf,
                   "the pointing differs across the meridian flip (pier side) by %.2f\" RMS on the "
@@ -310,6 +327,7 @@ void describe_family(const Run &run, const Candidate &c, const std::vector<int> 
     for (int i : newi)
         if (std::fabs(m.coef[i]) > std::fabs(m.coef[big]))
             big = i;
+    set_coefficients(m, c.fit.f.res, newi, fd);
     fd.amplitude_arcsec = big >= 0 ? arcsec(std::fabs(m.coef[big])) : 0;
     fd.amplitude_err_arcsec = big >= 0 ? arcsec(c.fit.f.res.err[big]) : 0;
     char buf[700];

@@ -52,6 +52,11 @@ std::string finding_json(const Finding &f)
          ", \"n_params_after\": " + std::to_string(f.n_params_after) + ", \"terms\": [";
     for (size_t k = 0; k < f.adds.size(); k++)
         j += std::string(k ? ", " : "") + str(f.adds[k]);
+    j += "], \"coefficients\": [";
+    for (size_t k = 0; k < f.coefficients.size(); k++)
+        j += std::string(k ? ", " : "") + "{\"name\": " + str(f.coefficients[k].name) +
+             ", \"value_arcsec\": " + num(f.coefficients[k].value_arcsec) +
+             ", \"error_arcsec\": " + num(f.coefficients[k].error_arcsec) + "}";
     j += "]";
     if (!f.lines.empty()) {
         j += ", \"lines\": [" + joined(f.lines) + "]";
