@@ -1211,15 +1211,15 @@ std::vector<Alternative> alternatives(const Run &run, const State &st, const Can
 // ------------------------------------------------------------- the pipeline
 
 // Where the baseline has too few observations: the highest lower order
-// whose terms the run can fit (2N > P), as the option that would, or
-// that no order can.
+// with few enough terms for the run (2N > P), or that no order has.
 std::string lower_order_hint(const Run &run, const State &st)
 {
     for (int k = st.order - 1; k >= 0; k--) {
         pm_model m = build_model(k, st.adds, run.obs, run.mount, run.latitude, run.aux_names);
         if ((long)st.use.size() > m.n_terms / 2)
-            return "; --order " + std::to_string(k) + " (P = " + std::to_string(m.n_terms) +
-                   ") fits this run";
+            return "; lower --order: --order " + std::to_string(k) + " (P = " +
+                   std::to_string(m.n_terms) + " terms) needs at least " +
+                   std::to_string(m.n_terms / 2 + 1);
     }
     return "; add observations";
 }
