@@ -1210,16 +1210,19 @@ std::vector<Alternative> alternatives(const Run &run, const State &st, const Can
 
 // ------------------------------------------------------------- the pipeline
 
+// The observations a model of P terms needs (2N > P).
+int min_obs(int P) { return P / 2 + 1; }
+
 // Where the baseline has too few observations: the highest lower order
-// with few enough terms for the run (2N > P), or that no order has.
+// with few enough terms for the run, or that no order has.
 std::string lower_order_hint(const Run &run, const State &st)
 {
     for (int k = st.order - 1; k >= 0; k--) {
         pm_model m = build_model(k, st.adds, run.obs, run.mount, run.latitude, run.aux_names);
-        if ((long)st.use.size() > m.n_terms / 2)
+        if ((long)st.use.size() >= min_obs(m.n_terms))
             return "; lower --order: --order " + std::to_string(k) + " (P = " +
                    std::to_string(m.n_terms) + " terms) needs at least " +
-                   std::to_string(m.n_terms / 2 + 1);
+                   std::to_string(min_obs(m.n_terms));
     }
     return "; add observations";
 }
@@ -1244,7 +1247,7 @@ State baseline(const Run &run, const ExplainOptions &opt)
     std::string why = "status " + std::to_string((int)f.status);
     if (f.status == PM_ERR_TOO_FEW)
         why = "too few observations (P = " + std::to_string(f.model.n_terms) +
-              " terms need at least " + std::to_string(f.model.n_terms / 2 + 1) + ", there are " +
+              " terms need at least " + std::to_string(min_obs(f.model.n_terms)) + ", there are " +
               std::to_string(st.use.size()) + ")" + lower_order_hint(run, st);
     else if (f.status == PM_ERR_SINGULAR && f.bad_term >= 0)
         why = "term " + term_name(f.model, f.bad_term) + " cannot be determined from these observations";
