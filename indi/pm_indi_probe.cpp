@@ -63,15 +63,9 @@ double sep(double a1, double b1, double a2, double b2)
 }
 
 /* The known mount: index offsets o1, o2 on the axes, then a fixed rotation
-** (small rotations about x and y) of the whole mount. */
+** (small rotations about x and y) of the whole mount; the probe needs only
+** its inverse, sky to mount (truth_inv). */
 const double O1 = 0.40 * D2R, O2 = -0.25 * D2R, RX = 0.20 * D2R, RY = -0.12 * D2R;
-
-Vec rotate(Vec v, double rx, double ry)
-{
-    Vec a = {v.x, std::cos(rx) * v.y - std::sin(rx) * v.z, std::sin(rx) * v.y + std::cos(rx) * v.z};
-    return {std::cos(ry) * a.x + std::sin(ry) * a.z, a.y, -std::sin(ry) * a.x + std::cos(ry) * a.z};
-}
-
 
 void truth_inv(double s1, double s2, double *m1, double *m2)
 {
