@@ -28,6 +28,15 @@
 **     recover the true mount within 5 sigma of every coefficient, with a
 **     residual sigma near 0.5 arcsec.
 **
+**  0) The model's own guard.  Every evaluation first checks that no
+**     coefficient changed since pm_model_prepare, bit for bit (on
+**     Armv7-M in Thumb-2 assembly of its own, lib/pm_detail.hpp): the
+**     lowest bit and the sign of each coefficient in turn, changed in a
+**     copy of the model, must make pm_model_apply, pm_model_invert and
+**     pm_model_invert_near refuse it (PM_ERR_STATE), and putting it back
+**     must make them work again; with an even and an odd number of terms
+**     (the check reads the coefficients in pairs).
+**
 **  Every result is compared with the host build of this same program
 **  (build/fw/gen/fw_ref.h, written by "demo --emit-ref"): within 1e-9 rad
 **  for the double evaluation, 0.01" on the sky for the float build
@@ -197,6 +206,65 @@ static pm_status ctl_track(double ah, double ad, double *eh, double *ed)
 #else
     return pm_model_track(&model, NULL, &trk, ah, ad, eh, ed);
 #endif
+}
+
+/* ---------------------------------------------------------------------- */
+/* Phase 0: the model's guard against a changed coefficient.             */
+/* ---------------------------------------------------------------------- */
+
+/* Flip one bit of x in place: bit 0 of its first byte (kind 0) or bit 7
+** of its last (kind 1): the lowest mantissa bit and the sign on a
+** little-endian machine, one in each 32-bit half of the double either way. */
+static void flip_bit(double *x, int kind)
+{
+    unsigned char b[sizeof(double)];
+    memcpy(b, x, sizeof b);
+    if (kind == 0)
+        b[0] ^= 1;
+    else
+        b[sizeof b - 1] ^= 0x80;
+    memcpy(x, b, sizeof b);
+}
+
+static void staleness(void)
+{
+    pm_term x;
+    double t, d, keep;
+    int pass, i, kind, refused = 0, n = 0;
+    truth = model; /* (a copy: pointing_run sets truth afresh) */
+    for (pass = 0; pass < 2; pass++) {
+        if (pass == 1) { /* one term more: the other parity */
+            memset(&x, 0, sizeof x);
+            x.kind = PM_TERM_FOURIER;
+            x.k = PM_BASE_C;
+            x.l = 1;
+            x.param = 2.0;
+            if (pm_model_add_term(&truth, &x, 1e-6, NULL) != PM_OK ||
+                pm_model_prepare(&truth) != PM_OK) {
+                fail("staleness: adding a term", 1, 0);
+                return;
+            }
+        }
+        for (i = 0; i < truth.n_terms; i++)
+            for (kind = 0; kind < 2; kind++) {
+                keep = truth.coef[i];
+                flip_bit(&truth.coef[i], kind);
+                n++;
+                refused += pm_model_apply(&truth, NULL, 0.1, 0.2, &t, &d) == PM_ERR_STATE &&
+                           pm_model_invert(&truth, NULL, 0.1, 0.2, PM_SIDE_NORMAL, &t, &d) ==
+                               PM_ERR_STATE &&
+                           pm_model_invert_near(&truth, NULL, 0.1, 0.2, 0.1, 0.2, &t, &d) ==
+                               PM_ERR_STATE;
+                truth.coef[i] = keep;
+                if (pm_model_apply(&truth, NULL, 0.1, 0.2, &t, &d) != PM_OK ||
+                    pm_model_invert(&truth, NULL, 0.1, 0.2, PM_SIDE_NORMAL, &t, &d) != PM_OK)
+                    fail("staleness: the model restored", (double)i, 0);
+            }
+    }
+    printf("staleness: %d of %d one-bit changes of a coefficient refused "
+           "(%d and %d terms)\n", refused, n, model.n_terms, model.n_terms + 1);
+    if (refused != n)
+        fail("staleness: changes not refused", (double)(n - refused), 0);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -469,6 +537,7 @@ int main(void)
     printf("model: order %d, %d terms (compiled in), tracking in %s\n", model.order,
            model.n_terms, FW_PREC);
 
+    staleness();
     fw_stack_paint();
     tracking();
     d_track = fw_stack_depth();

@@ -628,6 +628,17 @@ inline void finish_angles(const double ref[2], double *t, double *d)
 }
 
 
+/* The coefficient check in Thumb-2 assembly (coef_changed): on Armv7-M
+** and Armv8-M mainline cores, unless PM_LDM_COMPARE is defined 0. */
+#ifndef PM_LDM_COMPARE
+#if defined(__thumb2__) && defined(__GNUC__) && \
+    (defined(__ARM_ARCH_7M__) || defined(__ARM_ARCH_7EM__) || defined(__ARM_ARCH_8M_MAIN__))
+#define PM_LDM_COMPARE 1
+#else
+#define PM_LDM_COMPARE 0
+#endif
+#endif
+
 /* Is the model prepared, with a term count it can evaluate (model_ready's
 ** first part: what makes an evaluation safe to run). */
 __attribute__((always_inline)) inline pm_status model_shape(const pm_model *m)
@@ -643,6 +654,38 @@ __attribute__((always_inline)) inline pm_status model_shape(const pm_model *m)
 ** pm_model_prepare (model_ready's second part)? */
 __attribute__((always_inline)) inline bool coef_changed(const pm_model *m)
 {
+#if PM_LDM_COMPARE
+    /* Armv7-M / Armv8-M mainline: gcc loads the words one by one (ldr,
+    ** 19 instructions per two coefficients); here two coefficients of
+    ** each array per ldm, 12 instructions per two (docs/performance.md,
+    ** "The coefficient check on Armv7-M").  Registers named so that ldm's
+    ** lists ascend; r7 (Thumb's frame pointer) left out. */
+    typedef unsigned long __attribute__((may_alias)) word; /* 32 bits */
+    const word *a = (const word *)m->coef;
+    const word *b = (const word *)m->prep_coef;
+    const word *end = a + 4 * (m->n_terms / 2); /* n_terms >= 6: one pair at least */
+    unsigned long acc = 0;
+    __asm__("1:\n\t"
+            "ldmia %[a]!, {r4, r5, r6, r8}\n\t"
+            "ldmia %[b]!, {r9, r10, r11, r12}\n\t"
+            "eor r4, r4, r9\n\t"
+            "eor r5, r5, r10\n\t"
+            "eor r6, r6, r11\n\t"
+            "eor r8, r8, r12\n\t"
+            "orr r4, r4, r5\n\t"
+            "orr r6, r6, r8\n\t"
+            "orr %[acc], %[acc], r4\n\t"
+            "orr %[acc], %[acc], r6\n\t"
+            "cmp %[a], %[end]\n\t"
+            "bne 1b"
+            : [a] "+&r"(a), [b] "+&r"(b), [acc] "+&r"(acc)
+            : [end] "r"(end), "m"(*(const double(*)[PM_MAX_TERMS])m->coef),
+              "m"(*(const double(*)[PM_MAX_TERMS])m->prep_coef)
+            : "r4", "r5", "r6", "r8", "r9", "r10", "r11", "r12", "cc");
+    if (m->n_terms & 1) /* the last coefficient, after the pairs */
+        acc |= (a[0] ^ b[0]) | (a[1] ^ b[1]);
+    return acc != 0;
+#else
     /* Bit patterns XOR-ed and OR-ed together in the machine's words (two
     ** per double on a 32-bit core; two doubles per SSE2 register), four at
     ** a time, no early exit.  (Bitwise, so writing -0.0 over 0.0 also asks
@@ -674,6 +717,7 @@ __attribute__((always_inline)) inline bool coef_changed(const pm_model *m)
     word any = acc0;
 #endif
     return any != 0;
+#endif /* PM_LDM_COMPARE */
 }
 
 /* Is the model ready for evaluation: prepared, and no coefficient changed
