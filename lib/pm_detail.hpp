@@ -659,7 +659,10 @@ __attribute__((always_inline)) inline bool coef_changed(const pm_model *m)
     ** 19 instructions per two coefficients); here two coefficients of
     ** each array per ldm, 12 instructions per two (docs/performance.md,
     ** "The coefficient check on Armv7-M").  Registers named so that ldm's
-    ** lists ascend; r7 (Thumb's frame pointer) left out. */
+    ** lists ascend; r7 (Thumb's frame pointer) left out, and the arrays
+    ** read through a "memory" clobber, not "m" operands, whose addresses
+    ** would take two more registers: at -O0 only r0-r3 and lr are left
+    ** for the four operands. */
     typedef unsigned long __attribute__((may_alias)) word; /* 32 bits */
     const word *a = (const word *)m->coef;
     const word *b = (const word *)m->prep_coef;
@@ -679,9 +682,8 @@ __attribute__((always_inline)) inline bool coef_changed(const pm_model *m)
             "cmp %[a], %[end]\n\t"
             "bne 1b"
             : [a] "+&r"(a), [b] "+&r"(b), [acc] "+&r"(acc)
-            : [end] "r"(end), "m"(*(const double(*)[PM_MAX_TERMS])m->coef),
-              "m"(*(const double(*)[PM_MAX_TERMS])m->prep_coef)
-            : "r4", "r5", "r6", "r8", "r9", "r10", "r11", "r12", "cc");
+            : [end] "r"(end)
+            : "r4", "r5", "r6", "r8", "r9", "r10", "r11", "r12", "cc", "memory");
     if (m->n_terms & 1) /* the last coefficient, after the pairs */
         acc |= (a[0] ^ b[0]) | (a[1] ^ b[1]);
     return acc != 0;
