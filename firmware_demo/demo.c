@@ -5,6 +5,14 @@
 **  written during the build by "pmfit fit examples/sim_gem.dat --order 2
 **  --emit-c" and gives pm_fitted_load().  Then, as a controller would:
 **
+**  0) The model's own guard.  Every evaluation first checks that no
+**     coefficient changed since pm_model_prepare, bit for bit (on
+**     Armv7-M in Thumb-2 assembly of its own, lib/pm_detail.hpp): the
+**     lowest bit and the sign of each coefficient in turn, changed in a
+**     copy of the model, must make pm_model_apply, pm_model_invert and
+**     pm_model_invert_near refuse it (PM_ERR_STATE), and putting it back
+**     must make them work again; with an even and an odd number of terms
+**     (the check reads the coefficients in pairs).
 **  1) Tracking.  Every tick the controller reads the encoders, reports
 **     where the telescope points (forward model, pm_model_apply), and
 **     converts the target's apparent (ha, dec) for this tick into encoder
@@ -27,15 +35,6 @@
 **     of (deterministic, pseudo-random) noise per axis: the refit must
 **     recover the true mount within 5 sigma of every coefficient, with a
 **     residual sigma near 0.5 arcsec.
-**
-**  0) The model's own guard.  Every evaluation first checks that no
-**     coefficient changed since pm_model_prepare, bit for bit (on
-**     Armv7-M in Thumb-2 assembly of its own, lib/pm_detail.hpp): the
-**     lowest bit and the sign of each coefficient in turn, changed in a
-**     copy of the model, must make pm_model_apply, pm_model_invert and
-**     pm_model_invert_near refuse it (PM_ERR_STATE), and putting it back
-**     must make them work again; with an even and an odd number of terms
-**     (the check reads the coefficients in pairs).
 **
 **  Every result is compared with the host build of this same program
 **  (build/fw/gen/fw_ref.h, written by "demo --emit-ref"): within 1e-9 rad
