@@ -659,10 +659,14 @@ __attribute__((always_inline)) inline bool coef_changed(const pm_model *m)
     ** 19 instructions per two coefficients); here two coefficients of
     ** each array per ldm, 12 instructions per two (docs/performance.md,
     ** "The coefficient check on Armv7-M").  Registers named so that ldm's
-    ** lists ascend; r7 (Thumb's frame pointer) left out, and the arrays
-    ** read through a "memory" clobber, not "m" operands, whose addresses
-    ** would take two more registers: at -O0 only r0-r3 and lr are left
-    ** for the four operands. */
+    ** lists ascend.  Left out: r7 (Thumb's frame pointer) and r9, the
+    ** AAPCS platform register, which firmware may reserve (-ffixed-r9:
+    ** gcc would let the assembly overwrite it unannounced) or make the
+    ** PIC base (-msingle-pic-base: gcc refuses the assembly); lr is
+    ** clobbered instead.  The arrays are read through a "memory" clobber,
+    ** not "m" operands, whose addresses would take two more registers: at
+    ** -O0 only r0-r3 (and r9 where it is free) are left for the four
+    ** operands. */
     typedef unsigned long __attribute__((may_alias)) word; /* 32 bits */
     const word *a = (const word *)m->coef;
     const word *b = (const word *)m->prep_coef;
@@ -670,11 +674,11 @@ __attribute__((always_inline)) inline bool coef_changed(const pm_model *m)
     unsigned long acc = 0;
     __asm__("1:\n\t"
             "ldmia %[a]!, {r4, r5, r6, r8}\n\t"
-            "ldmia %[b]!, {r9, r10, r11, r12}\n\t"
-            "eor r4, r4, r9\n\t"
-            "eor r5, r5, r10\n\t"
-            "eor r6, r6, r11\n\t"
-            "eor r8, r8, r12\n\t"
+            "ldmia %[b]!, {r10, r11, r12, lr}\n\t"
+            "eor r4, r4, r10\n\t"
+            "eor r5, r5, r11\n\t"
+            "eor r6, r6, r12\n\t"
+            "eor r8, r8, lr\n\t"
             "orr r4, r4, r5\n\t"
             "orr r6, r6, r8\n\t"
             "orr %[acc], %[acc], r4\n\t"
@@ -683,7 +687,7 @@ __attribute__((always_inline)) inline bool coef_changed(const pm_model *m)
             "bne 1b"
             : [a] "+&r"(a), [b] "+&r"(b), [acc] "+&r"(acc)
             : [end] "r"(end)
-            : "r4", "r5", "r6", "r8", "r9", "r10", "r11", "r12", "cc", "memory");
+            : "r4", "r5", "r6", "r8", "r10", "r11", "r12", "lr", "cc", "memory");
     if (m->n_terms & 1) /* the last coefficient, after the pairs */
         acc |= (a[0] ^ b[0]) | (a[1] ^ b[1]);
     return acc != 0;
