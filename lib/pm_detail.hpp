@@ -628,11 +628,15 @@ inline void finish_angles(const double ref[2], double *t, double *d)
 }
 
 
-/* The coefficient check in Thumb-2 assembly (coef_changed): on Armv7-M
-** and Armv8-M mainline cores, unless PM_LDM_COMPARE is defined 0. */
+/* The coefficient check in Thumb-2 assembly (coef_changed): on the
+** M-profile cores with Thumb-2 (Armv7-M, Armv7E-M, Armv8-M and Armv8.1-M
+** mainline; ACLE's profile 'M' with __thumb2__: not Armv6-M or Armv8-M
+** baseline, whose ldm takes low registers only), unless PM_LDM_COMPARE is
+** defined 0.  (By ACLE's macros: clang names Armv8.1-M's architecture
+** macro apart, __ARM_ARCH_8_1M_MAIN__, where gcc 12 says 8M_MAIN.) */
 #ifndef PM_LDM_COMPARE
-#if defined(__thumb2__) && defined(__GNUC__) && \
-    (defined(__ARM_ARCH_7M__) || defined(__ARM_ARCH_7EM__) || defined(__ARM_ARCH_8M_MAIN__))
+#if defined(__thumb2__) && defined(__GNUC__) && defined(__ARM_ARCH_PROFILE) && \
+    __ARM_ARCH_PROFILE == 'M'
 #define PM_LDM_COMPARE 1
 #else
 #define PM_LDM_COMPARE 0
@@ -655,8 +659,9 @@ __attribute__((always_inline)) inline pm_status model_shape(const pm_model *m)
 __attribute__((always_inline)) inline bool coef_changed(const pm_model *m)
 {
 #if PM_LDM_COMPARE
-    /* Armv7-M / Armv8-M mainline: gcc loads the words one by one (ldr,
-    ** 19 instructions per two coefficients); here two coefficients of
+    /* M-profile Thumb-2 (Armv7-M, Armv8-M and 8.1-M mainline): gcc loads
+    ** the words one by one (ldr, 19 instructions per two coefficients);
+    ** here two coefficients of
     ** each array per ldm, 12 instructions per two (docs/performance.md,
     ** "The coefficient check on Armv7-M").  Registers named so that ldm's
     ** lists ascend.  Left out: r7 (Thumb's frame pointer) and r9, the

@@ -4,7 +4,7 @@
 **  tracks to 1e-12 rad, refits from its observations, and agrees with the
 **  host build within 1e-9 rad ("make firmware-run" exits 0); and the core
 **  compiles for Cortex-M7 and M3 at -O0, -Og and -Os, also with r9
-**  reserved, which it then leaves alone.  Skipped, passing,
+**  reserved, which it then leaves alone, and with clang for Armv8.1-M.  Skipped, passing,
 **  when the ARM toolchain or QEMU is not installed.
 */
 #define _POSIX_C_SOURCE 200809L
@@ -128,6 +128,26 @@ START_TEST(test_core_compiles_at_every_level)
                                   cpus[c]);
                 }
             }
+    /* clang names Armv8.1-M mainline's architecture macro apart
+    ** (__ARM_ARCH_8_1M_MAIN__): the check's assembly is chosen by ACLE's
+    ** profile 'M' and __thumb2__ instead, and is there for it too */
+    if (!have("clang++")) {
+        printf("skipped: clang's Armv8.1-M build of the core (clang++ not installed)\n");
+        return;
+    }
+    snprintf(obj, sizeof obj, "%s/build/fw/levels/model_clang_v81m.o", top());
+    snprintf(cmd, sizeof cmd,
+             "clang++ --target=thumbv8.1m.main-none-eabi -std=c++11 -O2 -ffreestanding "
+             "-fno-exceptions -fno-rtti -nostdinc++ -I'%s/include' -c '%s/lib/model.cpp' "
+             "-o '%s' > '%s.log' 2>&1",
+             top(), top(), obj, obj);
+    st = system(cmd);
+    ck_assert_msg(WIFEXITED(st) && WEXITSTATUS(st) == 0,
+                  "lib/model.cpp for thumbv8.1m.main (clang) does not compile: see %s.log", obj);
+    snprintf(cmd, sizeof cmd,
+             "arm-none-eabi-objdump -d '%s' | grep -q 'ldmia.*{sl, fp, ip, lr}'", obj);
+    ck_assert_msg(system(cmd) == 0, "%s: no ldm of the coefficient check (clang, Armv8.1-M)",
+                  obj);
 }
 END_TEST
 
