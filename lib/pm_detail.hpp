@@ -661,10 +661,9 @@ __attribute__((always_inline)) inline bool coef_changed(const pm_model *m)
 #if PM_LDM_COMPARE
     /* M-profile Thumb-2 (Armv7-M, Armv8-M and 8.1-M mainline): gcc loads
     ** the words one by one (ldr, 19 instructions per two coefficients);
-    ** here two coefficients of
-    ** each array per ldm, 12 instructions per two (docs/performance.md,
-    ** "The coefficient check on Armv7-M").  Registers named so that ldm's
-    ** lists ascend.  Left out: r7 (Thumb's frame pointer) and r9, the
+    ** here two coefficients of each array per ldm, 12 instructions per
+    ** two (docs/performance.md, "The coefficient check on Armv7-M").
+    ** Registers named so that ldm's lists ascend.  Left out: r7 (Thumb's frame pointer) and r9, the
     ** AAPCS platform register, which firmware may reserve (-ffixed-r9:
     ** gcc would let the assembly overwrite it unannounced) or make the
     ** PIC base (-msingle-pic-base: gcc refuses the assembly); lr is
