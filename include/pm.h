@@ -774,6 +774,13 @@ typedef struct pm_model_f {
 **     mf       pm_model_f*      float model
 **  Returned (function value):
 **              pm_status   PM_OK; PM_ERR_ARG; PM_ERR_STATE
+**  Notes:
+**  1) mf is a snapshot of m: a later change of m (new coefficients,
+**     pm_model_prepare, a refit by pm_fit_solve) does not reach it, and
+**     the float calls cannot see that it happened (mf keeps no link to m,
+**     and no copy to check as pm_model_prepare's Note 1 does).  Call
+**     pm_model_f_prepare again after every change of m; do not write
+**     mf's fields directly.
 */
 pm_status pm_model_f_prepare(pm_model_f *mf, const pm_model *m);
 
