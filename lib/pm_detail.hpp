@@ -663,11 +663,11 @@ __attribute__((always_inline)) inline bool coef_changed(const pm_model *m)
     ** the words one by one (ldr, 19 instructions per two coefficients);
     ** here two coefficients of each array per ldm, 12 instructions per
     ** two (docs/performance.md, "The coefficient check on Armv7-M").
-    ** Registers named so that ldm's lists ascend.  Left out: r7 (Thumb's frame pointer) and r9, the
-    ** AAPCS platform register, which firmware may reserve (-ffixed-r9:
-    ** gcc would let the assembly overwrite it unannounced) or make the
-    ** PIC base (-msingle-pic-base: gcc refuses the assembly); lr is
-    ** clobbered instead.  The arrays are read through a "memory" clobber,
+    ** Registers named so that ldm's lists ascend.  Left out: r7 (Thumb's
+    ** frame pointer) and r9, the AAPCS platform register, which firmware
+    ** may reserve (-ffixed-r9: gcc would let the assembly overwrite it
+    ** unannounced) or make the PIC base (-msingle-pic-base: gcc refuses
+    ** the assembly); lr is clobbered instead.  The arrays are read through a "memory" clobber,
     ** not "m" operands, whose addresses would take two more registers: at
     ** -O0 only r0-r3 (and r9 where it is free) are left for the four
     ** operands. */
