@@ -667,10 +667,10 @@ __attribute__((always_inline)) inline bool coef_changed(const pm_model *m)
     ** frame pointer) and r9, the AAPCS platform register, which firmware
     ** may reserve (-ffixed-r9: gcc would let the assembly overwrite it
     ** unannounced) or make the PIC base (-msingle-pic-base: gcc refuses
-    ** the assembly); lr is clobbered instead.  The arrays are read through a "memory" clobber,
-    ** not "m" operands, whose addresses would take two more registers: at
-    ** -O0 only r0-r3 (and r9 where it is free) are left for the four
-    ** operands. */
+    ** the assembly); lr is clobbered instead.  The arrays are read
+    ** through a "memory" clobber, not "m" operands, whose addresses would
+    ** take two more registers: at -O0 only r0-r3 (and r9 where it is
+    ** free) are left for the four operands. */
     typedef unsigned long __attribute__((may_alias)) word; /* 32 bits */
     const word *a = (const word *)m->coef;
     const word *b = (const word *)m->prep_coef;
