@@ -2,6 +2,9 @@
 #include "hostutil.hpp"
 
 #include <cerrno>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <cstdarg>
 #include <cstdio>
 #include <atomic>
@@ -20,18 +23,113 @@ void set_err(char *err, size_t errlen, const std::string &msg)
         std::snprintf(err, errlen, "%s", msg.c_str());
 }
 
-int write_atomic(const std::string &path, const std::string &text, char *err, size_t errlen)
+// The file a path names, for a rename onto it: an existing file's real
+// path (symbolic links followed, also /proc's links to open files); where
+// nothing exists yet, a dangling symbolic link's target (up to 32 links),
+// else the path itself.
+static std::string link_target(const std::string &path)
 {
-    std::string tmp = path + ".tmp";
-    FILE *f = std::fopen(tmp.c_str(), "w");
+    char *real = realpath(path.c_str(), nullptr);
+    if (real) {
+        std::string r(real);
+        std::free(real);
+        return r;
+    }
+    std::string p = path;
+    for (int hop = 0; hop < 32; hop++) {
+        struct stat st;
+        if (lstat(p.c_str(), &st) != 0 || !S_ISLNK(st.st_mode))
+            return p;
+        char buf[4096];
+        ssize_t n = readlink(p.c_str(), buf, sizeof buf);
+        if (n <= 0 || (size_t)n >= sizeof buf)
+            return p;
+        std::string to(buf, (size_t)n);
+        if (to[0] != '/') {
+            size_t slash = p.rfind('/');
+            to = (slash == std::string::npos ? std::string() : p.substr(0, slash + 1)) + to;
+        }
+        p = to;
+    }
+    return p;
+}
+
+static int write_in_place(const std::string &path, const std::string &text, char *err,
+                          size_t errlen)
+{
+    FILE *f = std::fopen(path.c_str(), "w");
     if (!f) {
         set_err(err, errlen, path + ": cannot write: " + std::strerror(errno));
         return -1;
     }
     bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-    ok = (std::fclose(f) == 0) && ok;
-    if (!ok || std::rename(tmp.c_str(), path.c_str()) != 0) {
-        int e = errno;
+    int e = errno;
+    if (std::fclose(f) != 0 && ok) {
+        ok = false;
+        e = errno;
+    }
+    if (!ok) {
+        set_err(err, errlen, path + ": cannot write: " + std::strerror(e ? e : EIO));
+        return -1;
+    }
+    return 0;
+}
+
+int write_atomic(const std::string &path, const std::string &text, char *err, size_t errlen)
+{
+    // A symbolic link keeps pointing where it did: the file it names is
+    // written (replaced through its own temporary).  What is not a regular
+    // file (a device such as /dev/stdout's target or /dev/null, a FIFO, a
+    // file of /proc) is written in place: a rename would replace the node
+    // itself.
+    struct stat st;
+    bool exists = stat(path.c_str(), &st) == 0;
+    if (exists && !S_ISREG(st.st_mode))
+        return write_in_place(path, text, err, errlen);
+    const std::string target = link_target(path);
+    if (exists && access(target.c_str(), W_OK) != 0) { // (a file made read-only stays)
+        set_err(err, errlen, path + ": cannot write: " + std::strerror(errno));
+        return -1;
+    }
+    // A temporary of a name of its own beside the target (O_EXCL: never a
+    // file that is already there, and never one another process writes at
+    // the same time), then a rename over the target: a failure leaves the
+    // target as it was.
+    static std::atomic<unsigned> serial(0);
+    std::string tmp;
+    int fd = -1;
+    for (int attempt = 0; attempt < 100 && fd < 0; attempt++) {
+        char sfx[64];
+        std::snprintf(sfx, sizeof sfx, ".tmp%ld.%u", (long)getpid(), serial++);
+        tmp = target + sfx;
+        fd = open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC,
+                  exists ? (st.st_mode & 07777) : 0666);
+        if (fd < 0 && errno != EEXIST)
+            break;
+    }
+    if (fd < 0) {
+        set_err(err, errlen, path + ": cannot write: " + std::strerror(errno));
+        return -1;
+    }
+    if (exists)
+        (void)fchmod(fd, st.st_mode & 07777); // (open's mode passes the umask)
+    size_t done = 0;
+    int e = 0;
+    while (done < text.size()) {
+        ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n <= 0) {
+            e = n < 0 ? errno : EIO;
+            break;
+        }
+        done += (size_t)n;
+    }
+    if (close(fd) != 0 && !e)
+        e = errno;
+    if (!e && std::rename(tmp.c_str(), target.c_str()) != 0)
+        e = errno;
+    if (e) {
         std::remove(tmp.c_str());
         set_err(err, errlen, path + ": cannot write: " + std::strerror(e));
         return -1;

@@ -9,9 +9,13 @@
 
 namespace pmhost {
 
-// Write text to path through "path.tmp" and a rename, so that a failure
-// never leaves a half-written file.  Returns 0, or -1 with a message in err
-// ("path: cannot write: reason").
+// Write text to path through a temporary beside it ("path.tmpPID.N",
+// created anew, never an existing file) and a rename, so that a failure
+// never leaves a half-written file.  A symbolic link is followed (the file
+// it names is replaced, the link stays); what is not a regular file (a
+// device, a FIFO, /dev/stdout's target) is written in place; an existing
+// file this process may not write is refused.  Returns 0, or -1 with a
+// message in err ("path: cannot write: reason").
 int write_atomic(const std::string &path, const std::string &text, char *err, size_t errlen);
 
 // Is the file at path a model file (its first line that is not blank or a
