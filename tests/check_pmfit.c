@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -168,6 +169,171 @@ START_TEST(test_pmfit_cli_errors)
 }
 END_TEST
 
+/* The whole of a file (malloc'd; NULL if it cannot be read). */
+static char *slurp_file(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    char *buf;
+    long n;
+    if (!f)
+        return NULL;
+    fseek(f, 0, SEEK_END);
+    n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    buf = (char *)malloc((size_t)n + 1);
+    ck_assert_ptr_nonnull(buf);
+    buf[fread(buf, 1, (size_t)n, f)] = 0;
+    fclose(f);
+    return buf;
+}
+
+static void put_file(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    ck_assert_ptr_nonnull(f);
+    fputs(text, f);
+    fclose(f);
+}
+
+/* No output may be an input or another output: refused before any work,
+** the input unchanged (a night's run overwritten by its own residuals, the
+** tester's report, was exit 0). */
+START_TEST(test_pmfit_output_not_input)
+{
+    char runp[300], alias[300], model[300], args[1200], cmd[1400];
+    char *before, *after;
+    const char *top = getenv("PM_TOP");
+    make_tmpdir();
+    snprintf(runp, sizeof runp, "%s/run.dat", tmpdir);
+    snprintf(cmd, sizeof cmd, "cp '%s/examples/sim_gem.dat' '%s'", top ? top : ".", runp);
+    ck_assert_int_eq(system(cmd), 0);
+    before = slurp_file(runp);
+    ck_assert_ptr_nonnull(before);
+    ck_assert_int_eq(run("%s fit %s --residuals %s", runp, runp), 1);
+    ck_assert_msg(strstr(out, "it is the input RUN (nothing was done)") != NULL, "%s", out);
+    snprintf(args, sizeof args, "%s --save %s", runp, runp);
+    ck_assert_int_eq(run("%s fit %s%s", args, ""), 1);
+    ck_assert_int_eq(run("%s report %s -o %s", runp, runp), 1);
+    ck_assert_msg(strstr(out, "--output") != NULL, "%s", out);
+    /* under another name: a symbolic link to the run */
+    snprintf(alias, sizeof alias, "%s/alias.dat", tmpdir);
+    ck_assert_int_eq(symlink("run.dat", alias), 0);
+    ck_assert_int_eq(run("%s fit %s --tpoint-terms %s", runp, alias), 1);
+    ck_assert_msg(strstr(out, "the same file as the input RUN") != NULL, "%s", out);
+    /* eval's MODEL is an input too */
+    snprintf(model, sizeof model, "%s/m.pm", tmpdir);
+    ck_assert_int_eq(run("%s fit %s --save %s", runp, model), 0);
+    snprintf(args, sizeof args, "%s %s --residuals %s", model, runp, model);
+    ck_assert_int_eq(run("%s eval %s%s", args, ""), 1);
+    ck_assert_msg(strstr(out, "the input MODEL") != NULL, "%s", out);
+    after = slurp_file(runp);
+    ck_assert_ptr_nonnull(after);
+    ck_assert_str_eq(after, before);
+    free(after);
+    /* two outputs, one file: the second would replace the first */
+    snprintf(args, sizeof args, "%s --residuals %s/two.txt --save %s/two.txt", runp, tmpdir,
+             tmpdir);
+    ck_assert_int_eq(run("%s fit %s%s", args, ""), 1);
+    ck_assert_msg(strstr(out, "writes the same file (nothing was done)") != NULL, "%s", out);
+    snprintf(cmd, sizeof cmd, "%s/two.txt", tmpdir);
+    ck_assert_int_ne(access(cmd, F_OK), 0);
+    free(before);
+}
+END_TEST
+
+/* Where an output goes: a symbolic link stays one (the file it names is
+** written), a device is written, not replaced (--save /dev/null replaced
+** the node as root), a file named like a temporary is not taken, and a
+** failing --residuals loses neither the report nor the other outputs. */
+START_TEST(test_pmfit_output_targets)
+{
+    char runp[300], path[300], args[1600];
+    char *text;
+    struct stat st;
+    const char *top = getenv("PM_TOP");
+    make_tmpdir();
+    snprintf(runp, sizeof runp, "%s/examples/sim_gem.dat", top ? top : ".");
+    snprintf(path, sizeof path, "%s/target.txt", tmpdir);
+    put_file(path, "keep\n");
+    snprintf(path, sizeof path, "%s/link.txt", tmpdir);
+    ck_assert_int_eq(symlink("target.txt", path), 0);
+    ck_assert_int_eq(run("%s fit %s --residuals %s", runp, path), 0);
+    ck_assert_int_eq(lstat(path, &st), 0);
+    ck_assert_msg(S_ISLNK(st.st_mode), "--residuals replaced the symbolic link");
+    snprintf(path, sizeof path, "%s/target.txt", tmpdir);
+    text = slurp_file(path);
+    ck_assert_ptr_nonnull(text);
+    ck_assert_msg(strncmp(text, "# residuals of pmfit fit", 24) == 0, "%.200s", text);
+    free(text);
+    /* a user's file named as the old temporary was */
+    snprintf(path, sizeof path, "%s/m.pm.tmp", tmpdir);
+    put_file(path, "mine\n");
+    snprintf(args, sizeof args, "%s --save %s/m.pm", runp, tmpdir);
+    ck_assert_int_eq(run("%s fit %s%s", args, ""), 0);
+    text = slurp_file(path);
+    ck_assert_ptr_nonnull(text);
+    ck_assert_str_eq(text, "mine\n");
+    free(text);
+    /* devices */
+    ck_assert_int_eq(run("%s fit %s --save /dev/null --residuals /dev/null%s", runp, ""), 0);
+    ck_assert_int_eq(stat("/dev/null", &st), 0);
+    ck_assert(S_ISCHR(st.st_mode));
+    if (stat("/dev/full", &st) == 0 && S_ISCHR(st.st_mode)) {
+        snprintf(args, sizeof args, "%s --residuals /dev/full --save %s/kept.pm", runp, tmpdir);
+        ck_assert_int_eq(run("%s fit %s%s", args, ""), 1);
+        ck_assert_msg(strstr(out, "unbiased sigma") != NULL, "no report: %s", out);
+        ck_assert_msg(strstr(out, "/dev/full: cannot write: ") != NULL, "%s", out);
+        ck_assert_msg(strstr(out, "(the fit is reported above)") != NULL, "%s", out);
+        snprintf(path, sizeof path, "%s/kept.pm", tmpdir);
+        ck_assert_msg(access(path, F_OK) == 0, "--save was lost with --residuals");
+        ck_assert_int_eq(stat("/dev/full", &st), 0);
+        ck_assert(S_ISCHR(st.st_mode));
+    }
+    /* a file made read-only is not replaced (root may write anything) */
+    if (geteuid() != 0) {
+        snprintf(path, sizeof path, "%s/ro.txt", tmpdir);
+        put_file(path, "read-only\n");
+        ck_assert_int_eq(chmod(path, 0444), 0);
+        ck_assert_int_eq(run("%s fit %s --residuals %s", runp, path), 1);
+        text = slurp_file(path);
+        ck_assert_ptr_nonnull(text);
+        ck_assert_str_eq(text, "read-only\n");
+        free(text);
+    }
+}
+END_TEST
+
+/* The first 15 records of the example (two patches of sky) cannot
+** determine its order-1 model between them: exit 0 (the fit is what was
+** asked), but a warning on the report, on stderr, in the JSON and in the
+** saved model; the whole run: none. */
+START_TEST(test_pmfit_undetermined)
+{
+    char part[300], model[300], cmd[1400];
+    char *text;
+    const char *top = getenv("PM_TOP");
+    make_tmpdir();
+    snprintf(part, sizeof part, "%s/part.dat", tmpdir);
+    snprintf(cmd, sizeof cmd, "head -20 '%s/examples/sim_gem.dat' > '%s'", top ? top : ".", part);
+    ck_assert_int_eq(system(cmd), 0);
+    snprintf(model, sizeof model, "%s/part.pm", tmpdir);
+    ck_assert_int_eq(run("%s fit %s --save %s", part, model), 0);
+    ck_assert_msg(strstr(out, "warning: the stars do not determine this model between them") !=
+                      NULL, "%s", out);
+    ck_assert_msg(strstr(out, "pmfit: warning: the stars do not determine") != NULL, "%s", out);
+    text = slurp_file(model);
+    ck_assert_ptr_nonnull(text);
+    ck_assert_msg(strstr(text, "# warning: the stars do not determine") != NULL, "%.400s", text);
+    free(text);
+    ck_assert_int_eq(run("%s fit %s --json%s", part, ""), 0);
+    ck_assert_msg(strstr(out, "\"undetermined\": true") != NULL, "%s", out);
+    snprintf(cmd, sizeof cmd, "%s/examples/sim_gem.dat", top ? top : ".");
+    ck_assert_int_eq(run("%s fit %s --json%s", cmd, ""), 0);
+    ck_assert_msg(strstr(out, "\"undetermined\": false") != NULL, "%s", out);
+    ck_assert_ptr_null(strstr(out, "warning: the stars"));
+}
+END_TEST
+
 static Suite *suite(void)
 {
     Suite *s = suite_create("pmfit");
@@ -179,6 +345,9 @@ static Suite *suite(void)
     tc = tcase_create("tool");
     tcase_add_test(tc, test_pmfit_simulate_fit_roundtrip);
     tcase_add_test(tc, test_pmfit_cli_errors);
+    tcase_add_test(tc, test_pmfit_output_not_input);
+    tcase_add_test(tc, test_pmfit_output_targets);
+    tcase_add_test(tc, test_pmfit_undetermined);
     tcase_set_timeout(tc, 60);
     suite_add_tcase(s, tc);
     return s;

@@ -44,6 +44,7 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <sys/stat.h>
 #include <unistd.h>
 #include <stdexcept>
 
@@ -800,8 +801,9 @@ void fail_fit(const FitOut &f, const std::string &what)
 
 
 
-// Write per-observation residuals (arcsec) atomically.
-void write_residuals(const std::string &path, const std::string &title,
+// Write per-observation residuals (arcsec) atomically; "" or the error (the
+// caller reports its results first).
+std::string write_residuals(const std::string &path, const std::string &title,
                      const std::vector<FitOut> &fits, const std::vector<Obs> &obs)
 {
     std::string text = "# " + title + ", arcsec on the sky\n"
@@ -817,11 +819,12 @@ void write_residuals(const std::string &path, const std::string &title,
         }
     char err[1024];
     if (pmhost::write_atomic(path, text, err, sizeof err) != 0)
-        die(err, 1);
+        return err;
+    return "";
 }
 
 // --robust: the residual file lists every observation, rejected ones flagged.
-void write_residuals_robust(const std::string &path, const std::string &title,
+std::string write_residuals_robust(const std::string &path, const std::string &title,
                             const std::vector<RobustFit> &rfs, const std::vector<Obs> &obs)
 {
     std::string text = "# " + title + ", arcsec on the sky; rejected = 1: left out by --robust "
@@ -838,7 +841,8 @@ void write_residuals_robust(const std::string &path, const std::string &title,
         }
     char err[1024];
     if (pmhost::write_atomic(path, text, err, sizeof err) != 0)
-        die(err, 1);
+        return err;
+    return "";
 }
 
 // The "robust" member of the JSON output.
@@ -930,8 +934,10 @@ int cmd_eval(const Options &o, const std::vector<Obs> &obs, int mount)
     for (size_t i = 0; i < obs.size(); i++)
         all[i] = (int)i;
     residuals(f, obs, all);
+    std::string werr;
     if (!o.residuals.empty())
-        write_residuals(o.residuals, "residuals of pmfit eval " + o.model + " " + o.run, {f}, obs);
+        werr = write_residuals(o.residuals, "residuals of pmfit eval " + o.model + " " + o.run,
+                               {f}, obs);
     if (o.json) {
         std::printf("{\"n_obs\": %zu, \"n_params\": %d, \"order\": %d, \"rms_arcsec\": %.6f}\n",
                     obs.size(), f.model.n_terms, f.model.order, f.rms * RAD2AS);
@@ -939,6 +945,10 @@ int cmd_eval(const Options &o, const std::vector<Obs> &obs, int mount)
         std::printf("pmfit eval %s on %s: %zu observations, model of order %d (%d terms)\n",
                     o.model.c_str(), o.run.c_str(), obs.size(), f.model.order, f.model.n_terms);
         std::printf("  sky RMS of the residuals, no refit: %.3f\"\n", f.rms * RAD2AS);
+    }
+    if (!werr.empty()) {
+        std::fflush(stdout);
+        die(werr + " (the evaluation is reported above)", 1);
     }
     return 0;
 }
@@ -1377,6 +1387,46 @@ void check_output(const std::string &opt, const std::string &path)
             " (nothing was done)", 1);
 }
 
+// One file under two names?  Both exist and are one node (links followed),
+// or neither exists yet and both name one place.
+bool same_file(const std::string &a, const std::string &b)
+{
+    struct stat sa, sb;
+    bool ea = stat(a.c_str(), &sa) == 0, eb = stat(b.c_str(), &sb) == 0;
+    if (ea && eb)
+        return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+    if (ea || eb)
+        return false;
+    std::error_code e1, e2;
+    std::filesystem::path ca = std::filesystem::weakly_canonical(a, e1);
+    std::filesystem::path cb = std::filesystem::weakly_canonical(b, e2);
+    return !e1 && !e2 && ca == cb;
+}
+
+// No output may be one of the inputs (a run overwritten by its own
+// residuals is a night's data lost), nor may two outputs be one file (the
+// second would replace the first): refused before any work.  A device or a
+// FIFO (/dev/null, /dev/stdout) may take several outputs.
+void check_distinct(const std::vector<std::pair<std::string, std::string>> &outs,
+                    const std::vector<std::pair<std::string, std::string>> &ins)
+{
+    for (size_t i = 0; i < outs.size(); i++) {
+        struct stat st;
+        if (stat(outs[i].second.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
+            continue;
+        for (const auto &in : ins)
+            if (same_file(outs[i].second, in.second))
+                die(outs[i].first + " " + outs[i].second + ": cannot write: it is " +
+                    (outs[i].second == in.second ? "" : "the same file as ") + "the input " +
+                    in.first + (outs[i].second == in.second ? "" : " " + in.second) +
+                    " (nothing was done)", 1);
+        for (size_t j = 0; j < i; j++)
+            if (same_file(outs[i].second, outs[j].second))
+                die(outs[i].first + " " + outs[i].second + ": cannot write: " + outs[j].first +
+                    " writes the same file (nothing was done)", 1);
+    }
+}
+
 // pmfit report RUN -o PAGE.html: the page, written through a temporary file
 // and a rename, so a failure leaves the output path as it was.  Progress on
 // stderr: on a terminal one line updated per stage; otherwise a line per
@@ -1447,6 +1497,42 @@ int run_main(int argc, char **argv)
     check_output("--output", o.output);
     if (o.cmd == "simulate")
         check_output("simulate", o.run);
+    {
+        std::vector<std::pair<std::string, std::string>> outs, ins;
+        auto out = [&](const char *opt, const std::string &p) {
+            if (!p.empty())
+                outs.emplace_back(opt, p);
+        };
+        auto in = [&](const char *what, const std::string &p) {
+            if (!p.empty())
+                ins.emplace_back(what, p);
+        };
+        for (const char *sfx : {"", "-east", "-west"}) {
+            if (o.split != (*sfx != 0))
+                continue;
+            if (!o.save.empty())
+                out("--save", o.save + sfx);
+            if (!o.emit_c.empty())
+                out("--emit-c", o.emit_c + sfx);
+            if (!o.error_map.empty())
+                out("--error-map", o.error_map + sfx);
+            if (!o.tpoint_terms.empty())
+                out("--tpoint-terms", o.tpoint_terms + sfx);
+        }
+        out("--residuals", o.residuals);
+        out("--output", o.output);
+        if (o.cmd == "simulate") {
+            out("simulate", o.run);
+            in("--into", o.into);
+        } else {
+            in("RUN", o.run);
+        }
+        in("MODEL", o.model);
+        in("--compare", o.compare);
+        in("--horizon", o.horizon);
+        in("--catalog", o.catalogue);
+        check_distinct(outs, ins);
+    }
     if (PM_CHECK_CONFIG() != PM_OK)
         die("library and program were built with different PM_MAX_L/PM_MAX_EXTRA", 1);
     if (o.cmd == "simulate")
@@ -1536,17 +1622,37 @@ int run_main(int argc, char **argv)
                            "split (independent sides) vs joint");
     }
 
+    std::vector<std::string> write_errors;
     if (!o.residuals.empty()) {
         std::string title = "residuals of pmfit fit " + o.run + " (order " +
                             std::to_string(o.order) + ", pier " + (o.split ? "split" : "joint") +
                             (o.robust ? ", robust" : "") + ")";
-        if (o.robust)
-            write_residuals_robust(o.residuals, title, robs, obs);
-        else
-            write_residuals(o.residuals, title, fits, obs);
+        std::string e = o.robust ? write_residuals_robust(o.residuals, title, robs, obs)
+                                 : write_residuals(o.residuals, title, fits, obs);
+        if (!e.empty())
+            write_errors.push_back(e);
     }
 
-    std::vector<std::string> write_errors;
+    // the predicted error map of each fit (pier side of a split fit: its
+    // own), and whether the stars determine the model between them
+    std::vector<ErrorMap> maps;
+    std::vector<std::string> undetermined;
+    for (size_t k = 0; k < fits.size(); k++) {
+        int side = fits.size() == 1 ? 0 : (k == 0 ? 1 : -1);
+        maps.push_back(error_map(run, fits[k], side));
+        undetermined.push_back(undetermined_warning(maps[k], fits[k].res.sigma * RAD2AS));
+        std::string suffix = fits.size() == 1 ? "" : (k == 0 ? "-east" : "-west");
+        if (!o.error_map.empty()) {
+            try {
+                error_map_plot(o.error_map + suffix, run, maps[k],
+                               "Predicted pointing error of the model (1 sigma per axis), " +
+                                   titles[k]);
+            } catch (const std::exception &x) {
+                write_errors.push_back(x.what());
+            }
+        }
+    }
+
     for (size_t k = 0; k < fits.size(); k++) {
         std::string suffix = fits.size() == 1 ? "" : (k == 0 ? "-east" : "-west");
         std::string note = "fitted by pmfit from " + o.run + " (" + titles[k] + ")\n" +
@@ -1554,7 +1660,8 @@ int run_main(int argc, char **argv)
                            std::to_string(fits[k].res.sigma * RAD2AS) + " arcsec" +
                            (o.robust ? ", --robust: " + std::to_string(robs[k].outliers.size()) +
                                            " outliers left out"
-                                     : std::string());
+                                     : std::string()) +
+                           (undetermined[k].empty() ? "" : "\nwarning: " + undetermined[k]);
         char e[1024];
         // a write that fails now still lets the report below be printed
         if (!o.save.empty() &&
@@ -1574,22 +1681,6 @@ int run_main(int argc, char **argv)
         }
     }
 
-    // the predicted error map of each fit (pier side of a split fit: its own)
-    std::vector<ErrorMap> maps;
-    for (size_t k = 0; k < fits.size(); k++) {
-        int side = fits.size() == 1 ? 0 : (k == 0 ? 1 : -1);
-        maps.push_back(error_map(run, fits[k], side));
-        std::string suffix = fits.size() == 1 ? "" : (k == 0 ? "-east" : "-west");
-        if (!o.error_map.empty()) {
-            try {
-                error_map_plot(o.error_map + suffix, run, maps[k],
-                               "Predicted pointing error of the model (1 sigma per axis), " +
-                                   titles[k]);
-            } catch (const std::exception &x) {
-                write_errors.push_back(x.what());
-            }
-        }
-    }
 
     std::string fjson;
     if (ftest.done) {
@@ -1603,7 +1694,7 @@ int run_main(int argc, char **argv)
     if (o.json) {
         auto rj = [&](size_t k) { return o.robust ? robust_json(robs[k], obs) : std::string(); };
         if (fits.size() == 1) {
-            std::string r = rj(0), em = error_map_json(maps[0]);
+            std::string r = rj(0), em = error_map_json(maps[0], fits[0].res.sigma * RAD2AS);
             r = r.empty() ? em : r + ", " + em;
             print_json_fit(fits[0], fjson + (fjson.empty() ? "" : ", ") + r);
         } else {
@@ -1611,7 +1702,8 @@ int run_main(int argc, char **argv)
                         fjson.empty() ? "" : ", ");
             auto with_map = [&](size_t k) {
                 std::string r = rj(k);
-                return (r.empty() ? "" : r + ", ") + error_map_json(maps[k]);
+                return (r.empty() ? "" : r + ", ") +
+                       error_map_json(maps[k], fits[k].res.sigma * RAD2AS);
             };
             print_json_fit(fits[0], with_map(0));
             std::printf(", \"west\": ");
@@ -1625,6 +1717,8 @@ int run_main(int argc, char **argv)
         for (size_t k = 0; k < fits.size(); k++) {
             print_table(titles[k].c_str(), fits[k], obs, o.run);
             std::printf("\n%s\n", error_map_text(run, maps[k]).c_str());
+            if (!undetermined[k].empty())
+                std::printf("\n  warning: %s.\n", undetermined[k].c_str());
             if (o.robust)
                 print_robust(robs[k], obs, o.run);
             else
@@ -1638,8 +1732,13 @@ int run_main(int argc, char **argv)
         std::printf("\n  * = significant at 3 sigma. Values are radians x 206265 (arcsec);\n"
                     "    the model is defined in docs/model.md.\n");
     }
+    std::fflush(stdout);
+    for (size_t k = 0; k < fits.size(); k++)
+        if (!undetermined[k].empty())
+            std::fprintf(stderr, "pmfit: warning: %s%s.\n",
+                         fits.size() == 1 ? "" : (k == 0 ? "east: " : "west: "),
+                         undetermined[k].c_str());
     if (!write_errors.empty()) {
-        std::fflush(stdout);
         for (size_t k = 0; k + 1 < write_errors.size(); k++)
             std::fprintf(stderr, "pmfit: %s\n", write_errors[k].c_str());
         die(write_errors.back() + " (the fit is reported above)", 1);

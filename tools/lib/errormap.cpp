@@ -145,14 +145,31 @@ std::string error_map_text(const Run &run, const ErrorMap &e)
     return b;
 }
 
-std::string error_map_json(const ErrorMap &e)
+std::string undetermined_warning(const ErrorMap &e, double sigma_arcsec)
+{
+    if (!(e.mean_arcsec > UNDETERMINED_RATIO * sigma_arcsec) || !(sigma_arcsec > 0))
+        return "";
+    char b[600];
+    std::snprintf(b, sizeof b,
+                  "the stars do not determine this model between them: its predicted error over "
+                  "the sky above %s %.0f deg, %.3g\" RMS, is %.3g times the residual sigma "
+                  "(%.3g\"), so its terms are extrapolated, not measured; lower --order, or take "
+                  "stars where the error is largest (pmfit plan RUN)",
+                  e.elevation ? "elevation" : "declination", e.limit_deg, e.mean_arcsec,
+                  e.mean_arcsec / sigma_arcsec, sigma_arcsec);
+    return b;
+}
+
+std::string error_map_json(const ErrorMap &e, double sigma_arcsec)
 {
     char b[400];
     std::snprintf(b, sizeof b,
                   "\"error_map\": {\"limit\": \"%s\", \"limit_deg\": %.6g, \"rms_arcsec\": %.6g, "
-                  "\"max_arcsec\": %.6g, \"max_at_deg\": [%.6g, %.6g], \"at_points_arcsec\": %.6g}",
+                  "\"max_arcsec\": %.6g, \"max_at_deg\": [%.6g, %.6g], \"at_points_arcsec\": %.6g, "
+                  "\"undetermined\": %s}",
                   e.elevation ? "elevation" : "declination", e.limit_deg, e.mean_arcsec,
-                  e.max_arcsec, e.max_x_deg, e.max_y_deg, e.at_points_arcsec);
+                  e.max_arcsec, e.max_x_deg, e.max_y_deg, e.at_points_arcsec,
+                  undetermined_warning(e, sigma_arcsec).empty() ? "false" : "true");
     return b;
 }
 

@@ -38,8 +38,17 @@ ErrorMap error_map(const Run &run, const FitOut &f, int side);
 
 // A line for the text report and a JSON object (keys in docs/formats.md).
 std::string error_map_text(const Run &run, const ErrorMap &e);
-std::string error_map_json(const ErrorMap &e);
+std::string error_map_json(const ErrorMap &e, double sigma_arcsec);
 
+// A model its stars do not determine between them: its predicted error over
+// the usable sky (RMS) is more than UNDETERMINED_RATIO times the residual
+// sigma, so pointing between the stars is worse than at them by more than
+// the noise -- the terms are extrapolated, not measured.  (Fits of the real
+// runs of ../shared/data and the examples at orders 0-2 reach 1.05; the
+// first 12-80 stars of a run, with order 1-2: 4-20,000.)  "" or the warning
+// (one sentence, no leading spaces).
+const double UNDETERMINED_RATIO = 3;
+std::string undetermined_warning(const ErrorMap &e, double sigma_arcsec);
 // The sky plot (an SVG file); throws with the reason on failure.
 void error_map_plot(const std::string &path, const Run &run, const ErrorMap &e,
                     const std::string &title);

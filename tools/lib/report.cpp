@@ -835,8 +835,14 @@ void summary(Page &p, const Data &d)
               fmt("<dt>explained</dt><dd>%zu finding%s: &sigma; = %s with %d terms</dd>\n", d.ex.findings.size(),
                   d.ex.findings.size() == 1 ? "" : "s", arcsec_text(d.ex.final_sigma_arcsec).c_str(),
                   d.ex.final_n_params) +
-              fmt("<dt>predicted error</dt><dd>%s over the sky (1&sigma; per axis), largest %s</dd>\n",
-                  arcsec_text(d.emap.mean_arcsec).c_str(), arcsec_text(d.emap.max_arcsec).c_str());
+              fmt("<dt>predicted error</dt><dd>%s over the sky above %s %.0f&deg; (the lowest star; "
+                  "1&sigma; per axis), largest %s",
+                  arcsec_text(d.emap.mean_arcsec).c_str(), d.emap.elevation ? "elevation" : "declination",
+                  d.emap.limit_deg, arcsec_text(d.emap.max_arcsec).c_str());
+    const std::string undetermined = undetermined_warning(d.emap, f.res.sigma * RAD2AS);
+    if (!undetermined.empty())
+        p.body += "<br><b>warning</b>: " + h(undetermined);
+    p.body += "</dd>\n";
     if (d.have_cmp)
         p.body += "<dt>since before</dt><dd>" + h(d.cmp.advice) + "</dd>\n";
     p.body += "</dl>\n";
