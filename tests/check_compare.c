@@ -205,6 +205,44 @@ START_TEST(test_compare_real_halves)
 }
 END_TEST
 
+/* A model of one site against a run of another: the same mount, the same
+** 20" of refraction, at latitudes 47 and 30 deg.  Refitted at the model's
+** latitude, the refraction term's elevations were wrong and cot(el) "moved"
+** by 18" (95 sigma); at the run's latitude nothing moves, and the advice
+** names both latitudes. */
+START_TEST(test_compare_other_site)
+{
+    char cmd[2048];
+    if (!dir[0])
+        tu_tmpdir(dir, "pm_compare_");
+    snprintf(cmd, sizeof cmd,
+             "cd %s && %s simulate north.dat --lat 47 --seed 3 --effect refraction=20 && "
+             "%s simulate south.dat --lat 30 --seed 4 --effect refraction=20 && "
+             "%s fit north.dat --add refraction --save north.pm > /dev/null",
+             dir, tu_pmfit_path(), tu_pmfit_path(), tu_pmfit_path());
+    ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
+    {
+        static const char *olds[2] = {"north.dat", "north.pm"};
+        int k;
+        for (k = 0; k < 2; k++) {
+            snprintf(cmd, sizeof cmd, "cd %s && %s compare %s south.dat --add refraction --json",
+                     dir, tu_pmfit_path(), olds[k]);
+            ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
+            printf("check_compare: %s vs a run 17 deg further south: %d moved; %s\n", olds[k],
+                   moved_count(), strstr(out, "\"advice\""));
+            ck_assert_ptr_nonnull(strstr(out, "fitted at latitude +47.0000 deg, the run is at "
+                                              "+30.0000 deg"));
+            ck_assert_int_eq(moved_count(), 0);
+        }
+    }
+    /* the same site: no word of latitudes */
+    snprintf(cmd, sizeof cmd, "cd %s && %s compare north.pm north.dat --add refraction --json", dir,
+             tu_pmfit_path());
+    ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
+    ck_assert_ptr_null(strstr(out, "fitted at latitude"));
+}
+END_TEST
+
 START_TEST(test_compare_misuse)
 {
     static const char *bad[][2] = {
@@ -252,6 +290,7 @@ static Suite *suite(void)
     tcase_set_timeout(t, 300);
     tcase_add_test(t, test_compare_simulated_nights);
     tcase_add_test(t, test_compare_real_halves);
+    tcase_add_test(t, test_compare_other_site);
     tcase_add_test(t, test_compare_misuse);
     suite_add_tcase(s, t);
     return s;

@@ -5,6 +5,7 @@
 #include "modelfile.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -138,9 +139,30 @@ double predicted_over(const FitOut &f, const Run &run)
     return n ? std::sqrt(ss / (double)n) * RAD2AS : NAN;
 }
 
-Comparison compare_models(const pm_model &old_model, const std::vector<double> &old_err,
+Comparison compare_models(const pm_model &old_in, const std::vector<double> &old_err,
                           const Run &run, const FitOut *old_fit, const Run *old_run)
 {
+    // The site is the run's: where the run gives a latitude other than the
+    // model's (a portable mount moved, or another mount's model), the model
+    // is evaluated and refitted there -- its elevation-dependent terms
+    // (refraction, flexure) belong to the sky it points at -- and the advice
+    // says so.
+    pm_model lat_model = old_in;
+    std::string site_note;
+    const double dlat = run.latitude - old_in.latitude;
+    if (std::isfinite(run.latitude) && std::fabs(dlat) > 1e-6) { // 0.2"
+        lat_model.latitude = run.latitude;
+        if (pm_model_prepare(&lat_model) != PM_OK)
+            throw std::runtime_error("the model cannot be prepared at the run's latitude");
+        char b[400];
+        std::snprintf(b, sizeof b,
+                      "The model was fitted at latitude %+.4f deg, the run is at %+.4f deg: compared "
+                      "at the run's (a mount moved changes its polar alignment, a and b; another "
+                      "site's model is another mount's). ",
+                      old_in.latitude * 180 / M_PI, run.latitude * 180 / M_PI);
+        site_note = b;
+    }
+    const pm_model &old_model = lat_model;
     if (old_model.mount != run.mount)
         throw std::runtime_error("the model is of an " +
                                  std::string(old_model.mount == PM_MOUNT_ALTAZ ? "alt-az" : "equatorial") +
@@ -212,6 +234,8 @@ Comparison compare_models(const pm_model &old_model, const std::vector<double> &
                       c.old_pred_new, c.old_pred_old);
         c.advice += b;
     }
+    if (!site_note.empty() && !c.advice.empty())
+        c.advice = site_note + (char)std::toupper((unsigned char)c.advice[0]) + c.advice.substr(1);
     return c;
 }
 
