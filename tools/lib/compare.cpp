@@ -146,20 +146,27 @@ Comparison compare_models(const pm_model &old_in, const std::vector<double> &old
     // model's (a portable mount moved, or another mount's model), the model
     // is evaluated and refitted there -- its elevation-dependent terms
     // (refraction, flexure) belong to the sky it points at -- and the advice
-    // says so.
+    // says so.  (An alt-az model reads its elevation from its own axis: no
+    // latitude in it.  An old run without a latitude was fitted at 0.)
     pm_model lat_model = old_in;
     std::string site_note;
     const double dlat = run.latitude - old_in.latitude;
-    if (std::isfinite(run.latitude) && std::fabs(dlat) > 1e-6) { // 0.2"
+    if (old_in.mount != PM_MOUNT_ALTAZ && std::isfinite(run.latitude) &&
+        std::fabs(dlat) > 1e-6) { // 0.2"
         lat_model.latitude = run.latitude;
         if (pm_model_prepare(&lat_model) != PM_OK)
             throw std::runtime_error("the model cannot be prepared at the run's latitude");
         char b[400];
-        std::snprintf(b, sizeof b,
-                      "The model was fitted at latitude %+.4f deg, the run is at %+.4f deg: compared "
-                      "at the run's (a mount moved changes its polar alignment, a and b; another "
-                      "site's model is another mount's). ",
-                      old_in.latitude * 180 / M_PI, run.latitude * 180 / M_PI);
+        if (old_run && !std::isfinite(old_run->latitude))
+            std::snprintf(b, sizeof b,
+                          "The old run gives no latitude: compared at the new run's, %+.4f deg. ",
+                          run.latitude * 180 / M_PI);
+        else
+            std::snprintf(b, sizeof b,
+                          "The model was fitted at latitude %+.4f deg, the run is at %+.4f deg: "
+                          "compared at the run's (a mount moved changes its polar alignment, a "
+                          "and b; another site's model is another mount's). ",
+                          old_in.latitude * 180 / M_PI, run.latitude * 180 / M_PI);
         site_note = b;
     }
     const pm_model &old_model = lat_model;
