@@ -313,6 +313,33 @@ START_TEST(test_pmrun_read_csv_equinox_option_overrides)
 }
 END_TEST
 
+/* An equinox asked of a format whose places it does not apply to (a TPOINT
+** file's are its catalogue's mean places; a column file's and an MMT
+** log's are apparent): refused, where it was ignored without a word --
+** detected or forced, with either equinox. */
+START_TEST(test_pmrun_read_equinox_refused_where_it_does_not_apply)
+{
+    static const char *names[] = {"tpoint_equat.dat", "four_column.dat", "named.dat", "mmt_log.dat"};
+    static const int forced[] = {PMRUN_FORMAT_TPOINT, PMRUN_FORMAT_FOUR_COLUMN,
+                                 PMRUN_FORMAT_NAMED, PMRUN_FORMAT_MMT};
+    pmrun_options o;
+    char path[4096];
+    size_t k;
+    int e;
+    for (k = 0; k < sizeof names / sizeof names[0]; k++)
+        for (e = 0; e < 4; e++) {
+            pmrun_options_default(&o);
+            o.equinox = e & 1 ? PMRUN_EQUINOX_JNOW : PMRUN_EQUINOX_J2000;
+            if (e & 2)
+                o.format = forced[k];
+            data_path(path, sizeof path, names[k]);
+            tu_read_fails(path, &o, PMRUN_ERR_ARG, 0, "refused rather than ignored");
+        }
+    /* and read as before without it */
+    pmrun_free(read_ok("four_column.dat"));
+}
+END_TEST
+
 START_TEST(test_pmrun_read_mmt_same_as_source)
 {
     same_records("mmt_log.dat", "formats_source_altaz.dat", NULL, TOL_SAME_RAD, 0);
@@ -570,6 +597,7 @@ static Suite *formats_suite(void)
     tcase_add_test(tc, test_pmrun_read_mw4_same_as_source);
     tcase_add_test(tc, test_pmrun_read_csv_same_as_source);
     tcase_add_test(tc, test_pmrun_read_csv_equinox_option_overrides);
+    tcase_add_test(tc, test_pmrun_read_equinox_refused_where_it_does_not_apply);
     tcase_add_test(tc, test_pmrun_read_mmt_same_as_source);
     suite_add_tcase(s, tc);
     tc = tcase_create("fit");

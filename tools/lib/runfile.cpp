@@ -268,6 +268,19 @@ std::unique_ptr<FormatParser> make_parser(Context &ctx, int format)
     }
 }
 
+bool equinox_applies(Context &ctx, int format)
+{
+    if (ctx.opt().equinox == PMRUN_EQUINOX_FILE || format == PMRUN_FORMAT_CSV ||
+        format == PMRUN_FORMAT_RTS2 || format == PMRUN_FORMAT_MW4)
+        return true;
+    return ctx.fail_with(PMRUN_ERR_ARG, 0,
+                         "the equinox option (pmfit --equinox) applies to CSV logs, RTS2 gpoint "
+                         "and MountWizzard4 files, and this is %s, whose places are what its "
+                         "format defines (a TPOINT file's: mean places of its catalogue; a "
+                         "column file's: apparent): refused rather than ignored",
+                         format_description(format));
+}
+
 const char *format_description(int format)
 {
     switch (format) {
@@ -543,6 +556,8 @@ private:
                                      n);
             }
         }
+        if (!equinox_applies(ctx_, format))
+            return false;
         parser_ = make_parser(ctx_, format);
         if (!why.empty())
             ctx_.set_reading_as(std::string(format_description(format)) + " (" + why + ")");
@@ -711,6 +726,8 @@ int read_file(Context &ctx)
         }
         ctx.set_reading_as(std::string(format_description(forced)) + " (format forced: " +
                            pmrun_format_name(forced) + ")");
+        if (!equinox_applies(ctx, forced))
+            return ctx.status();
     }
     std::string line;
     bool nul = false;

@@ -129,6 +129,9 @@ std::unique_ptr<FormatParser> make_mmt_parser(Context &ctx);
 std::unique_ptr<FormatParser> make_parser(Context &ctx, int format);
 // A description of each format for messages ("an RTS2 gpoint input file").
 const char *format_description(int format);
+// false (the error set in ctx) where an equinox is asked for (pmrun_options.equinox)
+// and the format has no places it applies to: refused, not ignored.
+bool equinox_applies(Context &ctx, int format);
 
 // Weather for the refraction (eraRefco arguments).
 struct Weather {
