@@ -237,7 +237,10 @@ START_TEST(test_pmmodel_emit_c_compiles_and_loads)
     make_tmpdir();
     random_model(&m, 2 <= PM_MAX_L ? 2 : PM_MAX_L, 11);
     path_in(hdr, sizeof hdr, "fitted_model.h");
-    ck_assert_int_eq(pmmodel_emit_c(hdr, &m, "pm_fitted", "test model", err, sizeof err), 0);
+    /* a comment with the end of a C comment in it (a run in a folder "x*"): it
+    ** must not end the header's comment */
+    ck_assert_int_eq(pmmodel_emit_c(hdr, &m, "pm_fitted", "test model of x*/run.dat", err,
+                                    sizeof err), 0);
     path_in(src, sizeof src, "use.c");
     path_in(exe, sizeof exe, "use");
     path_in(out, sizeof out, "use.out");

@@ -430,7 +430,12 @@ extern "C" int pmmodel_emit_c(const char *path, const pm_model *m, const char *p
         guard += (char)std::toupper((unsigned char)c);
     guard += "_MODEL_H";
     std::string o = "/*\n** Pointing model as constant data, written by pmfit --emit-c.\n";
-    comment_lines(o, comment, "** ");
+    // the comment (a run's path, a caption) must not end the C comment: "*/"
+    // written "* /"
+    std::string safe = comment ? comment : "";
+    for (size_t at = 0; (at = safe.find("*/", at)) != std::string::npos; at += 3)
+        safe.replace(at, 2, "* /");
+    comment_lines(o, comment ? safe.c_str() : nullptr, "** ");
     o += "**\n** Use:  pm_model m;  if (" + p + "_load(&m) != PM_OK) ...\n*/\n";
     o += "#ifndef " + guard + "\n#define " + guard + "\n\n#include \"pm.h\"\n\n";
     o += "#if PM_MAX_L < " + std::to_string(m->order) + "\n#error \"this model needs PM_MAX_L >= " +
