@@ -79,6 +79,17 @@ extern "C" int pmtp_terms(const pm_model *m, const double *err_rad, pmtp_term *n
     if (!m || !named || !n_named) return -1;
     const Map *map = map_of(m);
     if (!map) return -1;
+    // pm's polar-axis tilts a, b are the outermost rotation, at the index-
+    // shifted axis-1 angle tau + c' (docs/model.md, "The isotropic part is
+    // exact"); TPOINT's MA, ME (AW, AN) act at the raw angle.  So the tilt
+    // is turned by c': a sin(h + c') - b cos(h + c') = X sin h - Y cos h with
+    // X = a cos c' + b sin c', Y = b cos c' - a sin c' (and likewise in dh),
+    // in place of X = a, Y = b, which left a c' x tilt error: 345" of ME at
+    // IH = 5.5 deg and MA = 1 deg (cgx-l-data.dat).  Their errors are
+    // turned without the a-b covariance, which pm_fit_result does not hold
+    // (it mixes them by sin c').
+    const double cc = std::cos(m->coef[PM_BASE_C - 1]), sc = std::sin(m->coef[PM_BASE_C - 1]);
+    const double a = m->coef[PM_BASE_A - 1], b = m->coef[PM_BASE_B - 1];
     int n = 0;
     for (int j = 0; j < PMTP_MAX_NAMED; ++j) {
         const Map &e = map[j];
@@ -87,8 +98,15 @@ extern "C" int pmtp_terms(const pm_model *m, const double *err_rad, pmtp_term *n
         pmtp_term &t = named[n++];
         std::memset(&t, 0, sizeof t);
         std::snprintf(t.name, sizeof t.name, "%s", e.name);
-        t.value_arcsec = e.sign * m->coef[i] * kAs;
-        t.error_arcsec = err_rad ? err_rad[i] * kAs : std::nan("");
+        double v = m->coef[i], ev = err_rad ? err_rad[i] : std::nan("");
+        if (e.k == PM_BASE_A || e.k == PM_BASE_B) {
+            const double ea = err_rad ? err_rad[PM_BASE_A - 1] : std::nan("");
+            const double eb = err_rad ? err_rad[PM_BASE_B - 1] : std::nan("");
+            v = e.k == PM_BASE_A ? a * cc + b * sc : b * cc - a * sc;
+            ev = e.k == PM_BASE_A ? std::hypot(ea * cc, eb * sc) : std::hypot(eb * cc, ea * sc);
+        }
+        t.value_arcsec = e.sign * v * kAs;
+        t.error_arcsec = ev * kAs;
         t.pm_index = i;
     }
     *n_named = n;

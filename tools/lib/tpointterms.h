@@ -28,10 +28,15 @@
 **  pmfit's azimuth az from north through east).  Positive TF and TX move
 **  the true position away from the zenith (a drooping tube).  From pm's
 **  coefficients (docs/model.md): IH = IA = c', ID = IE = -e', NP = NPAE = -d,
-**  CH = CA = i, MA = a, ME = -b, AW = a, AN = b, TF = -(tube flexure),
-**  TX = -(cot(el) coefficient); tests/check_formats.c ("export") checks the
-**  formulas with these values against pm_model_apply at many places.  An
-**  alt-az model is taken to use pmfit's azimuth (north through east).
+**  CH = CA = i, TF = -(tube flexure), TX = -(cot(el) coefficient), and the
+**  polar-axis tilts turned by the index c' (pm's act at the index-shifted
+**  angle, TPOINT's at the raw one): MA = AW = a cos c' + b sin c',
+**  ME = -(b cos c' - a sin c'), AN = b cos c' - a sin c' (MA = a, ME = -b,
+**  AW = a, AN = b at c' = 0); their errors turned without the a-b
+**  covariance.  tests/check_tpointterms.c checks the formulas with these
+**  values against pm_model_apply at many places and against direct fits of
+**  the formulas to real runs.  An alt-az model is taken to use pmfit's
+**  azimuth (north through east).
 **
 **  Plain C (C89), reentrant.
 */
