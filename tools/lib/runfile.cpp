@@ -606,14 +606,24 @@ void check_duplicates(Context &ctx)
     seen.reserve(obs.size());
     long repeats = 0;
     int first = 0, first_of = 0;
+    // The values as the file gives them, to well below any file's
+    // precision: angles on a grid of 1e-11 rad (2 uas), the hour angles
+    // turned into one turn first (a record copied after the night's end
+    // reads its LST a day later, and its hour angles differ in the last
+    // bits: 24 of a copied run's 454 repeats were found), times on 1e-9 h.
+    auto grid = [](double v, double step) {
+        if (!std::isfinite(v)) return v;   // (NaN, inf: as read)
+        double q = std::nearbyint(v / step);
+        return q == 0 ? 0.0 : q;           // (-0 and 0 alike)
+    };
     for (const pmrun_obs &o : obs) {
         Key k;
-        std::memset(&k, 0, sizeof k);   // -0.0 vs 0.0 and NaN payloads: as read
-        k.v[0] = o.enc_ha;
-        k.v[1] = o.enc_dec;
-        k.v[2] = o.app_ha;
-        k.v[3] = o.app_dec;
-        k.v[4] = std::isnan(o.time_h) ? 0.0 : o.time_h;
+        std::memset(&k, 0, sizeof k);   // NaN payloads: as read
+        k.v[0] = grid(std::remainder(o.enc_ha, 2 * M_PI), 1e-11);
+        k.v[1] = grid(o.enc_dec, 1e-11);
+        k.v[2] = grid(std::remainder(o.app_ha, 2 * M_PI), 1e-11);
+        k.v[3] = grid(o.app_dec, 1e-11);
+        k.v[4] = std::isnan(o.time_h) ? 0.0 : grid(o.time_h, 1e-9);
         auto ins = seen.emplace(k, o.line);
         if (ins.second) continue;
         if (repeats++ == 0) {
