@@ -148,6 +148,15 @@ START_TEST(test_pmfit_cli_errors)
     ck_assert_int_eq(run("%s fit x.dat --bogus%s%s", "", ""), 2);
     ck_assert_ptr_nonnull(strstr(out, "unknown option"));
     ck_assert_int_eq(run("%s fit /nonexistent/run.dat%s%s", "", ""), 1);
+    /* a periodic term's G out of range: the message gives the range */
+    {
+        char ex[600];
+        const char *top = getenv("PM_TOP");
+        snprintf(ex, sizeof ex, "%s/examples/sim_gem.dat", top ? top : ".");
+        ck_assert_int_eq(run("%s fit %s --add ha_periodic:1e9%s", ex, ""), 1);
+        ck_assert_msg(strstr(out, "G must be cycles per revolution, > 0 and <= 100000") != NULL,
+                      "%s", out);
+    }
     /* a malformed record: file:line in the message, no residual file left */
     snprintf(bad, sizeof bad, "%s/bad.dat", tmpdir);
     snprintf(res, sizeof res, "%s/res.txt", tmpdir);

@@ -459,7 +459,8 @@ static void add_periodic(ModelBuilder &b, const AddSpec &a, pm_term t)
     char *end;
     double G = std::strtod(a.f[1].c_str(), &end);
     if (*end || !(G > 0 && G <= 100000))
-        throw std::runtime_error("--add " + a.spec + ": G must be cycles per revolution, > 0");
+        throw std::runtime_error("--add " + a.spec + ": G must be cycles per revolution, "
+                                 "> 0 and <= 100000");
     long H = a.f.size() == 3 ? std::strtol(a.f[2].c_str(), &end, 10) : 1;
     if (a.f.size() == 3 && (*end || H < 1 || H > 8))
         throw std::runtime_error("--add " + a.spec + ": H must be 1..8 harmonics");
