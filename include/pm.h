@@ -1063,7 +1063,8 @@ pm_status pm_fit_covariance(const pm_fit *fit, const pm_fit_result *res,
 **  Returned (function value):
 **              pm_status   PM_OK; PM_ERR_ARG (NULL, or m has another number
 **                          of terms than the fit); PM_ERR_STATE (no
-**                          successful solve); PM_ERR_NONFINITE (a
+**                          successful solve, or the last solve failed:
+**                          pm_fit_solve Note 6); PM_ERR_NONFINITE (a
 **                          non-finite angle, or a variance beyond the
 **                          double range); the model's statuses of
 **                          pm_fit_row.  Nothing is written on error.
@@ -1110,7 +1111,8 @@ pm_status pm_fit_pointing_sigma(const pm_fit *fit, const pm_fit_result *res,
 **                          sigma^2 before minus after (pm_fit_pointing_sigma)
 **  Returned (function value):
 **              pm_status   PM_OK; PM_ERR_ARG; PM_ERR_STATE (no successful
-**                          solve); PM_ERR_NONFINITE (a non-finite angle, or
+**                          solve, or the last solve failed: pm_fit_solve
+**                          Note 6); PM_ERR_NONFINITE (a non-finite angle, or
 **                          products beyond the double range); the model's
 **                          statuses.  Nothing is written on error.
 **  Notes:

@@ -373,7 +373,8 @@ pm_status pm_fit_add(pm_fit *fit, const pm_context *ctx, double enc_ha,
     return PM_OK;
 }
 
-pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res)
+/* pm_fit_solve but for the covariance's state after an error (there). */
+static pm_status solve(pm_fit *fit, pm_model *out, pm_fit_result *res)
 {
     if (!fit || !out)
         return PM_ERR_ARG;
@@ -420,7 +421,8 @@ pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res)
     }
 
     /* From here fit->cov is overwritten: it is valid again only when this
-    ** solve succeeds (pm_fit_covariance checks). */
+    ** solve succeeds (pm_fit_covariance checks; pm_fit_solve also clears
+    ** cov_valid after an error returned before this point). */
     fit->cov_valid = 0;
 
     /* column equilibration: unit diagonal */
@@ -516,6 +518,18 @@ pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res)
     fit->bad_term = -1;
     reset_pass(fit);
     return PM_OK;
+}
+
+pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res)
+{
+    pm_status st = solve(fit, out, res);
+    /* Every error ends the previous solve's covariance (Note 6 of pm.h):
+    ** pm_fit_covariance, pm_fit_pointing_sigma and pm_fit_point_gain
+    ** then return PM_ERR_STATE, whether or not the factorisation got to
+    ** overwrite fit->cov. */
+    if (st < 0 && fit)
+        fit->cov_valid = 0;
+    return st;
 }
 
 pm_status pm_fit_run(pm_fit *fit, pm_model *model, const pm_context *ctx,

@@ -1058,6 +1058,44 @@ START_TEST(test_pm_fit_covariance_after_failed_solve)
 }
 END_TEST
 
+/* Every failing status of a solve ends the previous covariance (pm.h,
+** pm_fit_solve Note 6), also those returned before the factorisation
+** touches it: PM_ERR_TOO_FEW (a solve again at once: the new pass is
+** empty) and PM_ERR_ARG (no output model). */
+START_TEST(test_pm_fit_covariance_after_early_failed_solve)
+{
+    static pm_model truth, m, out;
+    pm_fit_result res;
+    tu_run run;
+    double c, rho, s;
+    make_truth(&truth, 1, 0);
+    simulate(&run, &truth, 500, NOISE, 502);
+    make_zero(&m, 1);
+
+    ck_assert_int_eq(pm_fit_init(&g_fit, &m), PM_OK);
+    ck_assert_int_eq(add_all(&g_fit, &run, 0, run.n), PM_OK);
+    ck_assert_int_eq(pm_fit_solve(&g_fit, &out, &res), PM_OK);
+    ck_assert_int_eq(pm_fit_covariance(&g_fit, &res, 2, 3, &c, &rho), PM_OK);
+    ck_assert_int_eq(pm_fit_pointing_sigma(&g_fit, &res, &out, NULL, 0.1, 0.2, &s, NULL), PM_OK);
+    ck_assert_int_eq(pm_fit_solve(&g_fit, &out, &res), PM_ERR_TOO_FEW);
+    ck_assert_int_eq(pm_fit_covariance(&g_fit, &res, 2, 3, &c, &rho), PM_ERR_STATE);
+    ck_assert_int_eq(pm_fit_pointing_sigma(&g_fit, &res, &out, NULL, 0.1, 0.2, &s, NULL),
+                     PM_ERR_STATE);
+
+    ck_assert_int_eq(pm_fit_init(&g_fit, &m), PM_OK);
+    ck_assert_int_eq(add_all(&g_fit, &run, 0, run.n), PM_OK);
+    ck_assert_int_eq(pm_fit_solve(&g_fit, &out, &res), PM_OK);
+    ck_assert_int_eq(pm_fit_covariance(&g_fit, &res, 2, 3, &c, &rho), PM_OK);
+    ck_assert_int_eq(pm_fit_solve(&g_fit, NULL, &res), PM_ERR_ARG);
+    ck_assert_int_eq(pm_fit_covariance(&g_fit, &res, 2, 3, &c, &rho), PM_ERR_STATE);
+    /* a successful solve brings it back */
+    ck_assert_int_eq(add_all(&g_fit, &run, 0, run.n), PM_OK);
+    ck_assert_int_eq(pm_fit_solve(&g_fit, &out, &res), PM_OK);
+    ck_assert_int_eq(pm_fit_covariance(&g_fit, &res, 2, 3, &c, &rho), PM_OK);
+    tu_run_free(&run);
+}
+END_TEST
+
 /* Exactly consistent data (chi^2 = 0 at the solution): pm_fit_run must
 ** converge, not report PM_ERR_DIVERGED because statistical tests scaled by
 ** chi^2 can never be met (regression: the firmware demo's noiseless refit). */
@@ -1139,6 +1177,7 @@ static Suite *fit_suite(void)
     tcase_add_test(tc, test_pm_fit_solve_zero_obs);
     tcase_add_test(tc, test_pm_fit_solve_singular_keeps_pass);
     tcase_add_test(tc, test_pm_fit_covariance_after_failed_solve);
+    tcase_add_test(tc, test_pm_fit_covariance_after_early_failed_solve);
     tcase_add_test(tc, test_pm_fit_run_noiseless_converges);
     suite_add_tcase(s, tc);
     return s;
