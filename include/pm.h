@@ -1113,8 +1113,9 @@ pm_status pm_fit_pointing_sigma(const pm_fit *fit, const pm_fit_result *res,
 **              pm_status   PM_OK; PM_ERR_ARG; PM_ERR_STATE (no successful
 **                          solve, or the last solve failed: pm_fit_solve
 **                          Note 6); PM_ERR_NONFINITE (a non-finite angle, or
-**                          products beyond the double range); the model's
-**                          statuses.  Nothing is written on error.
+**                          products beyond the double range);
+**                          PM_ERR_SINGULAR (Note 3); the model's statuses.
+**                          Nothing is written on error.
 **  Notes:
 **  1) With C the covariance, J the candidate's two rows and J_g a place's:
 **     C' = C - C J^T S^-1 J C, S = sigma^2 I + J C J^T (one more star of
@@ -1122,6 +1123,13 @@ pm_status pm_fit_pointing_sigma(const pm_fit *fit, const pm_fit_result *res,
 **     U_g = J_g C J^T.  Cost: P^2 + n_sky (one evaluation + 4P).
 **  2) The sum over the places is the caller's choice of "the sky": above
 **     its horizon, on the pier side it will use there.
+**  3) PM_ERR_SINGULAR: S is not positive definite as computed (det S <= 0),
+**     so S^-1 does not exist.  Mathematically S >= sigma^2 I, so this
+**     happens where sigma^2 vanishes: res->sigma = 0 (a fit of exactly
+**     consistent data, chi^2 = 0), or so small (below ~1e-77 rad) that
+**     det S underflows to 0; and where rounding in det S cancels (J C J^T
+**     beyond ~1e16 sigma^2 and of rank one).  The fall is then 0 (no
+**     variance to lower) or not known to any digit.
 */
 pm_status pm_fit_point_gain(const pm_fit *fit, const pm_fit_result *res, const pm_model *m,
                             const pm_context *ctx, double enc_ha, double enc_dec,

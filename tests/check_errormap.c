@@ -173,6 +173,21 @@ START_TEST(test_errormap_errors)
         ck_assert_int_eq(pm_fit_point_gain(&fit, &res, &m, NULL, NAN, 0.2, sky, 2, &g), PM_ERR_NONFINITE);
         sky[3] = NAN;
         ck_assert_int_eq(pm_fit_point_gain(&fit, &res, &m, NULL, 0.1, 0.2, sky, 2, &g), PM_ERR_NONFINITE);
+        sky[3] = 0.5;
+        {
+            /* no noise (sigma = 0, or one whose square underflows): S = 0,
+            ** PM_ERR_SINGULAR (pm.h, pm_fit_point_gain Note 3), g untouched */
+            pm_fit_result r0 = res;
+            const double sig[2] = {0.0, 1e-160};
+            int k;
+            for (k = 0; k < 2; k++) {
+                r0.sigma = sig[k];
+                g = -7.0;
+                ck_assert_int_eq(pm_fit_point_gain(&fit, &r0, &m, NULL, 0.1, 0.2, sky, 2, &g),
+                                 PM_ERR_SINGULAR);
+                ck_assert(g == -7.0);
+            }
+        }
     }
 }
 END_TEST
