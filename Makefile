@@ -71,6 +71,17 @@ $(B)/tests/check_bounded $(B)/tests/check_track: $(B)/tests/%: tests/%.c $(PROBE
 	@mkdir -p $(@D)
 	$(CC) $(TEST_CFLAGS) $< -o $@ $(PROBE_OBJ) $(TEST_LIBS)
 
+# check_model also calls PM_CHECK_CONFIG() as compiled with other capacity
+# macros (tests/config_other.c: PM_MAX_AUX 1 and 8), against this library.
+CONFIG_OTHER := $(B)/tests/config_aux1.o $(B)/tests/config_aux8.o
+$(B)/tests/config_aux%.o: tests/config_other.c include/pm.h
+	@mkdir -p $(@D)
+	$(CC) $(TEST_CFLAGS) -DPM_MAX_AUX=$* -DCONFIG_FN=pm_test_config_aux$* -c $< -o $@
+
+$(B)/tests/check_model: tests/check_model.c $(CONFIG_OTHER) $(B)/libpmhost.a $(B)/libpm.a $(wildcard tests/*.h)
+	@mkdir -p $(@D)
+	$(CC) $(TEST_CFLAGS) $< -o $@ $(CONFIG_OTHER) $(B)/libpmhost.a $(B)/libpm.a $(TEST_LIBS)
+
 # check_internal tests the core's own helpers (lib/pm_detail.hpp) through a
 # test-only shim compiled with the core's flags.
 $(B)/tests/internal_shim.o: tests/internal_shim.cpp $(wildcard include/*.h lib/*.hpp)

@@ -23,8 +23,9 @@
 **    into (-pi, pi] exactly, in degrees (docs/formats.md).
 **  - The caller owns every struct.  All structs are fully defined here so
 **    that they can be allocated statically; their sizes depend on the
-**    capacity macros PM_MAX_L and PM_MAX_EXTRA, which must be the same when
-**    the library and the caller are compiled (PM_CHECK_CONFIG() verifies).
+**    capacity macros PM_MAX_L, PM_MAX_EXTRA and PM_MAX_AUX, which must be
+**    the same when the library and the caller are compiled
+**    (PM_CHECK_CONFIG() verifies).
 **  - Every function returns a pm_status.  PM_OK is 0, positive values are
 **    warnings with a usable result, negative values are errors; on error the
 **    outputs are left unchanged.
@@ -215,7 +216,8 @@ typedef enum pm_status {
 #define PM_AUX_DIR 2   /* pm_context.dir (+1/-1) */
 #define PM_AUX_USER 3  /* PM_AUX_USER + j: pm_context.aux[j] */
 
-/* User inputs in a pm_context. */
+/* User inputs in a pm_context (its size: the same in the library and the
+** caller, PM_CHECK_CONFIG()). */
 #ifndef PM_MAX_AUX
 #define PM_MAX_AUX 4
 #endif
@@ -1166,18 +1168,34 @@ pm_status pm_fit_row(const pm_model *m, const pm_context *ctx,
 /* ---------------------------------------------------------------------- */
 
 /*
-**  pm_check_config - do the caller's struct sizes match the library's?
+**  pm_check_config_all - do the caller's struct layouts match the library's?
 **
+**  Given:
+**     model_size, fit_size, context_size  size_t  sizeof(pm_model),
+**                          sizeof(pm_fit), sizeof(pm_context) as the
+**                          caller was compiled
+**     max_l, max_extra, max_aux  int  its PM_MAX_L, PM_MAX_EXTRA,
+**                          PM_MAX_AUX
 **  Returned (function value):
 **              pm_status   PM_OK; PM_ERR_CONFIG
 **  Notes:
 **  1) Call as PM_CHECK_CONFIG().  Different PM_MAX_L or PM_MAX_EXTRA in
-**     the caller and the library change the struct layouts.
+**     the caller and the library change pm_model's and pm_fit's layouts; a
+**     different PM_MAX_AUX pm_context's (the library would read a
+**     context's aux[] where the caller has none, or the term indices
+**     PM_AUX_USER + j it accepts would not be the caller's).
+**  2) pm_check_config is the check earlier headers' PM_CHECK_CONFIG()
+**     called: the same without pm_context and PM_MAX_AUX.  It is kept
+**     unchanged, so that programs built against them still link and
+**     check what they checked; new code should use PM_CHECK_CONFIG().
 */
+pm_status pm_check_config_all(size_t model_size, size_t fit_size, size_t context_size,
+                              int max_l, int max_extra, int max_aux);
 pm_status pm_check_config(size_t model_size, size_t fit_size, int max_l,
                           int max_extra);
 #define PM_CHECK_CONFIG() \
-    pm_check_config(sizeof(pm_model), sizeof(pm_fit), PM_MAX_L, PM_MAX_EXTRA)
+    pm_check_config_all(sizeof(pm_model), sizeof(pm_fit), sizeof(pm_context), \
+                        PM_MAX_L, PM_MAX_EXTRA, PM_MAX_AUX)
 
 #ifdef __cplusplus
 }

@@ -2463,4 +2463,13 @@ pm_status pm_check_config(size_t model_size, size_t fit_size, int max_l,
     return PM_OK;
 }
 
+pm_status pm_check_config_all(size_t model_size, size_t fit_size, size_t context_size,
+                              int max_l, int max_extra, int max_aux)
+{
+    if (pm_check_config(model_size, fit_size, max_l, max_extra) != PM_OK ||
+        context_size != sizeof(pm_context) || max_aux != PM_MAX_AUX)
+        return PM_ERR_CONFIG;
+    return PM_OK;
+}
+
 } /* extern "C" */

@@ -642,6 +642,31 @@ START_TEST(test_pm_terms_eval_bad_args)
 }
 END_TEST
 
+/* PM_CHECK_CONFIG() compiled with PM_MAX_AUX 1 and 8 (tests/config_other.c,
+** Makefile) against this library (PM_MAX_AUX 4): pm_context differs. */
+int pm_test_config_aux1(void);
+int pm_test_config_aux8(void);
+
+START_TEST(test_pm_check_config_other_max_aux)
+{
+    ck_assert_int_eq(PM_MAX_AUX, 4);
+    ck_assert_int_eq(pm_test_config_aux1(), PM_ERR_CONFIG);
+    ck_assert_int_eq(pm_test_config_aux8(), PM_ERR_CONFIG);
+    ck_assert_int_eq(pm_check_config_all(sizeof(pm_model), sizeof(pm_fit), sizeof(pm_context),
+                                         PM_MAX_L, PM_MAX_EXTRA, PM_MAX_AUX), PM_OK);
+    ck_assert_int_eq(pm_check_config_all(sizeof(pm_model), sizeof(pm_fit),
+                                         sizeof(pm_context) - 3 * sizeof(double), PM_MAX_L,
+                                         PM_MAX_EXTRA, PM_MAX_AUX), PM_ERR_CONFIG);
+    ck_assert_int_eq(pm_check_config_all(sizeof(pm_model), sizeof(pm_fit), sizeof(pm_context),
+                                         PM_MAX_L, PM_MAX_EXTRA, PM_MAX_AUX + 1), PM_ERR_CONFIG);
+    ck_assert_int_eq(pm_check_config_all(sizeof(pm_model), sizeof(pm_fit), sizeof(pm_context),
+                                         PM_MAX_L + 1, PM_MAX_EXTRA, PM_MAX_AUX), PM_ERR_CONFIG);
+    ck_assert_int_eq(pm_check_config_all(sizeof(pm_model) + 8, sizeof(pm_fit),
+                                         sizeof(pm_context), PM_MAX_L, PM_MAX_EXTRA, PM_MAX_AUX),
+                     PM_ERR_CONFIG);
+}
+END_TEST
+
 START_TEST(test_pm_check_config_mismatch)
 {
     ck_assert_int_eq(PM_CHECK_CONFIG(), PM_OK);
@@ -1860,6 +1885,7 @@ static Suite *model_suite(void)
     tcase_add_test(tc, test_pm_model_residual_stale);
     tcase_add_test(tc, test_pm_terms_eval_bad_args);
     tcase_add_test(tc, test_pm_check_config_mismatch);
+    tcase_add_test(tc, test_pm_check_config_other_max_aux);
     suite_add_tcase(s, tc);
 
     tc = tcase_create("values");
