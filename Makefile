@@ -82,6 +82,18 @@ $(B)/tests/check_model: tests/check_model.c $(CONFIG_OTHER) $(B)/libpmhost.a $(B
 	@mkdir -p $(@D)
 	$(CC) $(TEST_CFLAGS) $< -o $@ $(CONFIG_OTHER) $(B)/libpmhost.a $(B)/libpm.a $(TEST_LIBS)
 
+# check_capacity: the core built again with capacities beyond the default
+# (two-digit term indices), the suite compiled with the same.
+BIG_CAP := -DPM_MAX_L=10 -DPM_MAX_AUX=12
+BIG_OBJ := $(CORE_SRC:lib/%.cpp=$(B)/big/%.o)
+$(B)/big/%.o: lib/%.cpp $(wildcard include/*.h lib/*.hpp)
+	@mkdir -p $(@D)
+	$(CXX) $(CORE_FLAGS) $(BIG_CAP) -c $< -o $@
+
+$(B)/tests/check_capacity: tests/check_capacity.c $(BIG_OBJ) $(wildcard tests/*.h)
+	@mkdir -p $(@D)
+	$(CC) $(TEST_CFLAGS) $(BIG_CAP) $< -o $@ $(BIG_OBJ) $(TEST_LIBS)
+
 # check_internal tests the core's own helpers (lib/pm_detail.hpp) through a
 # test-only shim compiled with the core's flags.
 $(B)/tests/internal_shim.o: tests/internal_shim.cpp $(wildcard include/*.h lib/*.hpp)

@@ -396,7 +396,9 @@ pm_status pm_model_find(const pm_model *m, int k, int l, int mm, int *index);
 **     buf      char*            output buffer
 **     len      size_t           its size (>= 2)
 **  Returned (function value):
-**              pm_status   PM_OK; PM_ERR_ARG
+**              pm_status   PM_OK; PM_ERR_ARG (also a term pm_model_prepare
+**                          would refuse: m need not be prepared, but the
+**                          term must be valid; buf is then untouched)
 **  Notes:
 **  1) Isotropic terms are named a, b, c', d, e', i; harmonic terms
 **     "<base>*Y(l,m)"; periodic terms "<base>*cos(<G>*ha)" or "*sin(..dec)";

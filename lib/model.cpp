@@ -1896,6 +1896,46 @@ pm_status invert(const pm_model *m, const pm_context *ctx, double app_ha,
 
 } /* namespace */
 
+/* Is an added term well formed for model m? */
+static bool term_valid(const pm_model *m, const pm_term *t)
+{
+    if (t->side < -1 || t->side > 1)
+        return false;
+    if (t->kind != PM_TERM_ZENITH && (t->k < 1 || t->k > 6))
+        return false;
+    switch (t->kind) {
+    case PM_TERM_SH:
+        return t->l >= 0 && t->l <= m->order && t->m >= -t->l && t->m <= t->l;
+    case PM_TERM_FOURIER:
+        return (t->l == 1 || t->l == 2) && (t->m == 0 || t->m == 1) &&
+               finite(t->param) && t->param > 0 && t->param <= 1e6;
+    case PM_TERM_SECTORAL:
+        return (t->m == 0 || t->m == 1) && t->param >= 1 && t->param <= 100000 &&
+               t->param == (double)(long)t->param;
+    case PM_TERM_ZENITH:
+        return t->l == 0 || t->l == 1;
+    case PM_TERM_AUX:
+        return t->aux <= PM_AUX_USER + PM_MAX_AUX - 1 && finite(t->param);
+    default:
+        return false;
+    }
+}
+
+/* Is term i of m one pm_model_prepare accepts?  (m->order within
+** 0..PM_MAX_L and m->n_base within 6..m->n_terms checked before.) */
+static bool term_ok(const pm_model *m, int i)
+{
+    const pm_term *t = &m->term[i];
+    if (i >= m->n_base)
+        return term_valid(m, t);
+    /* the harmonic set: plain SH, both sides */
+    if (t->kind != PM_TERM_SH || t->k < 1 || t->k > 6 || t->side != 0)
+        return false;
+    if (i < 6)
+        return t->l == 0 && t->k == i + 1; /* the six isotropic terms come first */
+    return t->l >= 1 && t->l <= m->order && t->m >= -t->l && t->m <= t->l;
+}
+
 extern "C" {
 
 pm_status pm_model_init(pm_model *m, int mount, int order)
@@ -1924,31 +1964,6 @@ pm_status pm_model_init(pm_model *m, int mount, int order)
     m->n_terms = n;
     m->n_base = n;
     return pm_model_prepare(m);
-}
-
-/* Is an added term well formed for model m? */
-static bool term_valid(const pm_model *m, const pm_term *t)
-{
-    if (t->side < -1 || t->side > 1)
-        return false;
-    if (t->kind != PM_TERM_ZENITH && (t->k < 1 || t->k > 6))
-        return false;
-    switch (t->kind) {
-    case PM_TERM_SH:
-        return t->l >= 0 && t->l <= m->order && t->m >= -t->l && t->m <= t->l;
-    case PM_TERM_FOURIER:
-        return (t->l == 1 || t->l == 2) && (t->m == 0 || t->m == 1) &&
-               finite(t->param) && t->param > 0 && t->param <= 1e6;
-    case PM_TERM_SECTORAL:
-        return (t->m == 0 || t->m == 1) && t->param >= 1 && t->param <= 100000 &&
-               t->param == (double)(long)t->param;
-    case PM_TERM_ZENITH:
-        return t->l == 0 || t->l == 1;
-    case PM_TERM_AUX:
-        return t->aux <= PM_AUX_USER + PM_MAX_AUX - 1 && finite(t->param);
-    default:
-        return false;
-    }
 }
 
 pm_status pm_model_add_term(pm_model *m, const pm_term *t, double value, int *index)
@@ -1995,21 +2010,10 @@ pm_status pm_model_prepare(pm_model *m)
         return PM_ERR_ARG;
     m->needs_ctx = 0;
     for (int i = 0; i < m->n_terms; i++) {
-        const pm_term *t = &m->term[i];
-        if (i < m->n_base) { /* the harmonic set: plain SH, both sides */
-            if (t->kind != PM_TERM_SH || t->k < 1 || t->k > 6 || t->side != 0)
-                return PM_ERR_ARG;
-            if (i < 6 && (t->l != 0 || t->k != i + 1))
-                return PM_ERR_ARG; /* the six isotropic terms come first */
-            if (i >= 6 && (t->l < 1 || t->l > m->order || t->m < -t->l ||
-                           t->m > t->l))
-                return PM_ERR_ARG;
-        } else {
-            if (!term_valid(m, t))
-                return PM_ERR_ARG;
-            if (t->kind == PM_TERM_AUX)
-                m->needs_ctx = 1;
-        }
+        if (!term_ok(m, i))
+            return PM_ERR_ARG;
+        if (m->term[i].kind == PM_TERM_AUX)
+            m->needs_ctx = 1;
         if (!finite(m->coef[i]))
             return PM_ERR_NONFINITE;
     }
@@ -2081,9 +2085,13 @@ pm_status pm_term_name(const pm_model *m, int index, char *buf, size_t len)
     if (!m || !buf || len < 2 || index < 0 || index >= m->n_terms ||
         index >= PM_MAX_TERMS)
         return PM_ERR_ARG;
-    const pm_term *t = &m->term[index];
-    if (t->kind != PM_TERM_ZENITH && (t->k < 1 || t->k > 6))
+    /* the term as pm_model_prepare would accept it (a prepared model's term
+    ** changed since, or one of a model never prepared, may hold anything:
+    ** G = 1e300 has no long) */
+    if (m->order < 0 || m->order > PM_MAX_L || m->n_base < 6 || m->n_base > m->n_terms ||
+        !term_ok(m, index))
         return PM_ERR_ARG;
+    const pm_term *t = &m->term[index];
     char tmp[48];
     size_t n = 0;
     if (t->kind == PM_TERM_ZENITH) {
@@ -2103,7 +2111,8 @@ pm_status pm_term_name(const pm_model *m, int index, char *buf, size_t len)
                                                    : (t->m ? "*Ysin(" : "*Ycos(");
         while (*s)
             tmp[n++] = *s++;
-        /* G with up to 3 decimals, no printf in the core */
+        /* G with up to 3 decimals, no printf in the core (G within
+        ** 0..1e6, term_ok) */
         double g = t->param;
         long ip = (long)g;
         long fr = (long)((g - (double)ip) * 1000.0 + 0.5);
@@ -2111,14 +2120,7 @@ pm_status pm_term_name(const pm_model *m, int index, char *buf, size_t len)
             ip++;
             fr -= 1000;
         }
-        char d[24];
-        int nd = 0;
-        do {
-            d[nd++] = (char)('0' + ip % 10);
-            ip /= 10;
-        } while (ip > 0 && nd < 20);
-        while (nd > 0)
-            tmp[n++] = d[--nd];
+        n += format_long(ip, tmp + n);
         if (fr > 0) {
             tmp[n++] = '.';
             tmp[n++] = (char)('0' + fr / 100);
@@ -2141,19 +2143,14 @@ pm_status pm_term_name(const pm_model *m, int index, char *buf, size_t len)
         while (*s)
             tmp[n++] = *s++;
         if (t->aux >= PM_AUX_USER)
-            tmp[n++] = (char)('0' + (t->aux - PM_AUX_USER) % 10);
+            n += format_long(t->aux - PM_AUX_USER, tmp + n);
     } else if (t->kind == PM_TERM_SH && t->l > 0) {
         const char *s = "*Y(";
         while (*s)
             tmp[n++] = *s++;
-        tmp[n++] = (char)('0' + t->l % 10);
+        n += format_long(t->l, tmp + n);
         tmp[n++] = ',';
-        int mm = t->m;
-        if (mm < 0) {
-            tmp[n++] = '-';
-            mm = -mm;
-        }
-        tmp[n++] = (char)('0' + mm % 10);
+        n += format_long(t->m, tmp + n);
         tmp[n++] = ')';
     }
     if (t->side) {

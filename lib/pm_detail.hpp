@@ -49,6 +49,25 @@ inline unsigned long long bits_of(double x)
 #define PM_SOFT_DOUBLE 0
 #endif
 
+/* v in decimal at out ('-' first where negative; at most 20 characters
+** for any 64-bit long, no NUL): the count written.  (No printf in the
+** core: pm_term_name.) */
+inline int format_long(long v, char *out)
+{
+    unsigned long u = v < 0 ? 0UL - (unsigned long)v : (unsigned long)v;
+    char d[24];
+    int nd = 0, n = 0;
+    do {
+        d[nd++] = (char)('0' + u % 10);
+        u /= 10;
+    } while (u > 0);
+    if (v < 0)
+        out[n++] = '-';
+    while (nd > 0)
+        out[n++] = d[--nd];
+    return n;
+}
+
 /* x finite (not NaN, not +-inf). */
 inline bool finite(double x)
 {

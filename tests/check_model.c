@@ -356,6 +356,46 @@ START_TEST(test_pm_term_name_bad_args)
 }
 END_TEST
 
+/* A term pm_model_prepare would refuse (a model never prepared, or a term
+** changed since) is not named: PM_ERR_ARG, buf untouched.  (G = 1e300 or
+** -1e19 was converted to long: undefined, and a wrong name; l = 40 read
+** as "Y(0,...)".) */
+START_TEST(test_pm_term_name_invalid_term)
+{
+    static pm_model m;
+    static const double bad_g[] = {1e300, -1e19, 2e6, 0.0};
+    char buf[32];
+    pm_term t;
+    int i, idx;
+    ck_assert_int_eq(pm_model_init(&m, PM_MOUNT_EQUATORIAL, 1), PM_OK);
+    memset(&t, 0, sizeof t);
+    t.kind = PM_TERM_FOURIER;
+    t.k = PM_BASE_C;
+    t.l = 1;
+    t.param = 2.5;
+    ck_assert_int_eq(pm_model_add_term(&m, &t, 0.0, &idx), PM_OK);
+    ck_assert_int_eq(pm_term_name(&m, idx, buf, sizeof buf), PM_OK);
+    ck_assert_str_eq(buf, "c'*cos(2.5*ha)");
+    for (i = 0; i < 4; i++) {
+        m.term[idx].param = bad_g[i];
+        memset(buf, '#', sizeof buf);
+        ck_assert_int_eq(pm_term_name(&m, idx, buf, sizeof buf), PM_ERR_ARG);
+        ck_assert_int_eq(buf[0], '#');
+    }
+    m.term[idx].param = 2.5;
+    m.term[idx].kind = PM_TERM_AUX;
+    m.term[idx].aux = 250; /* beyond PM_AUX_USER + PM_MAX_AUX - 1 */
+    ck_assert_int_eq(pm_term_name(&m, idx, buf, sizeof buf), PM_ERR_ARG);
+    ck_assert_int_eq(pm_model_find(&m, PM_BASE_D, 1, -1, &idx), PM_OK);
+    ck_assert_int_eq(pm_term_name(&m, idx, buf, sizeof buf), PM_OK);
+    ck_assert_str_eq(buf, "d*Y(1,-1)");
+    m.term[idx].l = 40; /* beyond the order */
+    memset(buf, '#', sizeof buf);
+    ck_assert_int_eq(pm_term_name(&m, idx, buf, sizeof buf), PM_ERR_ARG);
+    ck_assert_int_eq(buf[0], '#');
+}
+END_TEST
+
 START_TEST(test_pm_model_apply_null)
 {
     static pm_model m;
@@ -1870,6 +1910,7 @@ static Suite *model_suite(void)
     tcase_add_test(tc, test_pm_model_prepare_bad_fields);
     tcase_add_test(tc, test_pm_model_find_null);
     tcase_add_test(tc, test_pm_term_name_bad_args);
+    tcase_add_test(tc, test_pm_term_name_invalid_term);
     tcase_add_test(tc, test_pm_model_apply_null);
     tcase_add_test(tc, test_pm_model_apply_nonfinite);
     tcase_add_test(tc, test_pm_model_apply_stale);
