@@ -278,7 +278,12 @@ typedef struct pm_model {
     double latitude;               /* site latitude (radians), needed by
                                       ZENITH terms on equatorial mounts */
     int needs_ctx;                 /* derived: some term reads pm_context */
-    pm_term term[PM_MAX_TERMS];
+    pm_term term[PM_MAX_TERMS];    /* set by pm_model_init and
+                                      pm_model_add_term; after changing it
+                                      (or n_terms, n_base, order, mount)
+                                      by hand, call pm_model_prepare before
+                                      any other use: otherwise undefined
+                                      (pm_model_prepare Note 2) */
     double coef[PM_MAX_TERMS];     /* radians */
     /* Derived by pm_model_prepare; do not set by hand. */
     int prepared;
@@ -338,10 +343,23 @@ pm_status pm_model_init(pm_model *m, int mount, int order);
 **                          the polar-axis rotation overflows); PM_ERR_CAPACITY
 **  Notes:
 **  1) pm_model_init and pm_fit_solve leave the model prepared.  After
-**     changing coef[] or term[] directly, call this again: apply, invert
-**     and the fit return PM_ERR_STATE if any coefficient differs from the
-**     ones last prepared, bit for bit (never a silently stale model).
-**  2) On error the model is left unprepared: every evaluation returns
+**     changing coef[] directly, call this again: apply, invert and the
+**     fit return PM_ERR_STATE if any coefficient differs from the ones
+**     last prepared, bit for bit (never a silently stale model).
+**  2) After changing term[] (or n_terms, n_base, order or mount) directly,
+**     call this again before any other use of the model.  Changing them
+**     and then calling anything else without preparing again is
+**     undefined: the evaluations (pm_model_apply, pm_model_invert,
+**     pm_model_invert_near, pm_model_track, pm_model_residual) do not look
+**     at the terms (it would cost every tick), and a term this function
+**     would refuse (l beyond the order, an AUX input beyond PM_MAX_AUX) is
+**     read out of bounds there.  The calls outside that path never read
+**     such a term: pm_model_f_prepare, pm_fit_init (so pm_fit_run),
+**     pm_fit_row, pm_fit_pointing_sigma and pm_fit_point_gain return
+**     PM_ERR_STATE for a prepared model whose shape or terms this function
+**     would now refuse (a term changed into another valid one goes
+**     unnoticed there too), pm_term_name PM_ERR_ARG for such a term.
+**  3) On error the model is left unprepared: every evaluation returns
 **     PM_ERR_STATE until a pm_model_prepare succeeds.
 */
 pm_status pm_model_prepare(pm_model *m);
@@ -777,7 +795,9 @@ typedef struct pm_model_f {
 **  Returned:
 **     mf       pm_model_f*      float model
 **  Returned (function value):
-**              pm_status   PM_OK; PM_ERR_ARG; PM_ERR_STATE
+**              pm_status   PM_OK; PM_ERR_ARG; PM_ERR_STATE (m not
+**                          prepared, or changed since: pm_model_prepare
+**                          Notes 1 and 2)
 **  Notes:
 **  1) mf is a snapshot of m: a later change of m (new coefficients,
 **     pm_model_prepare, a refit by pm_fit_solve) does not reach it, and

@@ -308,6 +308,8 @@ pm_status pm_fit_init(pm_fit *fit, const pm_model *start)
     pm_status st = model_ready(start);
     if (st != PM_OK)
         return st;
+    if (!terms_intact(start))
+        return PM_ERR_STATE; /* a term changed since pm_model_prepare */
     fit->lin = *start;
     fit->n_par = start->n_terms;
     fit->bad_term = -1;
@@ -575,6 +577,8 @@ static pm_status prediction_ready(const pm_fit *fit, const pm_model *m, double e
         return PM_ERR_STATE;
     if (m->n_terms != fit->n_par)
         return PM_ERR_ARG;
+    if (model_ready(m) != PM_OK || !terms_intact(m))
+        return PM_ERR_STATE; /* before pm_model_apply, which does not look at the terms */
     if (!finite(enc_ha) || !finite(enc_dec))
         return PM_ERR_NONFINITE;
     return PM_OK;
@@ -722,7 +726,11 @@ pm_status pm_fit_row(const pm_model *m, const pm_context *ctx, double enc_ha,
                      double enc_dec, double app_ha, double app_dec,
                      double *row0, double *row1, double r[2])
 {
-    pm_status st = eval_ready(m, ctx);
+    pm_status st = model_ready(m);
+    if (st == PM_OK && !terms_intact(m))
+        st = PM_ERR_STATE; /* a term changed since pm_model_prepare */
+    if (st == PM_OK)
+        st = context_ok(m, ctx);
     if (st != PM_OK)
         return st;
     if (!row0 || !row1 || !r)

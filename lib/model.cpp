@@ -1936,6 +1936,28 @@ static bool term_ok(const pm_model *m, int i)
     return t->l >= 1 && t->l <= m->order && t->m >= -t->l && t->m <= t->l;
 }
 
+namespace pm {
+namespace detail {
+
+bool terms_intact(const pm_model *m)
+{
+    if (m->mount != PM_MOUNT_EQUATORIAL && m->mount != PM_MOUNT_ALTAZ)
+        return false;
+    if (m->order < 0 || m->order > PM_MAX_L || m->n_terms < 6 || m->n_terms > PM_MAX_TERMS ||
+        m->n_base < 6 || m->n_base > m->n_terms)
+        return false;
+    int aux = 0;
+    for (int i = 0; i < m->n_terms; i++) {
+        if (!term_ok(m, i))
+            return false;
+        aux |= m->term[i].kind == PM_TERM_AUX;
+    }
+    return m->needs_ctx == aux;
+}
+
+} /* namespace detail */
+} /* namespace pm */
+
 extern "C" {
 
 pm_status pm_model_init(pm_model *m, int mount, int order)

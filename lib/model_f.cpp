@@ -578,6 +578,8 @@ pm_status pm_model_f_prepare(pm_model_f *mf, const pm_model *m)
     pm_status st = model_ready(m);
     if (st != PM_OK)
         return st;
+    if (!terms_intact(m))
+        return PM_ERR_STATE; /* a term changed since pm_model_prepare */
     __builtin_memset(mf, 0, sizeof *mf);
     mf->mount = m->mount;
     mf->order = m->order;

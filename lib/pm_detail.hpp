@@ -68,6 +68,12 @@ inline int format_long(long v, char *out)
     return n;
 }
 
+/* A model's shape and terms as pm_model_prepare accepts them (needs_ctx
+** as it sets it): what the entries outside the evaluation's hot path
+** (pm_model_f_prepare, the fit's) check, so that a term changed after
+** pm_model_prepare is never read out of bounds there (model.cpp). */
+bool terms_intact(const pm_model *m);
+
 /* x finite (not NaN, not +-inf). */
 inline bool finite(double x)
 {

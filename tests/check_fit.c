@@ -1096,6 +1096,69 @@ START_TEST(test_pm_fit_covariance_after_early_failed_solve)
 }
 END_TEST
 
+/* term[] changed after pm_model_prepare into a term it refuses (pm.h,
+** pm_model_prepare Note 1): the entries outside the evaluation's hot path
+** return PM_ERR_STATE instead of reading it (out of bounds: l = 40 in the
+** harmonics, aux = 250 in pm_context.aux). */
+START_TEST(test_terms_changed_after_prepare)
+{
+    static pm_model truth, m, fitted, bad;
+    static pm_model_f mf;
+    pm_fit_result res;
+    pm_context ctx;
+    tu_run run;
+    pm_term t;
+    double r0[PM_MAX_TERMS], r1[PM_MAX_TERMS], r[2], s, g, sky[2] = {0.3, 0.4};
+    int idx, k;
+    make_truth(&truth, 1, 0);
+    simulate(&run, &truth, 300, NOISE, 503);
+    make_zero(&m, 1);
+    memset(&t, 0, sizeof t);
+    t.kind = PM_TERM_AUX;
+    t.k = PM_BASE_C;
+    t.aux = PM_AUX_USER;
+    ck_assert_int_eq(pm_model_add_term(&m, &t, 0.0, &idx), PM_OK);
+    memset(&ctx, 0, sizeof ctx);
+    ck_assert_int_eq(pm_fit_init(&g_fit, &m), PM_OK);
+    for (k = 0; k < run.n; k++) {
+        ctx.aux[0] = k % 7 - 3.0;
+        ck_assert_int_eq(pm_fit_add(&g_fit, &ctx, run.eh[k], run.ed[k], run.ah[k], run.ad[k]),
+                         PM_OK);
+    }
+    ck_assert_int_eq(pm_fit_solve(&g_fit, &fitted, &res), PM_OK);
+    ck_assert_int_eq(pm_fit_pointing_sigma(&g_fit, &res, &fitted, &ctx, 0.1, 0.2, &s, NULL), PM_OK);
+    ck_assert_int_eq(pm_fit_row(&fitted, &ctx, 0.1, 0.2, 0.1, 0.2, r0, r1, r), PM_OK);
+    for (k = 0; k < 2; k++) {
+        int j;
+        bad = fitted;
+        if (k == 0) {
+            ck_assert_int_eq(pm_model_find(&bad, PM_BASE_D, 1, 0, &j), PM_OK);
+            bad.term[j].l = 40;
+        } else {
+            bad.term[idx].aux = 250;
+        }
+        ck_assert_int_eq(pm_fit_init(&g_fit2, &bad), PM_ERR_STATE);
+        ck_assert_int_eq(pm_model_f_prepare(&mf, &bad), PM_ERR_STATE);
+        ck_assert_int_eq(pm_fit_row(&bad, &ctx, 0.1, 0.2, 0.1, 0.2, r0, r1, r), PM_ERR_STATE);
+        ck_assert_int_eq(pm_fit_pointing_sigma(&g_fit, &res, &bad, &ctx, 0.1, 0.2, &s, NULL),
+                         PM_ERR_STATE);
+        ck_assert_int_eq(pm_fit_point_gain(&g_fit, &res, &bad, &ctx, 0.1, 0.2, sky, 1, &g),
+                         PM_ERR_STATE);
+        ck_assert_int_eq(pm_fit_run(&g_fit2, &bad, &ctx, 1, run.eh, run.ed, run.ah, run.ad, 5,
+                                    &res), PM_ERR_STATE);
+        /* preparing again refuses it too */
+        ck_assert_int_eq(pm_model_prepare(&bad), PM_ERR_ARG);
+    }
+    /* a term made AUX after the prepare: needs_ctx says no term reads the
+    ** context (a NULL one would be read) */
+    bad = fitted;
+    bad.needs_ctx = 0;
+    ck_assert_int_eq(pm_fit_init(&g_fit2, &bad), PM_ERR_STATE);
+    ck_assert_int_eq(pm_fit_row(&bad, NULL, 0.1, 0.2, 0.1, 0.2, r0, r1, r), PM_ERR_STATE);
+    tu_run_free(&run);
+}
+END_TEST
+
 /* Exactly consistent data (chi^2 = 0 at the solution): pm_fit_run must
 ** converge, not report PM_ERR_DIVERGED because statistical tests scaled by
 ** chi^2 can never be met (regression: the firmware demo's noiseless refit). */
@@ -1178,6 +1241,7 @@ static Suite *fit_suite(void)
     tcase_add_test(tc, test_pm_fit_solve_singular_keeps_pass);
     tcase_add_test(tc, test_pm_fit_covariance_after_failed_solve);
     tcase_add_test(tc, test_pm_fit_covariance_after_early_failed_solve);
+    tcase_add_test(tc, test_terms_changed_after_prepare);
     tcase_add_test(tc, test_pm_fit_run_noiseless_converges);
     suite_add_tcase(s, tc);
     return s;
