@@ -1,5 +1,7 @@
 /* Fit an L=1 model to observations held in arrays, then correct a target.
-** Build: cc -std=c89 -Iinclude examples/fit_and_apply.c build/libpm.a -lm */
+** Build and run, with the synthetic run of examples/fit_and_apply_main.c:
+**   cc -std=c89 -Iinclude examples/fit_and_apply.c examples/fit_and_apply_main.c \
+**      build/libpm.a -lm -o fit_and_apply && ./fit_and_apply */
 #include <stdio.h>
 #include "pm.h"
 

@@ -103,7 +103,8 @@ extern "C" {
 ** terms within 10 deg and harmonic terms of order L <= 2 within 10' each
 ** (AUX terms allowed): at most this many
 ** model evaluations (pm_model_invert Note 1 gives the reasons; measured
-** worst 3, tests/check_bounded.c asserts both). */
+** worst 4 in tests/check_bounded.c's tracking calls, which asserts both:
+** every call within 8, the worst within 4). */
 #define PM_INVERT_TRACK_MAX_EVALS 8
 
 /* Round-trip tolerance the inverse iterates to (radians). */
