@@ -254,8 +254,9 @@ class Model(_pm.Model):
     of order L (4L^2+12L+6 terms, all zero); models also come from fits
     (``FitResult.model``) and model files (``load_model``).
 
-    Attributes: ``names``, ``coefficients`` (settable: the model is prepared
-    again, and left unchanged if that fails), ``terms`` (dicts), ``order``,
+    Attributes: ``names``, ``coefficients`` (read-only arrays; settable as a
+    whole: the model is prepared again, and left unchanged if that fails),
+    ``terms`` (dicts), ``order``,
     ``n_terms``, ``mount``, ``latitude`` (radians, used by refraction and
     tube-flexure terms).
     """
@@ -275,6 +276,21 @@ class Model(_pm.Model):
     @property
     def mount(self):
         return "altaz" if self._mount == 1 else "equatorial"
+
+    @property
+    def coefficients(self):
+        """The coefficients (radians, one per term): a read-only copy, so that
+        an in-place edit raises instead of being lost.  To change them assign
+        a whole array (``c = m.coefficients.copy(); c[2] += 1e-5;
+        m.coefficients = c``): the model is prepared again, and left
+        unchanged if that fails."""
+        c = _pm.Model.coefficients.__get__(self)
+        c.setflags(write=False)
+        return c
+
+    @coefficients.setter
+    def coefficients(self, value):
+        _pm.Model.coefficients.__set__(self, value)
 
     def copy(self):
         return Model._wrap(self)

@@ -224,6 +224,25 @@ def test_bad_coefficients_leave_the_model_unchanged():
         assert m.apply(0.3, 0.4) == before
 
 
+def test_model_coefficients_are_read_only():
+    """Model.coefficients is a read-only copy, as FitResult.coefficients: an
+    edit in place raises instead of being lost; a whole array assigned
+    through the setter is taken (the model prepared again)."""
+    m = pm.fit_run(os.path.join(TOP, "examples", "sim_gem.dat")).model
+    before = m.apply(0.3, 0.4)
+    with pytest.raises(ValueError, match="read-only"):
+        m.coefficients[2] += 0.01
+    assert not m.coefficients.flags.writeable
+    assert m.apply(0.3, 0.4) == before
+    c = m.coefficients.copy()
+    c[2] += 0.01
+    m.coefficients = c
+    assert np.array_equal(m.coefficients, c)
+    assert m.apply(0.3, 0.4) != before
+    m.coefficients = list(c - 0.01 * (np.arange(m.n_terms) == 2))  # any sequence of numbers
+    assert m.apply(0.3, 0.4) == before
+
+
 def test_explain_errors(tmp_path):
     run = os.path.join(TOP, "examples", "sim_gem.dat")
     with pytest.raises(pm.FileError):

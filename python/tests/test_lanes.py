@@ -236,7 +236,7 @@ def test_lanes_overflow_in_the_terms():
     """Coefficients so large that the terms overflow: the scalar call's
     error (outputs non-finite) at the same point."""
     m = random_model(2, 1e-3, seed=71)
-    c = m.coefficients
+    c = m.coefficients.copy()
     c[10] = 1e300
     m.coefficients = c
     ha, dec = sky_points(1003, seed=72, flipped=True)
@@ -279,7 +279,7 @@ def test_lanes_decline_other_models(fitted):
     for k in (2, 4):
         for v, ok in ((0.5, True), (-0.5, True), (np.nextafter(0.5, 1), False), (0.7, False)):
             m = fitted[2].copy()
-            c = m.coefficients
+            c = m.coefficients.copy()
             c[k] = v
             m.coefficients = c
             assert m._lanes_ok == ok, (k, v)

@@ -13,7 +13,7 @@ COLS = ["enc_ha", "enc_dec", "app_ha", "app_dec", "pier", "temp_c", "time_h", "d
 
 def truth(order=1, mount="equatorial", **terms):
     m = pm.Model(order=order, mount=mount)
-    c = m.coefficients
+    c = m.coefficients.copy()
     for name, v in terms.items():
         c[m.names.index(name.replace("_p", "'"))] = v / pm.RAD2ARCSEC
     m.coefficients = c
