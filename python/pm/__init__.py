@@ -112,19 +112,42 @@ def _path(path, what="path"):
         raise ArgumentError("%s: expected a file name, got %r" % (what, path)) from None
 
 
-def _as_float(name, value):
+def _index(a, i):
+    """"[i, j]" for the flat index i of array a ("" for a scalar)."""
+    where = _np.unravel_index(i, a.shape) if a.ndim else ()
+    return "[%s]" % ", ".join(str(int(j)) for j in where) if where else ""
+
+
+def _as_float(name, value, what="numbers"):
+    """value as a float64 array.  ArgumentError, naming the argument, for
+    what numpy would turn silently into a wrong number: complex values
+    (their real part, with only a ComplexWarning), and anything that is not
+    a number."""
     try:
-        a = _np.asarray(value, dtype=_np.float64)
+        a = _np.asarray(value)
     except (TypeError, ValueError) as e:
-        raise ArgumentError("%s: expected numbers (%s)" % (name, e)) from None
-    return a
+        raise ArgumentError("%s: expected %s (%s)" % (name, what, e)) from None
+    if a.dtype.kind == "O":  # a Python loop, for object arrays only
+        for i, x in enumerate(a.reshape(-1)):
+            if isinstance(x, (complex, _np.complexfloating)):
+                raise ArgumentError("%s%s is %r: expected a real number (complex values; "
+                                    "take .real to drop the imaginary part)" % (
+                                        name, _index(a, i), x))
+    elif a.dtype.kind == "c":
+        if not a.size:
+            raise ArgumentError("%s: expected real numbers, got %s" % (name, a.dtype))
+        i = int(_np.argmax(a.reshape(-1).imag != 0))  # the first with an imaginary part
+        raise ArgumentError("%s%s is %r: expected a real number (%s values; take .real to "
+                            "drop the imaginary part)" % (name, _index(a, i),
+                                                          a.reshape(-1)[i].item(), a.dtype))
+    try:
+        return a.astype(_np.float64, copy=False)
+    except (TypeError, ValueError) as e:
+        raise ArgumentError("%s: expected %s (%s)" % (name, what, e)) from None
 
 
 def _as_int(name, value, allowed=None):
-    try:
-        f = _np.asarray(value, dtype=_np.float64)
-    except (TypeError, ValueError) as e:
-        raise ArgumentError("%s: expected integers (%s)" % (name, e)) from None
+    f = _as_float(name, value, "integers")
     if f.size and not (_np.isfinite(f).all() and (f == _np.round(f)).all()):
         raise ArgumentError("%s: expected integers" % name)
     a = f.astype(_np.int64)
@@ -137,9 +160,8 @@ def _first_bad(name, a):
     """NonFiniteError naming the first non-finite element of a."""
     flat = a.reshape(-1)
     i = int(_np.flatnonzero(~_np.isfinite(flat))[0])
-    where = _np.unravel_index(i, a.shape) if a.ndim else ()
-    idx = "[%s]" % ", ".join(str(int(j)) for j in where) if where else ""
-    return NonFiniteError("%s%s is %r: expected a finite number" % (name, idx, float(flat[i])))
+    return NonFiniteError("%s%s is %r: expected a finite number" % (name, _index(a, i),
+                                                                   float(flat[i])))
 
 
 def _broadcast(named):
@@ -290,7 +312,11 @@ class Model(_pm.Model):
 
     @coefficients.setter
     def coefficients(self, value):
-        _pm.Model.coefficients.__set__(self, value)
+        c = _as_float("coefficients", value)
+        if c.shape != (self.n_terms,):
+            raise ArgumentError("coefficients: expected %d numbers (one per term), got shape %s"
+                                % (self.n_terms, c.shape))
+        _pm.Model.coefficients.__set__(self, c)
 
     def copy(self):
         return Model._wrap(self)

@@ -217,8 +217,12 @@ def test_bad_coefficients_leave_the_model_unchanged():
     c = np.arange(m.n_terms) * 1e-6
     m.coefficients = c
     before = m.apply(0.3, 0.4)
-    for bad in (np.full(m.n_terms, np.nan), np.full(m.n_terms, 1e200), np.ones(3), "x"):
-        with pytest.raises((pm.ArgumentError, TypeError)):
+    for bad, what in ((np.full(m.n_terms, np.nan), "PM_ERR_NONFINITE"),
+                      (np.full(m.n_terms, 1e200), "coefficients"),
+                      (np.ones(3), r"expected 22 numbers \(one per term\), got shape \(3,\)"),
+                      ("x", "coefficients: expected numbers"),
+                      (np.zeros(m.n_terms) + 1j, r"coefficients\[0\] is 1j: expected a real")):
+        with pytest.raises(pm.ArgumentError, match=what):
             m.coefficients = bad
         assert (m.coefficients == c).all()
         assert m.apply(0.3, 0.4) == before
@@ -241,6 +245,50 @@ def test_model_coefficients_are_read_only():
     assert m.apply(0.3, 0.4) != before
     m.coefficients = list(c - 0.01 * (np.arange(m.n_terms) == 2))  # any sequence of numbers
     assert m.apply(0.3, 0.4) == before
+
+
+def _real_inputs_cases(m, fit, run):
+    """(label, call, name): call(x) passes x to one argument of each function
+    that converts arrays; name is how the message names that argument."""
+    ha, dec = np.linspace(-1, 1, 8), np.full(8, 0.4)
+    return [
+        ("apply", lambda x: m.apply(x, dec), "enc_ha"),
+        ("apply, dec", lambda x: m.apply(ha, x), "enc_dec"),
+        ("apply, pier", lambda x: m.apply(ha, dec, pier=x), "pier"),
+        ("invert", lambda x: m.invert(x, dec), "app_ha"),
+        ("invert, side", lambda x: m.invert(ha, dec, side=x), "side"),
+        ("invert, start", lambda x: m.invert(ha, dec, start_ha=x, start_dec=dec), "start_ha"),
+        ("residual", lambda x: m.residual(ha, dec, ha, x), "app_dec"),
+        ("pointing_sigma", lambda x: fit.pointing_sigma(ha, x), "enc_dec"),
+        ("Model", lambda x: pm.Model(latitude=x), "latitude"),
+        ("coefficients", lambda x: setattr(m, "coefficients", x), "coefficients"),
+        ("fit", lambda x: pm.fit(ha, dec, x, dec), "app_ha"),
+        ("from_arrays, temp_c", lambda x: pm.Run.from_arrays(ha, dec, ha, dec, temp_c=x),
+         "temp_c"),
+        ("explain, gears", lambda x: pm.explain(run, gears=x), "gears"),
+        ("plan, lst", lambda x: pm.plan(run, lst=x), "lst"),
+    ]
+
+
+@pytest.mark.filterwarnings("error")  # numpy's ComplexWarning would be one
+def test_complex_inputs_are_argument_errors():
+    """Complex numbers are never cut to their real part (numpy's cast, with
+    only a ComplexWarning): ArgumentError naming the argument and the first
+    element with an imaginary part, from every function that converts
+    arrays."""
+    m = pm.Model(order=1)
+    run = pm.read_run(os.path.join(TOP, "examples", "sim_gem.dat"))
+    fit = pm.fit_run(run)
+    before = m.coefficients
+    for label, call, name in _real_inputs_cases(m, fit, run):
+        for x, where in ((np.array([0.3, 0.3 + 0.5j] + [0.3] * 6), r"\[1\] is \(0\.3\+0\.5j\)"),
+                         (np.complex128(1j), r" is 1j"),
+                         (np.array([0.1, 2j] + [0.1] * 6, dtype=object), r"\[1\] is 2j")):
+            with pytest.raises(pm.ArgumentError, match=r"^%s%s: expected a real number" % (
+                    name, where)):
+                call(x)
+    assert np.array_equal(m.coefficients, before)
+    m.coefficients = np.zeros(m.n_terms, dtype=np.complex64).real  # .real: taken
 
 
 def test_explain_errors(tmp_path):
