@@ -120,15 +120,19 @@ def _index(a, i):
 
 def _as_float(name, value, what="numbers"):
     """value as a float64 array.  ArgumentError, naming the argument, for
-    what numpy would turn silently into a wrong number: complex values
-    (their real part, with only a ComplexWarning), and anything that is not
-    a number."""
+    what numpy would turn silently into a wrong number: None (NaN), complex
+    values (their real part, with only a ComplexWarning), and anything that
+    is not a number."""
+    if value is None:
+        raise ArgumentError("%s is None: not a number" % name)
     try:
         a = _np.asarray(value)
     except (TypeError, ValueError) as e:
         raise ArgumentError("%s: expected %s (%s)" % (name, what, e)) from None
     if a.dtype.kind == "O":  # a Python loop, for object arrays only
         for i, x in enumerate(a.reshape(-1)):
+            if x is None:
+                raise ArgumentError("%s%s is None: not a number" % (name, _index(a, i)))
             if isinstance(x, (complex, _np.complexfloating)):
                 raise ArgumentError("%s%s is %r: expected a real number (complex values; "
                                     "take .real to drop the imaginary part)" % (

@@ -118,8 +118,6 @@ def test_arrays_shape_and_type_errors():
         m.apply([0.1, 0.2], [0.1, 0.2, 0.3])
     with pytest.raises(pm.ArgumentError, match="expected numbers"):
         m.apply("north", 0.1)
-    with pytest.raises(pm.NonFiniteError, match=r"enc_ha\[1\] is nan"):
-        m.apply([0.1, None], [0.1, 0.2])  # None reads as NaN
     with pytest.raises(pm.ArgumentError):
         m.apply([1j], [0.1])
     with pytest.raises(pm.ArgumentError, match="side"):
@@ -220,7 +218,7 @@ def test_bad_coefficients_leave_the_model_unchanged():
     for bad, what in ((np.full(m.n_terms, np.nan), "PM_ERR_NONFINITE"),
                       (np.full(m.n_terms, 1e200), "coefficients"),
                       (np.ones(3), r"expected 22 numbers \(one per term\), got shape \(3,\)"),
-                      ("x", "coefficients: expected numbers"),
+                      ("x", "coefficients: expected numbers"), (None, "coefficients is None"),
                       (np.zeros(m.n_terms) + 1j, r"coefficients\[0\] is 1j: expected a real")):
         with pytest.raises(pm.ArgumentError, match=what):
             m.coefficients = bad
@@ -289,6 +287,27 @@ def test_complex_inputs_are_argument_errors():
                 call(x)
     assert np.array_equal(m.coefficients, before)
     m.coefficients = np.zeros(m.n_terms, dtype=np.complex64).real  # .real: taken
+
+
+@pytest.mark.filterwarnings("error")
+def test_none_inputs_are_not_numbers():
+    """None, or None in an object array, is not a number (numpy would read
+    it as NaN): ArgumentError saying so, not NonFiniteError "is nan"."""
+    m = pm.Model(order=1)
+    run = pm.read_run(os.path.join(TOP, "examples", "sim_gem.dat"))
+    fit = pm.fit_run(run)
+    for label, call, name in _real_inputs_cases(m, fit, run):
+        for x, where in ((np.array([0.1, None] + [0.1] * 6, dtype=object), r"\[1\]"),
+                         ([0.1, None] + [0.1] * 6, r"\[1\]")):
+            with pytest.raises(pm.ArgumentError, match=r"^%s%s is None: not a number$" % (
+                    name, where)) as e:
+                call(x)
+            assert type(e.value) is pm.ArgumentError, label
+    with pytest.raises(pm.ArgumentError, match=r"^enc_ha is None: not a number$") as e:
+        m.apply(None, 0.2)
+    assert type(e.value) is pm.ArgumentError
+    with pytest.raises(pm.ArgumentError, match=r"^coefficients is None: not a number$"):
+        m.coefficients = None
 
 
 def test_explain_errors(tmp_path):
