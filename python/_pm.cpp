@@ -1112,6 +1112,10 @@ std::string plan_run(const std::shared_ptr<RunData> &d, const std::string &mount
         p = plan_targets(run, po);
     } catch (const std::runtime_error &e) {
         std::string w = e.what();
+        // the host library words a bad date after pmfit's flag: here it is
+        // the keyword utc=
+        if (w.rfind("--utc: ", 0) == 0)
+            fail(K_ARGUMENT, w.substr(2));
         fail(w.rfind("--add", 0) == 0 ? K_ARGUMENT : K_ERROR, w);
     }
     return plan_json(p, po, run.obs.size());

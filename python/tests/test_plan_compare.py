@@ -80,6 +80,11 @@ def test_plan_errors(tmp_path):
     cat.write_text("1 2 x\n")
     with pytest.raises(pm.ArgumentError, match="needs the time"):
         pm.plan(SIM, catalogue=cat)
+    # a bad date is worded with the keyword utc, not pmfit's flag --utc
+    for utc in ("2024-13-01T20:00", "tonight"):
+        with pytest.raises(pm.ArgumentError) as e:
+            pm.plan(SIM, catalogue=cat, utc=utc, lon=20)
+        assert str(e.value) == ("utc: expected YYYY-MM-DDTHH:MM[:SS] (UTC), got '%s'" % utc)
 
 
 def test_compare_equals_pmfit(tmp_path):
