@@ -1,5 +1,5 @@
-"""The examples in the documentation run: the Python block of docs/python.md
-and examples/python_demo.py (make demo)."""
+"""The examples in the documentation run: the Python blocks of docs/python.md
+and README.md, and examples/python_demo.py (make demo)."""
 import os
 import re
 import subprocess
@@ -21,6 +21,19 @@ def test_docs_python_md_example_runs(tmp_path, monkeypatch, capsys):
     assert "N = 300, P = 22, sigma = 2.203 arcsec" in out
     assert "['refraction', 'ha_periodic']" in out
     assert "tests/data/bad_pier.dat:2: field 5 (pier)" in out
+
+
+def test_readme_python_block_runs(monkeypatch):
+    """README.md's Python snippet runs as written (every name it uses defined
+    there), from the repository root."""
+    text = open(os.path.join(TOP, "README.md")).read()
+    blocks = re.findall(r"```python\n(.*?)```", text, re.S)
+    assert blocks, "no python block in README.md"
+    monkeypatch.chdir(TOP)
+    for code in blocks:
+        g = {}
+        exec(compile(code, "README.md", "exec"), g)
+        assert g["enc_ha"].shape == g["app_ha"].shape
 
 
 def test_python_demo_runs():
