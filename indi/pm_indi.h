@@ -47,7 +47,9 @@ typedef struct pm_indi_result {
     double cv[PM_INDI_MAX_ORDER + 1]; /* leave-one-out rms per axis of each
                           order fitted (radians; -1 not fitted, HUGE_VAL
                           when a point alone determines terms) */
-    char bad_term[48]; /* the term that made the last given-up fit singular */
+    char bad_term[64]; /* why the last given-up fit failed: the term that
+                          made it singular, else pm's status in words
+                          ("the fit did not converge") */
 } pm_indi_result;
 
 /*
@@ -99,6 +101,10 @@ int pm_indi_choose_order(long n, double spread);
 pm_status pm_indi_fit(int mount, long n, const double *enc1, const double *enc2,
                       const double *app1, const double *app2, pm_fit *fit,
                       pm_model *out, pm_indi_result *res);
+
+/* A pm_status in words for the log (the meanings of include/pm.h's enum,
+** as pmfit and the Python package print them; "unknown status" for others). */
+const char *pm_indi_status_words(pm_status s);
 
 /* One line for the log: what model, from how many points, its sigma. */
 void pm_indi_describe(const pm_indi_result *res, long n, long skipped, char *buf, size_t len);
