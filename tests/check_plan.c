@@ -411,6 +411,16 @@ START_TEST(test_plan_catalogue)
     ck_assert_int_eq((int)tu_json_num(out, "candidates"), above); /* one side each (GEM, run rule) */
     n = parse_targets(out, t, 20);
     ck_assert_int_eq(n, 20);
+    ck_assert_ptr_null(strstr(out, "targets asked for"));
+    /* more asked for than there are stars above the horizon: all of them,
+    ** and the note says so */
+    snprintf(args, sizeof args, "--next %d --json --catalog '%s' --lst 6", above + 5, cat);
+    ck_assert_msg(plan_cli(args) == 0, "%s", out);
+    snprintf(line, sizeof line, "only %d of the %d targets asked for: the catalogue has no more",
+             above, above + 5);
+    ck_assert_msg(strstr(out, line) != NULL, "%s", out);
+    snprintf(args, sizeof args, "--next 20 --json --catalog '%s' --lst 6", cat);
+    ck_assert_msg(plan_cli(args) == 0, "%s", out);
     for (i = 0; i < n; i++) {
         int k = -1;
         ck_assert(t[i].name[0]);

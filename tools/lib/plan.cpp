@@ -617,6 +617,14 @@ Plan plan_targets(const Run &taken, const PlanOptions &o)
         t.slew_s = secs[k];
         plan.targets.push_back(t);
     }
+    if ((int)plan.targets.size() < o.next) { // (each candidate is taken once)
+        std::string fewer =
+            "only " + std::to_string(plan.targets.size()) + " of the " + std::to_string(o.next) +
+            " targets asked for: " +
+            (o.stars.empty() ? "the grid has no more usable places (a finer --grid has more)"
+                             : "the catalogue has no more usable stars " + horizon_text(o));
+        plan.note = plan.note.empty() ? fewer : plan.note + "; " + fewer;
+    }
     return plan;
 }
 
