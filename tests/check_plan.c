@@ -781,6 +781,25 @@ START_TEST(test_plan_bad_inputs)
     ck_assert_int_eq(plan_cli("--sides east"), 2);
     ck_assert_ptr_nonnull(strstr(out, "--sides: expected run, meridian or both"));
     ck_assert_int_eq(plan_cli("--utc 2024-13-01T00:00 --lon 10 --catalog x"), 1);
+    /* a time with anything after its minutes or seconds: refused (04:00x
+    ** was taken as 04:00) */
+    {
+        static const char *utc[4] = {"2024-03-20T04:00x", "2024-03-20T04:00:30x",
+                                     "2024-03-20T04:00:", "2024-03-20T04:00:30"};
+        const char *top = getenv("PM_TOP");
+        int k;
+        for (k = 0; k < 4; k++) {
+            snprintf(args, sizeof args, "--utc %s --lon 20 --catalog '%s/examples/bright_stars.txt'",
+                     utc[k], top && *top ? top : ".");
+            if (k < 3) {
+                ck_assert_msg(plan_cli(args) == 1, "%s: %s", utc[k], out);
+                ck_assert_msg(strstr(out, "--utc: expected YYYY-MM-DDTHH:MM[:SS]") != NULL, "%s",
+                              out);
+            } else {
+                ck_assert_msg(plan_cli(args) == 0, "%s: %s", utc[k], out);
+            }
+        }
+    }
     /* --mount against the run's own mount: its observations would be read
     ** as the other mount's axes (it planned an alt-az sky from a German run
     ** before); the same mount is accepted */

@@ -316,13 +316,20 @@ namespace {
 // The UTC of a SkyTime as an ERFA two-part quasi-JD; false if unparsable.
 bool utc_jd(const std::string &s, double &u1, double &u2)
 {
-    int y, mo, d, h = 0, mi = 0;
+    int y, mo, d, h = 0, mi = 0, used = -1;
     double sec = 0;
-    char tail = 0;
-    int n = std::sscanf(s.c_str(), "%d-%d-%d%*[T ]%d:%d:%lf%c", &y, &mo, &d, &h, &mi, &sec, &tail);
-    if (n == 5)
-        sec = 0;
-    if (n < 5 || n == 7 || h < 0 || h > 23 || mi < 0 || mi > 59 || !(sec >= 0 && sec < 61))
+    if (std::sscanf(s.c_str(), "%d-%d-%d%*[T ]%d:%d%n", &y, &mo, &d, &h, &mi, &used) != 5 ||
+        used < 0)
+        return false;
+    const char *rest = s.c_str() + used;
+    if (*rest == ':') { // seconds, then nothing ("04:00x" was taken as 04:00)
+        int more = -1;
+        if (std::sscanf(rest + 1, "%lf%n", &sec, &more) != 1 || more < 0 || rest[1 + more])
+            return false;
+    } else if (*rest) {
+        return false;
+    }
+    if (h < 0 || h > 23 || mi < 0 || mi > 59 || !(sec >= 0 && sec < 61))
         return false;
     return eraDtf2d("UTC", y, mo, d, h, mi, sec, &u1, &u2) >= 0;
 }
