@@ -343,6 +343,32 @@ START_TEST(test_pmfit_undetermined)
 }
 END_TEST
 
+/* The sign of a refraction finding in words: the run's places below
+** where the telescope points (c < 0) is refraction missing from the
+** reduction -- as --no-refraction shows on a real run (docs/model.md: c
+** moves by -A) -- and above (c > 0) too much of it.  The words had the two
+** the other way round. */
+START_TEST(test_pmfit_explain_refraction_words)
+{
+    static const double size[2] = {-20, 20};
+    static const char *said[2] = {"refraction missing from the reduction",
+                                  "refraction over-corrected"};
+    char runp[300], cmd[2400];
+    int k;
+    make_tmpdir();
+    snprintf(runp, sizeof runp, "%s/refr.dat", tmpdir);
+    for (k = 0; k < 2; k++) {
+        snprintf(cmd, sizeof cmd,
+                 "%s simulate %s --lat 40 --seed 7 --noise 1 --effect refraction=%g > /dev/null "
+                 "&& %s explain %s",
+                 tu_pmfit_path(), runp, size[k], tu_pmfit_path(), runp);
+        ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
+        ck_assert_msg(strstr(out, said[k]) != NULL, "refraction %g: %s", size[k], out);
+        ck_assert_msg(strstr(out, said[1 - k]) == NULL, "refraction %g: %s", size[k], out);
+    }
+}
+END_TEST
+
 static Suite *suite(void)
 {
     Suite *s = suite_create("pmfit");
@@ -357,6 +383,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_pmfit_output_not_input);
     tcase_add_test(tc, test_pmfit_output_targets);
     tcase_add_test(tc, test_pmfit_undetermined);
+    tcase_add_test(tc, test_pmfit_explain_refraction_words);
     tcase_set_timeout(tc, 60);
     suite_add_tcase(s, tc);
     return s;

@@ -288,15 +288,22 @@ void describe_pier(const Run &run, const State &st, const Candidate &c,
 }
 
 // What a one-family effect is, in the mount's vocabulary; sign: of the
-// (single) coefficient of refraction and tube flexure, + toward the zenith.
+// (single) coefficient of refraction and tube flexure, + toward the zenith:
+// the place the run gives is the encoder's moved that way.  Refraction
+// raises a star, so a reduction without it gives places below where the
+// telescope points: c < 0 (c = -A, docs/model.md; --no-refraction on
+// gem-28 moves c by -55"); c > 0 is more lift than the air gave.  (The
+// words had the two the other way round until stop 38.)
 const char *family_words(const Run &run, const std::string &e, double sign)
 {
     bool az = run.mount == PM_MOUNT_ALTAZ;
     if (e == "refraction")
-        return sign >= 0 ? "an elevation-dependent shift toward the zenith growing as cot(el): "
-                           "refraction missing from the reduction or under-corrected"
-                         : "an elevation-dependent shift toward the horizon growing as cot(el): "
-                           "refraction over-corrected (applied twice, or a wrong pressure)";
+        return sign < 0 ? "an elevation-dependent shift toward the horizon growing as cot(el): "
+                          "refraction missing from the reduction or under-corrected (the "
+                          "stars are higher than the run's places say)"
+                        : "an elevation-dependent shift toward the zenith growing as cot(el): "
+                          "refraction over-corrected (applied twice, or a wrong pressure or "
+                          "temperature)";
     if (e == "tube_flexure")
         return sign < 0 ? (az ? "elevation-dependent flexure: the tube sags toward the horizon as cos(el)"
                               : "tube flexure: a sag toward the horizon growing as cos(el)")
