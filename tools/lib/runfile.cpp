@@ -639,6 +639,42 @@ void check_duplicates(Context &ctx)
                  first_of, repeats, repeats == 1 ? "" : "s");
 }
 
+// A named-column run of a German mount with both pier sides and no
+// encoder declination beyond +-90 deg writes its W records folded back
+// into the sky position (the convention of ASCOM logs, whose pierWest is
+// "through the pole"): mechanically one side must be beyond the pole.
+// Its W records are read as the mount's axes are, (HA + 180, +-180 - dec):
+// as they were, d, e', i and the order-1 terms of those base vectors
+// changed sign across the flip by the file's convention, and explain read
+// that as physics (a pier-side flexure of 310" and order 3 on a run of
+// 2" noise).  enc_raw keeps the file's values; a note says so.
+void unfold_sky_convention(Context &ctx)
+{
+    pmrun *run = ctx.run();
+    if (run->format != PMRUN_FORMAT_NAMED || run->mount != PMRUN_MOUNT_EQUATORIAL)
+        return;
+    int first_w = 0;
+    bool east = false;
+    for (const pmrun_obs &o : run->obs) {
+        if (std::fabs(o.enc_dec) > kPi / 2)
+            return; // beyond the pole: the mount's own convention
+        east = east || o.pier == PMRUN_PIER_EAST;
+        if (o.pier == PMRUN_PIER_WEST && !first_w)
+            first_w = o.line;
+    }
+    if (!east || !first_w)
+        return;
+    for (pmrun_obs &o : run->obs)
+        if (o.pier == PMRUN_PIER_WEST) {
+            o.enc_ha = std::remainder(o.enc_ha + kPi, 2 * kPi);
+            o.enc_dec = (o.enc_dec >= 0 ? kPi : -kPi) - o.enc_dec;
+        }
+    ctx.warn(first_w,
+             "both pier sides and no encoder declination beyond +-90 deg: the W records are "
+             "the sky position folded back (as ASCOM's pierWest, through the pole); read as the "
+             "mount's axes, (HA + 180, 180 - dec) (docs/formats.md, \"Beyond the pole\")");
+}
+
 // One encoder convention per run (docs/formats.md, "Beyond the pole"): a
 // pier column must relate to the encoder declination the same way for all
 // records of a side, and the encoder axis 1 (beyond the pole turned back by
@@ -780,6 +816,7 @@ int read_file(Context &ctx)
         return ctx.status();
     }
     if (!parser->finish(rd.number())) return ctx.status();
+    unfold_sky_convention(ctx);
     if (!check_conventions(ctx)) return ctx.status();
     check_duplicates(ctx);
     ctx.finish_messages();
