@@ -196,7 +196,15 @@ START_TEST(test_pmrun_read_named_columns)
     ck_assert_int_eq(o->pier, PMRUN_PIER_WEST);
     ck_assert_int_eq(o->dir, 0);
     ck_assert_double_eq_tol(o->aux[1], -12.5, 1e-12);
-    ck_assert_double_eq_tol(o->enc_dec, -20.0 * DEG, TOL_PARSE_RAD);
+    /* both sides, no encoder dec beyond 90: the W records are the sky
+    ** position folded back, read as the mount's axes (HA + 180, -180 -
+    ** dec), the file's values in enc_raw, and a note */
+    ck_assert_double_eq_tol(o->enc_dec, -160.0 * DEG, TOL_PARSE_RAD);
+    ck_assert_double_eq_tol(o->enc_ha, -160.0 * DEG, TOL_PARSE_RAD);
+    ck_assert_double_eq_tol(o->enc_raw[1], -20.0 * DEG, TOL_PARSE_RAD);
+    ck_assert_double_eq_tol(o->enc_raw[0], 20.0 * DEG, TOL_PARSE_RAD);
+    ck_assert_double_eq_tol(pmrun_get(run, 0)->enc_dec, 45.25 * DEG, TOL_PARSE_RAD);
+    ck_assert_int_ge(find_warning(run, "named.dat:7:", "the W records are the sky position"), 0);
     pmrun_free(run);
 }
 END_TEST
