@@ -369,6 +369,33 @@ START_TEST(test_pmfit_explain_refraction_words)
 }
 END_TEST
 
+/* 20 points of an alt-az mount (a 20" azimuth runout under 3" noise):
+** order 1's 22 terms are more than they determine (cross-validated RMS
+** 18-21" against order 0's 8-10"); explain says so and points to --order
+** 0, where it said the harmonics were "that one term" of a refraction
+** consistent with zero.  The example run of 300 points: no such note. */
+START_TEST(test_pmfit_explain_few_points_order0)
+{
+    char runp[300], cmd[2400];
+    const char *top = getenv("PM_TOP");
+    make_tmpdir();
+    snprintf(runp, sizeof runp, "%s/az20.dat", tmpdir);
+    snprintf(cmd, sizeof cmd,
+             "%s simulate %s --mount altaz --n 20 --noise 3 --seed 2 --effect ha_periodic:2=20 "
+             "> /dev/null && %s explain %s",
+             tu_pmfit_path(), runp, tu_pmfit_path(), runp);
+    ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
+    ck_assert_msg(strstr(out, "order 0 alone predicts better than the order-1 baseline") != NULL,
+                  "%s", out);
+    ck_assert_msg(strstr(out, "explain with --order 0") != NULL, "%s", out);
+    ck_assert_msg(strstr(out, "are that one term") == NULL, "%s", out);
+    snprintf(cmd, sizeof cmd, "%s explain %s/examples/sim_gem.dat", tu_pmfit_path(),
+             top ? top : ".");
+    ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
+    ck_assert_msg(strstr(out, "order 0 alone predicts") == NULL, "%s", out);
+}
+END_TEST
+
 static Suite *suite(void)
 {
     Suite *s = suite_create("pmfit");
@@ -384,6 +411,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_pmfit_output_targets);
     tcase_add_test(tc, test_pmfit_undetermined);
     tcase_add_test(tc, test_pmfit_explain_refraction_words);
+    tcase_add_test(tc, test_pmfit_explain_few_points_order0);
     tcase_set_timeout(tc, 60);
     suite_add_tcase(s, tc);
     return s;

@@ -787,8 +787,9 @@ void fail_fit(const FitOut &f, const std::string &what)
         std::snprintf(buf, sizeof buf, "%.6f", f.corr);
         msg += " in " + std::to_string(MAX_PASSES) +
                " passes: the sky coverage hardly separates " + term_name(m, f.corr_j) +
-               " from " + term_name(m, f.corr_i) + " (correlation " + buf +
-               "); lower --order or use both pier sides";
+               " from " + term_name(m, f.corr_i) + " (correlation " + buf + "); lower --order or " +
+               (m.mount == PM_MOUNT_ALTAZ ? "add stars over more of the sky"
+                                          : "use both pier sides");
     }
     if (f.status == PM_ERR_TOO_FEW)
         msg += " (P = " + std::to_string(m.n_terms) + " terms need at least " +

@@ -290,8 +290,9 @@ def test_explain_compose_matches_pmfit():
 
 
 def test_read_run_columns(tmp_path):
-    """The reader's columns: what the file says, in radians, pier from the
-    column, skipped records listed with file:line."""
+    """The reader's columns: what the file says, in radians (a folded W
+    record as the mount's axes), pier from the column, skipped records
+    listed with file:line."""
     f = tmp_path / "r.dat"
     f.write_text("# tau delta T D pier temp\n"
                  "10 20 10.01 20.02 E 5.5\n"
@@ -307,7 +308,11 @@ def test_read_run_columns(tmp_path):
     assert list(r.temp_c) == [5.5, 6.0, 7.0]
     assert r.format == "named" and r.mount == "equatorial"
     assert len(r.skipped) == 1 and r.skipped[0].startswith(str(f) + ":4:")
-    assert np.allclose(np.degrees(r.enc_ha), [10, -30, 100], atol=1e-12)
+    # both pier sides, no encoder dec beyond 90: the W record is the sky
+    # position folded back (ASCOM's pierWest), read as the mount's axes,
+    # (HA + 180, 180 - dec) (docs/formats.md, "Beyond the pole")
+    assert np.allclose(np.degrees(r.enc_ha), [10, 150, 100], atol=1e-12)
+    assert np.allclose(np.degrees(r.enc_dec), [20, 135, -10], atol=1e-12)
     assert np.allclose(np.degrees(r.app_dec), [20.02, 45.01, -10.03], atol=1e-12)
     with pytest.raises(ValueError):
         r.enc_ha[0] = 1.0  # read-only: the run stays what was read

@@ -1252,7 +1252,10 @@ State baseline(const Run &run, const ExplainOptions &opt)
     else if (f.status == PM_ERR_SINGULAR && f.bad_term >= 0)
         why = "term " + term_name(f.model, f.bad_term) + " cannot be determined from these observations";
     else if (f.status == PM_ERR_DIVERGED)
-        why = "the fit did not converge";
+        why = "the fit did not converge" +
+              (st.order > 0 ? std::string(" (--order ") + std::to_string(st.order - 1) +
+                                  " fits fewer terms)"
+                            : std::string());
     throw std::runtime_error(run.path + ": the baseline fit failed: " + why +
                              "; try pmfit fit for details");
 }
@@ -1484,6 +1487,28 @@ std::string physical_reading(const Run &run, const Explanation &ex, const Explai
         best_cv = cv;
         best_val = arcsec(f.f.model.coef[6]);
         best_err = arcsec(f.f.res.err[6]);
+    }
+    // A term consistent with zero is not what the harmonics are: then it is
+    // order 0 alone that predicts as well (few points: the order-1 terms
+    // are more than the run determines; 20 points said "the 16 harmonic
+    // terms are that one term" of 0.44" +- 3.07").
+    if (!best.empty() && !(std::fabs(best_val) >= 3 * best_err)) {
+        std::vector<int> use(run.obs.size());
+        std::iota(use.begin(), use.end(), 0);
+        Fit f0 = fit_spec(run, use, 0, {});
+        double cv0 = arcsec(cv_of(run, use, 0, {}, opt, f0, ex.cv_left_out));
+        if (f0.ok && cv0 <= ex.base_cv_rms_arcsec) {
+            char buf[512];
+            std::snprintf(buf, sizeof buf,
+                          "order 0 alone predicts %s the order-1 baseline (cross-validated "
+                          "RMS %.3f\" vs %.3f\"): the %d harmonic terms of order 1 are more than "
+                          "these %zu points determine, and effects may hide in them; explain with "
+                          "--order 0",
+                          cv0 < ex.base_cv_rms_arcsec ? "better than" : "as well as", cv0,
+                          ex.base_cv_rms_arcsec, ex.base_n_params - 6, run.obs.size());
+            return buf;
+        }
+        return "";
     }
     if (best.empty())
         return "";

@@ -44,7 +44,8 @@ std::string finding_json(const Finding &f)
              num(f.cycles_lo) + ", " + num(f.cycles_hi) + "], \"axis_sampled_deg\": " +
              num(f.sampled_deg) + ", \"phase_deg\": " + num(f.phase_deg);
     j += ", \"amplitude_arcsec\": " + num(f.amplitude_arcsec) +
-         ", \"amplitude_error_arcsec\": " + num(f.amplitude_err_arcsec) +
+         ", \"amplitude_error_arcsec\": " +
+         (f.amplitude_err_arcsec > 0 ? num(f.amplitude_err_arcsec) : std::string("null")) +
          ", \"false_alarm_probability\": " + num(f.false_alarm_probability) +
          ", \"log10_false_alarm_probability\": " + num(f.log10_p) +
          ", \"sigma_after_arcsec\": " + num(f.sigma_after_arcsec) +

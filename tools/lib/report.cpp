@@ -200,8 +200,10 @@ const char *status_words(pm_status s)
                "drop the term or add points)";
     if (f.status == PM_ERR_DIVERGED && f.corr_i >= 0)
         msg += fmt(": the sky coverage hardly separates %s from %s (correlation %.6f); lower "
-                   "--order or use both pier sides",
-                   term_name(m, f.corr_j).c_str(), term_name(m, f.corr_i).c_str(), f.corr);
+                   "--order or %s",
+                   term_name(m, f.corr_j).c_str(), term_name(m, f.corr_i).c_str(), f.corr,
+                   m.mount == PM_MOUNT_ALTAZ ? "add stars over more of the sky"
+                                             : "use both pier sides");
     if (f.status == PM_ERR_TOO_FEW)
         msg += fmt(" (P = %d terms need at least %d observations, 2N > P; there are %ld; lower "
                    "--order)", m.n_terms, m.n_terms / 2 + 1, f.res.n_obs);
