@@ -190,6 +190,80 @@ START_TEST(test_pmmodel_version_1)
 }
 END_TEST
 
+/* A version-2 file's side-specific c' or d term (an added SH term of
+** l = 0): its base vector, cos d or -sin d, moved to the index-shifted
+** position with every other; such files were read without a word and
+** pointed up to 5.75" differently.  Refused as the moved harmonics are;
+** e'@W and i@W (constant base vectors) still read. */
+START_TEST(test_pmmodel_version_2_side_terms)
+{
+    static const char *xterm[4] = {"xterm c'@W sh 3 0 0 -1 0 0 -0.0007",
+                                   "xterm d@W sh 4 0 0 -1 0 0 -0.0005",
+                                   "xterm e'@W sh 5 0 0 -1 0 0 0.0003",
+                                   "xterm i@W sh 6 0 0 -1 0 0 0.0002"};
+    pm_model m;
+    char path[300], err[512], where[320];
+    int k;
+    make_tmpdir();
+    path_in(path, sizeof path, "v2.pm");
+    for (k = 0; k < 4; k++) {
+        FILE *f = fopen(path, "w");
+        ck_assert_ptr_nonnull(f);
+        fprintf(f, "pm-model 2\nmount equatorial\norder 0\nlatitude -0.8\nterms 7\n"
+                   "term a 1 0 0 -0.0008\nterm b 2 0 0 0.00085\nterm c' 3 0 0 -0.013\n"
+                   "term d 4 0 0 -0.00045\nterm e' 5 0 0 0.0287\nterm i 6 0 0 -0.00036\n"
+                   "%s\nend\n", xterm[k]);
+        fclose(f);
+        if (k < 2) {
+            ck_assert_int_eq(pmmodel_load(path, &m, err, sizeof err), -1);
+            snprintf(where, sizeof where, "%s:12:", path);
+            ck_assert_msg(strstr(err, where) && strstr(err, "'pm-model 2'") && strstr(err, "refit"),
+                          "%s", err);
+        } else {
+            ck_assert_msg(pmmodel_load(path, &m, err, sizeof err) == 0, "%s: %s", xterm[k], err);
+        }
+    }
+}
+END_TEST
+
+/* Save writes only what load reads back: a subnormal coefficient round
+** trips (strtod's ERANGE on underflow was taken for an error); a NaN
+** coefficient or a latitude beyond the pole is refused before anything is
+** written (it was written, and the file failed to load); emit-c refuses a
+** prefix that is not a C identifier. */
+START_TEST(test_pmmodel_save_only_what_loads)
+{
+    pm_model m, back;
+    char path[300], err[512];
+    make_tmpdir();
+    random_model(&m, 1, 7);
+    m.coef[7] = 1e-310;
+    m.coef[8] = -4.9e-324;
+    ck_assert_int_eq(pm_model_prepare(&m), PM_OK);
+    path_in(path, sizeof path, "sub.pm");
+    ck_assert_msg(pmmodel_save(path, &m, NULL, err, sizeof err) == 0, "%s", err);
+    ck_assert_msg(pmmodel_load(path, &back, err, sizeof err) == 0, "%s", err);
+    ck_assert(memcmp(&back.coef[7], &m.coef[7], sizeof(double)) == 0);
+    ck_assert(memcmp(&back.coef[8], &m.coef[8], sizeof(double)) == 0);
+    path_in(path, sizeof path, "nan.pm");
+    m.coef[3] = NAN;
+    ck_assert_int_eq(pmmodel_save(path, &m, NULL, err, sizeof err), -1);
+    ck_assert_msg(strstr(err, "not written") != NULL, "%s", err);
+    ck_assert_int_ne(access(path, F_OK), 0);
+    ck_assert_int_eq(pmmodel_emit_c(path, &m, "pm_x", NULL, err, sizeof err), -1);
+    ck_assert_int_ne(access(path, F_OK), 0);
+    m.coef[3] = 0;
+    m.latitude = 5;
+    ck_assert_int_eq(pmmodel_save(path, &m, NULL, err, sizeof err), -1);
+    ck_assert_int_ne(access(path, F_OK), 0);
+    m.latitude = 0.7;
+    ck_assert_int_eq(pmmodel_emit_c(path, &m, "my-model 1", NULL, err, sizeof err), -1);
+    ck_assert_msg(strstr(err, "not a C identifier") != NULL, "%s", err);
+    ck_assert_int_ne(access(path, F_OK), 0);
+    ck_assert_msg(pmmodel_emit_c(path, &m, "_my_model1", NULL, err, sizeof err) == 0, "%s", err);
+}
+END_TEST
+
 START_TEST(test_pmmodel_load_binary_and_missing)
 {
     pm_model m;
@@ -271,6 +345,8 @@ static Suite *suite(void)
     TCase *tc = tcase_create("roundtrip");
     tcase_add_test(tc, test_pmmodel_save_load_roundtrip_bit_exact);
     tcase_add_test(tc, test_pmmodel_emit_c_compiles_and_loads);
+    tcase_add_test(tc, test_pmmodel_version_2_side_terms);
+    tcase_add_test(tc, test_pmmodel_save_only_what_loads);
     tcase_set_timeout(tc, 60);
     suite_add_tcase(s, tc);
     tc = tcase_create("errors");

@@ -396,6 +396,37 @@ START_TEST(test_pmfit_explain_few_points_order0)
 }
 END_TEST
 
+/* eval of a model whose terms read an input the run does not give (a
+** temperature model on a run without temperatures): an error at the first
+** such record, where it printed "sky RMS 0.000"" with exit 0.  And a model
+** file whose first comment is longer than 255 bytes (pmfit's own
+** undetermined-fit warning is ~290) is still a model file to compare. */
+START_TEST(test_pmfit_eval_missing_input_and_long_comment)
+{
+    char model[300], longm[300], cmd[2400], args[1400];
+    const char *top = getenv("PM_TOP");
+    if (!top)
+        top = ".";
+    make_tmpdir();
+    snprintf(model, sizeof model, "%s/t.pm", tmpdir);
+    snprintf(args, sizeof args, "%s/tests/data/indep_temp_sag_gem.dat --order 0 --add temperature "
+             "--save %s", top, model);
+    ck_assert_msg(run("%s fit %s%s", args, "") == 0, "%s", out);
+    snprintf(args, sizeof args, "%s %s/tests/data/four_column.dat", model, top);
+    ck_assert_int_eq(run("%s eval %s%s", args, ""), 1);
+    ck_assert_msg(strstr(out, "four_column.dat:5: ") != NULL &&
+                      strstr(out, "cannot be evaluated here") != NULL &&
+                      strstr(out, "c'*temp") != NULL, "%s", out);
+    ck_assert_ptr_null(strstr(out, "sky RMS"));
+    /* the long comment */
+    snprintf(longm, sizeof longm, "%s/long.pm", tmpdir);
+    snprintf(cmd, sizeof cmd, "{ printf '# %%0300d\\n' 0; cat '%s'; } > '%s'", model, longm);
+    ck_assert_int_eq(system(cmd), 0);
+    snprintf(args, sizeof args, "%s %s/tests/data/indep_temp_sag_gem.dat", longm, top);
+    ck_assert_msg(run("%s compare %s%s", args, "") == 0, "%s", out);
+}
+END_TEST
+
 static Suite *suite(void)
 {
     Suite *s = suite_create("pmfit");
@@ -412,6 +443,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_pmfit_undetermined);
     tcase_add_test(tc, test_pmfit_explain_refraction_words);
     tcase_add_test(tc, test_pmfit_explain_few_points_order0);
+    tcase_add_test(tc, test_pmfit_eval_missing_input_and_long_comment);
     tcase_set_timeout(tc, 60);
     suite_add_tcase(s, tc);
     return s;

@@ -935,7 +935,21 @@ int cmd_eval(const Options &o, const std::vector<Obs> &obs, int mount)
     std::vector<int> all(obs.size());
     for (size_t i = 0; i < obs.size(); i++)
         all[i] = (int)i;
-    residuals(f, obs, all);
+    size_t bad = 0;
+    pm_status rst = residuals(f, obs, all, &bad);
+    if (rst != PM_OK) {
+        std::string inputs;
+        for (int i = 0; i < f.model.n_terms; i++)
+            if (f.model.term[i].kind == PM_TERM_AUX)
+                inputs += (inputs.empty() ? "" : ", ") + term_name(f.model, i);
+        die(o.run + ":" + std::to_string(obs[(size_t)all[bad]].line) + ": " + o.model +
+                " cannot be evaluated here (status " + std::to_string((int)rst) + (inputs.empty()
+                    ? std::string(")")
+                    : "): its terms " + inputs + " read an input (temperature, time, slew "
+                      "direction or a column) this record does not give") +
+                "; nothing evaluated",
+            1);
+    }
     std::string werr;
     if (!o.residuals.empty())
         werr = write_residuals(o.residuals, "residuals of pmfit eval " + o.model + " " + o.run,

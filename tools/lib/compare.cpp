@@ -194,6 +194,9 @@ Comparison compare_models(const pm_model &old_in, const std::vector<double> &old
              : f.status == PM_ERR_TOO_FEW
                  ? std::to_string(all.size()) + " points are too few for " +
                        std::to_string(old_model.n_terms) + " terms"
+             : f.status == PM_ERR_NONFINITE
+                 ? std::string("the run does not give an input the model's terms read "
+                               "(temperature, time, slew direction or a column)")
                  : "the fit does not converge (status " + std::to_string((int)f.status) + ")") +
             "; compare needs a run that determines the model (or a lower --order)");
     c.refit = f.model;

@@ -282,19 +282,38 @@ FTest f_test(double chi2_small, int p_small, double chi2_big, int p_big, long n_
     return t;
 }
 
-// Residuals of f.model on the observations `use`, and their RMS on the sky.
-void residuals(FitOut &f, const std::vector<Obs> &obs, const std::vector<int> &use)
+// Residuals of f.model on the observations `use`, and their RMS on the sky
+// (fitrun.hpp).  A residual the model cannot give is NaN, not the 0 that
+// pm_model_residual leaves: pmfit eval of a temperature model on a run
+// without temperatures printed "sky RMS 0.000"".
+pm_status residuals(FitOut &f, const std::vector<Obs> &obs, const std::vector<int> &use,
+                    size_t *bad)
 {
     double ss = 0;
-    for (int i : use) {
-        double r[2];
-        pm_model_residual(&f.model, &obs[i].ctx, obs[i].eh, obs[i].ed, obs[i].ah, obs[i].ad, r);
+    size_t n = 0;
+    pm_status first = PM_OK;
+    for (size_t j = 0; j < use.size(); j++) {
+        const int i = use[j];
+        double r[2] = {NAN, NAN};
+        pm_status st = pm_model_residual(&f.model, &obs[i].ctx, obs[i].eh, obs[i].ed, obs[i].ah,
+                                         obs[i].ad, r);
+        if (st != PM_OK) {
+            r[0] = r[1] = NAN;
+            if (first == PM_OK) {
+                first = st;
+                if (bad)
+                    *bad = j;
+            }
+        } else {
+            ss += r[0] * r[0] + r[1] * r[1];
+            n++;
+        }
         f.r0.push_back(r[0]);
         f.r1.push_back(r[1]);
         f.idx.push_back(i);
-        ss += r[0] * r[0] + r[1] * r[1];
     }
-    f.rms = use.empty() ? 0 : std::sqrt(ss / (double)use.size());
+    f.rms = n ? std::sqrt(ss / (double)n) : 0;
+    return first;
 }
 
 FitOut do_fit(const std::vector<Obs> &obs, const std::vector<int> &use, const pm_model &start,

@@ -97,7 +97,13 @@ FitOut do_fit(const std::vector<Obs> &obs, const std::vector<int> &use, const pm
 // static workspace, so it is not reentrant.
 FitOut do_fit(pm_fit &work, const std::vector<Obs> &obs, const std::vector<int> &use,
               const pm_model &start, int max_passes);
-void residuals(FitOut &f, const std::vector<Obs> &obs, const std::vector<int> &use);
+// Residuals of f.model on the observations `use` into f (r0, r1, idx, rms).
+// Returns PM_OK, or the status of the first observation the model cannot
+// be evaluated at (a term reads an input the record does not give:
+// temperature, time, an aux column), its position in `use` in *bad; the
+// residuals there are NaN, and rms is of the others.
+pm_status residuals(FitOut &f, const std::vector<Obs> &obs, const std::vector<int> &use,
+                    size_t *bad = nullptr);
 // J C J^T at one position: J its two design rows at the fitted model
 // (pm_fit_row with the observed place ah, ad; the model's own prediction
 // for a place not observed), C the fit's coefficient covariance (rad^2):

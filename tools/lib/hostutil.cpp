@@ -144,10 +144,19 @@ int is_model_file(const std::string &path, char *err, size_t errlen)
         set_err(err, errlen, path + ": cannot open: " + std::strerror(errno));
         return -1;
     }
-    char line[256] = "";
+    // The first line that is not blank or a comment, read whole (a comment
+    // longer than a buffer -- pmfit's own undetermined-fit warning is ~290
+    // bytes -- left its tail to be taken for that line, and the model file
+    // for a run); at most 64 kB of a line.
     int model = 0;
-    while (std::fgets(line, sizeof line, f)) {
-        const char *q = line + std::strspn(line, " \t\r\n");
+    std::string line;
+    int ch = 0;
+    while (ch != EOF) {
+        line.clear();
+        while ((ch = std::fgetc(f)) != EOF && ch != '\n')
+            if (line.size() < 65536)
+                line += (char)ch;
+        const char *q = line.c_str() + std::strspn(line.c_str(), " \t\r");
         if (!*q || *q == '#')
             continue;
         model = std::strncmp(q, "pm-model", 8) == 0;

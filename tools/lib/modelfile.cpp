@@ -69,7 +69,9 @@ bool parse_double(const std::string &s, double *v)
     char *end = nullptr;
     errno = 0;
     double x = std::strtod(s.c_str(), &end);
-    if (*end || errno == ERANGE || !std::isfinite(x))
+    /* (ERANGE on underflow is a subnormal or zero, which %.17g writes and
+    ** is a value: only an overflow is refused) */
+    if (*end || (errno == ERANGE && std::fabs(x) == HUGE_VAL) || !std::isfinite(x))
         return false;
     *v = x;
     return true;
@@ -106,6 +108,24 @@ int read_line(std::istream &in, std::string &line, size_t max)
 
 } // namespace
 
+// A model pmmodel_load would read back (and a compiler compile): one that
+// pm_model_prepare accepts -- finite coefficients, a latitude, valid terms.
+// A NaN coefficient was written as "nan", a term of l = 40 as it was, and
+// the file then failed to load.
+static bool preparable(const pm_model *m, const char *path, const char *who, char *err,
+                       size_t errlen)
+{
+    pm_model c = *m;
+    pm_status st = pm_model_prepare(&c);
+    if (st == PM_OK)
+        return true;
+    set_err(err, errlen, std::string(path) + ": " + who + ": not written: pm_model_prepare " +
+                             "refuses the model (status " + std::to_string((int)st) +
+                             ": a coefficient or the latitude not finite or out of range, or a "
+                             "term not valid)");
+    return false;
+}
+
 extern "C" int pmmodel_save(const char *path, const pm_model *m, const char *comment,
                             char *err, size_t errlen)
 {
@@ -113,6 +133,8 @@ extern "C" int pmmodel_save(const char *path, const pm_model *m, const char *com
         set_err(err, errlen, "pmmodel_save: invalid arguments");
         return -1;
     }
+    if (!preparable(m, path, "pmmodel_save", err, errlen))
+        return -1;
     std::string out;
     comment_lines(out, comment, "# ");
     out += "pm-model 3\n";
@@ -171,15 +193,19 @@ std::string old_term(const Loader &L, const std::string &name)
 }
 
 // Does this term of an older file evaluate differently now (old_term)?
-bool moved_term(const Loader &L, int kind, long k, long l, double v)
+// added: an added term (xterm; a side-specific isotropic term is an added
+// SH term of l = 0, whose base vector moved as every other did).
+bool moved_term(const Loader &L, int kind, long k, long l, double v, bool added)
 {
     if (L.version >= 3 || v == 0 || (L.m.coef[2] == 0 && L.m.coef[4] == 0))
         return false;
     if (L.version == 1 && (k == 1 || k == 2) && (kind != PM_TERM_SH || l >= 1))
         return true; /* (version 1: the tilts at the encoder reading) */
-    if (kind == PM_TERM_SH)
+    if (kind == PM_TERM_SH && (l >= 1 || !added))
         return l >= 1;
-    return k == 3 || k == 4; /* base vectors cos d, -sin d */
+    /* base vectors cos d, -sin d (c'@W, d@W of a version-2 file were read
+    ** without a word and pointed up to 5.75" differently) */
+    return k == 3 || k == 4;
 }
 
 // The header's lines, one state each: "" when the line is right, else why.
@@ -248,7 +274,7 @@ std::string added_term(Loader &L, const std::vector<std::string> &tok)
         return "bad fields of an added term (expected xterm NAME KIND k l m side aux param value)";
     if (!parse_double(tok[8], &param) || !parse_double(tok[9], &v))
         return "bad parameter or value (expected finite numbers)";
-    if (moved_term(L, kind, k, l, v))
+    if (moved_term(L, kind, k, l, v, true))
         return old_term(L, tok[1]);
     if (L.base < 0)
         L.base = L.got;
@@ -281,7 +307,7 @@ std::string harmonic_term(Loader &L, const std::vector<std::string> &tok)
                "' (expected k in 1..6, l in 0..order, |m| <= l)";
     if (!parse_double(tok[5], &v))
         return "bad value '" + tok[5] + "' (expected a finite number, radians)";
-    if (moved_term(L, PM_TERM_SH, k, l, v))
+    if (moved_term(L, PM_TERM_SH, k, l, v, false))
         return old_term(L, tok[1]);
     L.m.term[L.got].kind = PM_TERM_SH;
     L.m.term[L.got].k = (unsigned char)k;
@@ -424,6 +450,17 @@ extern "C" int pmmodel_emit_c(const char *path, const pm_model *m, const char *p
         set_err(err, errlen, "pmmodel_emit_c: invalid arguments");
         return -1;
     }
+    bool ident = (std::isalpha((unsigned char)prefix[0]) || prefix[0] == '_');
+    for (const char *q = prefix; *q && ident; q++)
+        ident = std::isalnum((unsigned char)*q) || *q == '_';
+    if (!ident) {
+        set_err(err, errlen, std::string(path) + ": pmmodel_emit_c: the prefix '" + prefix +
+                                 "' is not a C identifier (letters, digits, '_', not a digit "
+                                 "first)");
+        return -1;
+    }
+    if (!preparable(m, path, "pmmodel_emit_c", err, errlen))
+        return -1;
     std::string p = prefix;
     std::string guard;
     for (char c : p)

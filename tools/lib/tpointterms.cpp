@@ -77,6 +77,8 @@ const char *convention(const pm_model *m)
 extern "C" int pmtp_terms(const pm_model *m, const double *err_rad, pmtp_term *named, int *n_named)
 {
     if (!m || !named || !n_named) return -1;
+    if (m->n_terms < 6 || m->n_terms > PM_MAX_TERMS || m->n_base < 6 || m->n_base > m->n_terms)
+        return -1; /* (the model need not be prepared: its counts are checked) */
     const Map *map = map_of(m);
     if (!map) return -1;
     // pm's polar-axis tilts a, b are the outermost rotation, at the index-
