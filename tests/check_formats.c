@@ -333,7 +333,7 @@ START_TEST(test_pmrun_read_equinox_refused_where_it_does_not_apply)
             if (e & 2)
                 o.format = forced[k];
             data_path(path, sizeof path, names[k]);
-            tu_read_fails(path, &o, PMRUN_ERR_ARG, 0, "refused rather than ignored");
+            tu_read_fails(path, &o, PMRUN_ERR_FORMAT, 0, "refused rather than ignored");
         }
     /* and read as before without it */
     pmrun_free(read_ok("four_column.dat"));

@@ -273,12 +273,14 @@ bool equinox_applies(Context &ctx, int format)
     if (ctx.opt().equinox == PMRUN_EQUINOX_FILE || format == PMRUN_FORMAT_CSV ||
         format == PMRUN_FORMAT_RTS2 || format == PMRUN_FORMAT_MW4)
         return true;
-    return ctx.fail_with(PMRUN_ERR_ARG, 0,
-                         "the equinox option (pmfit --equinox) applies to CSV logs, RTS2 gpoint "
-                         "and MountWizzard4 files, and this is %s, whose places are what its "
-                         "format defines (a TPOINT file's: mean places of its catalogue; a "
-                         "column file's: apparent): refused rather than ignored",
-                         format_description(format));
+    // (PMRUN_ERR_FORMAT, as the MW4 reader's refusal of J2000: _ARG is for
+    // NULL arguments, and the fuzzer's status invariant caught it)
+    return ctx.fail(0,
+                    "the equinox option (pmfit --equinox) applies to CSV logs, RTS2 gpoint and "
+                    "MountWizzard4 files, and this is %s, whose places are what its format "
+                    "defines (a TPOINT file's: mean places of its catalogue; a column file's: "
+                    "apparent): refused rather than ignored",
+                    format_description(format));
 }
 
 const char *format_description(int format)
