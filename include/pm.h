@@ -1187,6 +1187,24 @@ pm_status pm_fit_row(const pm_model *m, const pm_context *ctx,
                      double *row0, double *row1, double r[2]);
 
 /* ---------------------------------------------------------------------- */
+/* Status words.                                                          */
+/* ---------------------------------------------------------------------- */
+
+/*
+**  pm_status_text - a status in words, for messages and logs
+**
+**  Given:
+**     s        pm_status   any value
+**  Returned (function value):
+**              const char* a static string, never NULL ("unknown status"
+**                          for a value not in the enum); at most 63 bytes
+**  Notes:
+**  1) The one table of them: pmfit, the Python package and the INDI
+**     plugin print these words.
+*/
+const char *pm_status_text(pm_status s);
+
+/* ---------------------------------------------------------------------- */
 /* Configuration check.                                                   */
 /* ---------------------------------------------------------------------- */
 

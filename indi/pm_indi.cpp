@@ -170,7 +170,7 @@ pm_status pm_indi_fit(int mount, long n, const double *enc1, const double *enc2,
             if (st == PM_ERR_SINGULAR && fit->bad_term >= 0 && fit->bad_term < m.n_terms)
                 pm_term_name(&m, fit->bad_term, r.bad_term, sizeof r.bad_term);
             else
-                std::snprintf(r.bad_term, sizeof r.bad_term, "%s", pm_indi_status_words(st));
+                std::snprintf(r.bad_term, sizeof r.bad_term, "%s", pm_status_text(st));
             break;
         }
         r.cv[L] = loo_rms(fit, &fr, &m, n, enc1, enc2, app1, app2);
@@ -190,24 +190,6 @@ pm_status pm_indi_fit(int mount, long n, const double *enc1, const double *enc2,
     *out = best;
     *res = r;
     return PM_OK;
-}
-
-const char *pm_indi_status_words(pm_status s)
-{
-    switch (s) {
-    case PM_OK: return "ok";
-    case PM_WARN_NOT_CONVERGED: return "iteration bound reached";
-    case PM_WARN_UNREACHABLE: return "target unreachable";
-    case PM_ERR_ARG: return "invalid argument";
-    case PM_ERR_NONFINITE: return "non-finite input, or an evaluation overflowed";
-    case PM_ERR_CAPACITY: return "beyond the compiled capacity";
-    case PM_ERR_TOO_FEW: return "too few observations for the number of terms";
-    case PM_ERR_SINGULAR: return "a term cannot be determined from these observations";
-    case PM_ERR_STATE: return "call out of order";
-    case PM_ERR_CONFIG: return "library built with other capacities";
-    case PM_ERR_DIVERGED: return "the fit did not converge";
-    }
-    return "unknown status";
 }
 
 void pm_indi_describe(const pm_indi_result *r, long n, long skipped, char *buf, size_t len)

@@ -102,10 +102,6 @@ pm_status pm_indi_fit(int mount, long n, const double *enc1, const double *enc2,
                       const double *app1, const double *app2, pm_fit *fit,
                       pm_model *out, pm_indi_result *res);
 
-/* A pm_status in words for the log (the meanings of include/pm.h's enum,
-** as pmfit and the Python package print them; "unknown status" for others). */
-const char *pm_indi_status_words(pm_status s);
-
 /* One line for the log: what model, from how many points, its sigma. */
 void pm_indi_describe(const pm_indi_result *res, long n, long skipped, char *buf, size_t len);
 

@@ -268,7 +268,7 @@ bool PmMathPlugin::Initialise(InMemoryDatabase *db)
                                s1v.data(), s2v.data(), fit_, &model_, &r);
     if (st < 0) {
         /* never happens for the statuses pm_indi_fit documents; keep what we had */
-        note("fit failed (%s); the previous model is kept", pm_indi_status_words(st));
+        note("fit failed (%s); the previous model is kept", pm_status_text(st));
         return false;
     }
     kind_ = r.kind;
@@ -303,7 +303,7 @@ bool PmMathPlugin::TransformCelestialToTelescope(const double RightAscension, co
     if (st < 0 || st == PM_WARN_UNREACHABLE) {
         note("TransformCelestialToTelescope: RA %.6f h Dec %.6f deg %s%s", RightAscension, Declination,
              st == PM_WARN_UNREACHABLE ? "is not reachable by the model's mount" : "failed: ",
-             st == PM_WARN_UNREACHABLE ? "" : pm_indi_status_words(st));
+             st == PM_WARN_UNREACHABLE ? "" : pm_status_text(st));
         return false;
     }
     if (st == PM_WARN_NOT_CONVERGED)
@@ -336,7 +336,7 @@ bool PmMathPlugin::TransformTelescopeToCelestial(const TelescopeDirectionVector 
     }
     pm_status st = pm_model_apply(&model_, nullptr, e1, e2, &s1, &s2);
     if (st < 0) {
-        note("TransformTelescopeToCelestial: model evaluation failed (%s)", pm_indi_status_words(st));
+        note("TransformTelescopeToCelestial: model evaluation failed (%s)", pm_status_text(st));
         return false;
     }
     sky_radec(s1, s2, lst, lat, &RightAscension, &Declination);

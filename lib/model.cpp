@@ -2482,6 +2482,24 @@ pm_status pm_check_config(size_t model_size, size_t fit_size, int max_l,
     return PM_OK;
 }
 
+const char *pm_status_text(pm_status s)
+{
+    switch (s) {
+    case PM_OK: return "ok";
+    case PM_WARN_NOT_CONVERGED: return "iteration bound reached";
+    case PM_WARN_UNREACHABLE: return "target unreachable";
+    case PM_ERR_ARG: return "invalid argument";
+    case PM_ERR_NONFINITE: return "non-finite input, or an evaluation overflowed";
+    case PM_ERR_CAPACITY: return "beyond the compiled capacity";
+    case PM_ERR_TOO_FEW: return "too few observations for the number of terms";
+    case PM_ERR_SINGULAR: return "a term cannot be determined from these observations";
+    case PM_ERR_STATE: return "call out of order (model not prepared, or changed since)";
+    case PM_ERR_CONFIG: return "library built with other capacities";
+    case PM_ERR_DIVERGED: return "the fit did not converge";
+    }
+    return "unknown status";
+}
+
 pm_status pm_check_config_all(size_t model_size, size_t fit_size, size_t context_size,
                               int max_l, int max_extra, int max_aux)
 {

@@ -80,24 +80,8 @@ const char *status_name(int s)
     return "unknown status";
 }
 
-// The words of pm.h's status enum (as pmfit prints them).
-const char *status_text(int s)
-{
-    switch (s) {
-    case PM_OK: return "ok";
-    case PM_WARN_NOT_CONVERGED: return "iteration bound reached";
-    case PM_WARN_UNREACHABLE: return "target unreachable";
-    case PM_ERR_ARG: return "invalid argument";
-    case PM_ERR_NONFINITE: return "non-finite input, or an evaluation overflowed";
-    case PM_ERR_CAPACITY: return "beyond the compiled capacity";
-    case PM_ERR_TOO_FEW: return "too few observations for the number of terms";
-    case PM_ERR_SINGULAR: return "a term cannot be determined from these observations";
-    case PM_ERR_STATE: return "call out of order (model not prepared, or changed since)";
-    case PM_ERR_CONFIG: return "library built with other capacities";
-    case PM_ERR_DIVERGED: return "the fit did not converge";
-    }
-    return "unknown status";
-}
+// The words of pm.h's status enum (pm_status_text, as pmfit prints them).
+const char *status_text(int s) { return pm_status_text((pm_status)s); }
 
 // A failure of a core call: "what: PM_ERR_X (words)".
 [[noreturn]] void fail_status(pm_status s, const std::string &what)

@@ -690,23 +690,6 @@ Options parse_args(int argc, char **argv)
     return o;
 }
 
-const char *status_text(pm_status s)
-{
-    switch (s) {
-    case PM_OK: return "ok";
-    case PM_WARN_NOT_CONVERGED: return "iteration bound reached";
-    case PM_WARN_UNREACHABLE: return "target unreachable";
-    case PM_ERR_ARG: return "invalid argument";
-    case PM_ERR_NONFINITE: return "non-finite input";
-    case PM_ERR_CAPACITY: return "beyond the compiled capacity";
-    case PM_ERR_TOO_FEW: return "too few observations for the number of terms";
-    case PM_ERR_SINGULAR: return "a term cannot be determined from these observations";
-    case PM_ERR_STATE: return "call out of order";
-    case PM_ERR_CONFIG: return "library built with other capacities";
-    case PM_ERR_DIVERGED: return "the fit did not converge";
-    }
-    return "unknown status";
-}
 
 
 
@@ -774,7 +757,7 @@ void print_json_fit(const FitOut &f, const std::string &extra)
 
 void fail_fit(const FitOut &f, const std::string &what)
 {
-    std::string msg = what + ": " + status_text(f.status);
+    std::string msg = what + ": " + pm_status_text(f.status);
     const pm_model &m = f.model; // the model that was fitted (unchanged on error)
     if (f.status == PM_ERR_SINGULAR && f.bad_term >= 0) {
         msg += " (term " + term_name(m, f.bad_term) + ", " + meaning(m, f.bad_term) +
