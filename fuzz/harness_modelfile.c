@@ -1,8 +1,8 @@
 /*
 **  harness_modelfile.c - fuzz target body: the bytes as a model file read by
-**  pmmodel_load; a model that loads is evaluated (apply, invert), saved,
+**  pmmodel_load_info; a model that loads is evaluated (apply, invert), saved,
 **  emitted as C and loaded again, which must give the same model bit for
-**  bit.
+**  bit and the same information (pier side, the names of the inputs read).
 */
 #ifndef _GNU_SOURCE
 #define _GNU_SOURCE
@@ -40,6 +40,23 @@ static int mf_same(const pm_model *a, const pm_model *b)
             s->side != t->side || s->aux != t->aux ||
             (i >= a->n_base && memcmp(&s->param, &t->param, sizeof(double)) != 0))
             return pmfz_fail("modelfile: reloaded term %d differs", i);
+    }
+    return 0;
+}
+
+/* The information a reloaded file gives back: its pier side, and the name
+** of every input a term reads (a name no term reads is not written). */
+static int mf_same_info(const pm_model *m, const pmmodel_info *a, const pmmodel_info *b)
+{
+    int i;
+    if (a->pier != b->pier)
+        return pmfz_fail("modelfile: reloaded pier side %d, saved %d", b->pier, a->pier);
+    for (i = m->n_base; i < m->n_terms; i++) {
+        int j = m->term[i].aux - PM_AUX_USER;
+        if (m->term[i].kind == PM_TERM_AUX && j >= 0 && j < PM_MAX_AUX &&
+            strcmp(a->input[j], b->input[j]) != 0)
+            return pmfz_fail("modelfile: reloaded input %d is '%s', saved '%s'", j, b->input[j],
+                             a->input[j]);
     }
     return 0;
 }
@@ -93,6 +110,7 @@ static int mf_evaluate(const pm_model *m)
 int pmfz_modelfile(const unsigned char *data, size_t size)
 {
     pm_model m, before, again;
+    pmmodel_info info, info_before, info_again;
     char path[64], err[512], out[128], hdr[128];
     const char *dir;
     int fd, r, bad = 0;
@@ -108,14 +126,18 @@ int pmfz_modelfile(const unsigned char *data, size_t size)
     }
     memset(&m, 0xA5, sizeof m);
     before = m;
+    memset(&info, 0x5A, sizeof info);
+    info_before = info;
     memset(err, 'x', sizeof err);
-    r = pmmodel_load(path, &m, err, sizeof err);
+    r = pmmodel_load_info(path, &m, &info, err, sizeof err);
     close(fd);
     if (r != 0) {
         if (r != -1)
             return pmfz_fail("modelfile: pmmodel_load returned %d", r);
         if (memcmp(&m, &before, sizeof m) != 0)
             return pmfz_fail("modelfile: failed load changed the model");
+        if (memcmp(&info, &info_before, sizeof info) != 0)
+            return pmfz_fail("modelfile: failed load changed the information");
         if (!memchr(err, '\0', sizeof err) || strncmp(err, path, strlen(path)) != 0)
             return pmfz_fail("modelfile: error message '%.80s' does not name the file", err);
         return 0;
@@ -129,12 +151,12 @@ int pmfz_modelfile(const unsigned char *data, size_t size)
         return 0;
     snprintf(out, sizeof out, "%s/model.pm", dir);
     snprintf(hdr, sizeof hdr, "%s/model.h", dir);
-    if (pmmodel_save(out, &m, "fuzz\nround trip", err, sizeof err) != 0)
+    if (pmmodel_save_info(out, &m, &info, "fuzz\nround trip", err, sizeof err) != 0)
         bad = pmfz_fail("modelfile: saving a loaded model failed: %s", err);
-    else if (pmmodel_load(out, &again, err, sizeof err) != 0)
+    else if (pmmodel_load_info(out, &again, &info_again, err, sizeof err) != 0)
         bad = pmfz_fail("modelfile: reloading a saved model failed: %s", err);
     else
-        bad = mf_same(&m, &again);
+        bad = mf_same(&m, &again) || mf_same_info(&m, &info, &info_again);
     if (!bad && pmmodel_emit_c(hdr, &m, "pm_fz", "fuzz", err, sizeof err) != 0)
         bad = pmfz_fail("modelfile: emitting C for a loaded model failed: %s", err);
     unlink(out);

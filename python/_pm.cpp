@@ -271,8 +271,23 @@ std::pair<long, pm_status> apply_lanes_on(const pm_model &m, int path, long n, i
 
 struct Model {
     pm_model m;
+    pmmodel_info info; // a model file's column names and pier side (modelfile.h)
 
-    Model() { std::memset(&m, 0, sizeof m); }
+    Model()
+    {
+        std::memset(&m, 0, sizeof m);
+        std::memset(&info, 0, sizeof info);
+    }
+
+    // {j: name}: the run column each aux[j] the model reads is
+    py::dict inputs() const
+    {
+        py::dict d;
+        for (int j = 0; j < PM_MAX_AUX; j++)
+            if (info.input[j][0])
+                d[py::int_(j)] = std::string(info.input[j]);
+        return d;
+    }
 
     static Model make(int mount, int order, double latitude)
     {
@@ -538,7 +553,8 @@ struct Model {
     void save(const std::string &path, std::optional<std::string> comment) const
     {
         char err[1024];
-        if (pmmodel_save(path.c_str(), &m, comment ? comment->c_str() : nullptr, err, sizeof err) != 0)
+        if (pmmodel_save_info(path.c_str(), &m, &info, comment ? comment->c_str() : nullptr, err,
+                              sizeof err) != 0)
             fail(K_FILE, err);
     }
 
@@ -555,7 +571,7 @@ struct Model {
     {
         Model r;
         char err[1024];
-        if (pmmodel_load(path.c_str(), &r.m, err, sizeof err) != 0) {
+        if (pmmodel_load_info(path.c_str(), &r.m, &r.info, err, sizeof err) != 0) {
             // a file that cannot be opened is an OSError, its content a ValueError
             FILE *f = std::fopen(path.c_str(), "rb");
             if (!f)
@@ -761,11 +777,13 @@ struct Fit {
     FitOut out;
     std::string title;
     std::vector<int> lines;       // file line of each fitted observation
+    pmmodel_info info{};          // the run's columns the model reads, its side
 
     Model model() const
     {
         Model r;
         r.m = out.model;
+        r.info = info;
         return r;
     }
     py::array_t<double> coefficients() const
@@ -856,7 +874,8 @@ struct Fit {
 }
 
 std::unique_ptr<Fit> fit_points(const Run &run, const std::vector<int> &use, const pm_model &start,
-                                int max_iter, const std::string &what, const std::string &title)
+                                int max_iter, const std::string &what, const std::string &title,
+                                int pier = 0)
 {
     auto f = std::make_unique<Fit>();
     f->work.reset(new pm_fit);
@@ -864,6 +883,7 @@ std::unique_ptr<Fit> fit_points(const Run &run, const std::vector<int> &use, con
     if (f->out.status != PM_OK)
         fail_fit(f->out, what, max_iter);
     f->title = title;
+    f->info = model_info(f->out.model, run.aux_names, pier);
     for (int i : f->out.idx)
         f->lines.push_back(run.obs[i].line);
     return f;
@@ -934,7 +954,7 @@ py::tuple fit_run(const RunData &d, int order, std::vector<std::string> adds, bo
                 std::string t = side > 0 ? "pier side east (normal)" : "pier side west (beyond the pole)";
                 if (use.empty())
                     throw Failure{K_FIT, 0, run.path + ": split: no observations on the " + t, ""};
-                fits.push_back(fit_points(run, use, start, max_iter, run.path + " (" + t + ")", t));
+                fits.push_back(fit_points(run, use, start, max_iter, run.path + " (" + t + ")", t, side));
                 kept.insert(kept.end(), use.begin(), use.end());
             }
             std::sort(kept.begin(), kept.end());
@@ -1121,6 +1141,9 @@ std::string compare_run(const Model *old_model, const std::shared_ptr<RunData> &
             os.model = old_model->m;
             if (pm_model_prepare(&os.model) != PM_OK)
                 fail(K_ARGUMENT, "old: the model cannot be prepared (non-finite coefficients?)");
+            for (int j = 0; j < PM_MAX_AUX; j++)
+                os.inputs.push_back(old_model->info.input[j]);
+            os.pier = old_model->info.pier;
         } else if (old_run) {
             os = old_from_run(old_run->run, order, adds, passes);
         } else {
@@ -1138,8 +1161,7 @@ std::string compare_run(const Model *old_model, const std::shared_ptr<RunData> &
         fail_fit(os.fit, (old_path.empty() ? std::string("old run") : old_path) + " (the old run)", passes);
     Comparison c;
     try {
-        c = compare_models(os.model, os.err, d.run, os.is_run ? &os.fit : nullptr,
-                           os.is_run ? &os.run : nullptr);
+        c = compare_old(os, d.run, old_model ? std::string("old") : old_path.empty() ? "old run" : old_path);
     } catch (const std::runtime_error &e) {
         fail(K_ERROR, e.what());
     }
@@ -1293,6 +1315,8 @@ PYBIND11_MODULE(_pm, mod)
         .def_property("coefficients", &Model::coefficients, &Model::set_coefficients)
         .def_property_readonly("names", &Model::names)
         .def_property_readonly("terms", &Model::terms)
+        .def_property_readonly("inputs", &Model::inputs)
+        .def_property_readonly("pier_side", [](const Model &m) { return m.info.pier; })
         .def_property_readonly("_inputs_needed", &Model::inputs_needed)
         .def("_add_term", &Model::add_term)
         .def("_apply", &Model::apply)

@@ -101,7 +101,7 @@ START_TEST(test_pmmodel_load_errors_name_line)
     make_tmpdir();
     expect_load_error("", "1", "empty");
     expect_load_error("hello\n", "1", "pm-model");
-    expect_load_error("pm-model 4\n", "1", "version");
+    expect_load_error("pm-model 5\n", "1", "version");
     expect_load_error("pm-model 1\nmount dobsonian\n", "2", "mount");
     expect_load_error("pm-model 1\nmount altaz\norder x\n", "3", "order");
     snprintf(big, sizeof big, "pm-model 1\nmount altaz\norder %d\n", PM_MAX_L + 1);
@@ -339,6 +339,93 @@ START_TEST(test_pmmodel_emit_c_compiles_and_loads)
 }
 END_TEST
 
+/* Version 4: the names of the columns a model reads (pm_context.aux[j])
+** and its pier side, written where the model reads a named input or is of
+** one side (version 3 otherwise), read back; bad lines are errors at
+** their line; a name that is not a column name is not written. */
+START_TEST(test_pmmodel_info)
+{
+    static const char head4[] = "pm-model 4\nmount equatorial\norder 0\n";
+    static const char body[] = "terms 6\nterm a 1 0 0 0\nterm b 2 0 0 0\nterm c 3 0 0 0\n"
+                               "term d 4 0 0 0\nterm e 5 0 0 0\nterm i 6 0 0 0\nend\n";
+    static const struct { const char *lines, *line, *word; } bad[] = {
+        {"input 0 hum\ninput 0 press\n", "5", "second name for input 0"},
+        {"input 0 hum\ninput 1 hum\n", "5", "named 'hum' as input 0"},
+        {"input 9 hum\n", "4", "PM_MAX_AUX"},
+        {"input 0 9hum\n", "4", "not a column name"},
+        {"input 0\n", "4", "expected 'input J NAME'"},
+        {"input -1 hum\n", "4", "expected 'input J NAME'"},
+        {"pier north\n", "4", "'pier east' or 'pier west'"},
+        {"pier east\npier west\n", "5", "second 'pier'"},
+    };
+    pm_model a, b;
+    pmmodel_info in, got;
+    pm_term t;
+    char path[300], err[512], text[1024];
+    FILE *f;
+    size_t k;
+    make_tmpdir();
+    path_in(path, sizeof path, "i.pm");
+    random_model(&a, 1, 11);
+    memset(&t, 0, sizeof t);
+    t.kind = PM_TERM_AUX;
+    t.k = PM_BASE_E;
+    t.aux = PM_AUX_USER + 2;
+    t.param = 1010;
+    ck_assert_int_eq(pm_model_add_term(&a, &t, 1e-6, NULL), PM_OK);
+    t.aux = PM_AUX_TEMP;
+    ck_assert_int_eq(pm_model_add_term(&a, &t, 2e-6, NULL), PM_OK);
+    memset(&in, 0, sizeof in);
+    strcpy(in.input[2], "press");
+    strcpy(in.input[0], "hum"); /* read by no term: not written */
+    in.pier = -1;
+    ck_assert_msg(pmmodel_save_info(path, &a, &in, "c", err, sizeof err) == 0, "%s", err);
+    memset(&got, 0x55, sizeof got);
+    ck_assert_msg(pmmodel_load_info(path, &b, &got, err, sizeof err) == 0, "%s", err);
+    ck_assert_str_eq(got.input[2], "press");
+    ck_assert_str_eq(got.input[0], "");
+    ck_assert_str_eq(got.input[1], "");
+    ck_assert_int_eq(got.pier, -1);
+    ck_assert_int_eq(b.n_terms, a.n_terms);
+    ck_assert_int_eq(b.term[a.n_terms - 2].aux, PM_AUX_USER + 2);
+    ck_assert(memcmp(b.coef, a.coef, sizeof(double) * (size_t)a.n_terms) == 0);
+    /* pmmodel_load reads it too (without the information) */
+    ck_assert_int_eq(pmmodel_load(path, &b, err, sizeof err), 0);
+    /* nothing more to say: version 3 */
+    memset(&in, 0, sizeof in);
+    strcpy(in.input[0], "hum");
+    ck_assert_int_eq(pmmodel_save_info(path, &a, &in, NULL, err, sizeof err), 0);
+    f = fopen(path, "r");
+    ck_assert_ptr_nonnull(f);
+    ck_assert_ptr_nonnull(fgets(text, sizeof text, f));
+    fclose(f);
+    ck_assert_str_eq(text, "pm-model 3\n");
+    ck_assert_int_eq(pmmodel_load_info(path, &b, &got, err, sizeof err), 0);
+    ck_assert_str_eq(got.input[2], "");
+    ck_assert_int_eq(got.pier, 0);
+    /* what cannot be written */
+    strcpy(in.input[2], "two words");
+    ck_assert_int_eq(pmmodel_save_info(path, &a, &in, NULL, err, sizeof err), -1);
+    ck_assert_msg(strstr(err, "not a column name") != NULL, "%s", err);
+    memset(&in, 0, sizeof in);
+    in.pier = 2;
+    ck_assert_int_eq(pmmodel_save_info(path, &a, &in, NULL, err, sizeof err), -1);
+    ck_assert_msg(strstr(err, "pier 2") != NULL, "%s", err);
+    /* the lines: an error at their line; not in version 3 */
+    for (k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        snprintf(text, sizeof text, "%s%s%s", head4, bad[k].lines, body);
+        expect_load_error(text, bad[k].line, bad[k].word);
+    }
+    snprintf(text, sizeof text, "pm-model 3\nmount equatorial\norder 0\ninput 0 hum\n%s", body);
+    expect_load_error(text, "4", "version 4 has them");
+    snprintf(text, sizeof text, "%sinput 3 x.y-z_\npier east\n%s", head4, body);
+    write_text(path, text);
+    ck_assert_msg(pmmodel_load_info(path, &b, &got, err, sizeof err) == 0, "%s", err);
+    ck_assert_str_eq(got.input[3], "x.y-z_");
+    ck_assert_int_eq(got.pier, 1);
+}
+END_TEST
+
 static Suite *suite(void)
 {
     Suite *s = suite_create("modelfile");
@@ -354,6 +441,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_pmmodel_version_1);
     tcase_add_test(tc, test_pmmodel_load_binary_and_missing);
     tcase_add_test(tc, test_pmmodel_save_unwritable);
+    tcase_add_test(tc, test_pmmodel_info);
     suite_add_tcase(s, tc);
     return s;
 }

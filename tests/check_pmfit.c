@@ -427,6 +427,125 @@ START_TEST(test_pmfit_eval_missing_input_and_long_comment)
 }
 END_TEST
 
+/* A run's auxiliary columns are found by name, not by position.  A run
+** "a" with columns "hum press" whose encoder Dec reads 3" per hPa of
+** pressure off, and the same records as "b" with the two columns swapped
+** and as "c" without "press": the model fitted on a (aux:press) must
+** evaluate on b exactly as on a -- it read b's "hum" as the pressure and
+** gave an RMS of thousands of arcseconds with exit 0 -- and refuse c, where
+** it read the derived "dec_dir" in the pressure's place.  compare (a model
+** file or a run as OLD) likewise.  A version-3 file, which does not name
+** its columns, is read by position with a note saying which column.  A
+** model fitted with --pier split says its side, and eval uses that side's
+** records only (it used all of them). */
+static void write_aux_run(const char *base, const char *path, int order)
+{
+    FILE *in = fopen(base, "r"), *f = fopen(path, "w");
+    char line[512];
+    unsigned long long x = 12345;
+    ck_assert_ptr_nonnull(in);
+    ck_assert_ptr_nonnull(f);
+    while (fgets(line, sizeof line, in)) {
+        double eh, ed, hum, press;
+        int used;
+        line[strcspn(line, "\n")] = 0;
+        if (line[0] == '#') {
+            fprintf(f, "%s%s\n", line,
+                    strncmp(line, "# tau", 5) ? "" : order == 0 ? " hum press" : order == 1 ? " press hum" : " hum");
+            continue;
+        }
+        ck_assert_int_eq(sscanf(line, "%lf %lf%n", &eh, &ed, &used), 2);
+        x = x * 6364136223846793005ULL + 1442695040888963407ULL;
+        hum = 50 + 30 * (double)(x >> 11) / 9007199254740992.0;
+        x = x * 6364136223846793005ULL + 1442695040888963407ULL;
+        press = 1000 + 20 * (double)(x >> 11) / 9007199254740992.0;
+        ed += 3.0 * (press - 1010) / 3600;
+        fprintf(f, "%.10f %.10f%s ", eh, ed, line + used);
+        if (order == 0)
+            fprintf(f, "%.6f %.6f\n", hum, press);
+        else if (order == 1)
+            fprintf(f, "%.6f %.6f\n", press, hum);
+        else
+            fprintf(f, "%.6f\n", hum);
+    }
+    fclose(in);
+    fclose(f);
+}
+
+START_TEST(test_pmfit_columns_by_name)
+{
+    char base[300], a[300], b[300], c[300], m[300], m3[300], h[300], sp[300], cmd[2000],
+        args[1400];
+    double rms_fit;
+    int n_east = 0;
+    FILE *f;
+    make_tmpdir();
+    snprintf(base, sizeof base, "%s/base.dat", tmpdir);
+    snprintf(a, sizeof a, "%s/a.dat", tmpdir);
+    snprintf(b, sizeof b, "%s/b.dat", tmpdir);
+    snprintf(c, sizeof c, "%s/c.dat", tmpdir);
+    snprintf(m, sizeof m, "%s/m.pm", tmpdir);
+    snprintf(m3, sizeof m3, "%s/m3.pm", tmpdir);
+    snprintf(h, sizeof h, "%s/m.h", tmpdir);
+    snprintf(sp, sizeof sp, "%s/s.pm", tmpdir);
+    ck_assert_int_eq(run("%s simulate %s --n 150 --seed 3%s", base, ""), 0);
+    write_aux_run(base, a, 0);
+    write_aux_run(base, b, 1);
+    write_aux_run(base, c, 2);
+
+    snprintf(args, sizeof args, "%s --add \"aux:press:e'\" --save %s --emit-c %s --json", a, m, h);
+    ck_assert_msg(run("%s fit %s%s", args, "") == 0, "%s", out);
+    rms_fit = tu_json_num(out, "rms_arcsec");
+    ck_assert_double_lt(rms_fit, 2.0);
+    snprintf(cmd, sizeof cmd, "grep -c '^input 1 press$' %s && grep -c '^pm-model 4$' %s && "
+             "grep -c \"aux\\[1\\]: the run's column 'press'\" %s", m, m, h);
+    ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
+
+    /* b: the columns swapped */
+    snprintf(args, sizeof args, "%s %s --json", m, b);
+    ck_assert_msg(run("%s eval %s%s", args, "") == 0, "%s", out);
+    ck_assert_double_eq_tol(tu_json_num(out, "rms_arcsec"), rms_fit, 1e-6);
+    /* c: no "press" */
+    snprintf(args, sizeof args, "%s %s", m, c);
+    ck_assert_int_eq(run("%s eval %s%s", args, ""), 1);
+    ck_assert_msg(strstr(out, "reads the column 'press', which") != NULL &&
+                      strstr(out, "hum, dec_dir") != NULL, "%s", out);
+    /* a version-3 file: by position, said */
+    snprintf(cmd, sizeof cmd, "grep -v '^input' %s | sed 's/^pm-model 4$/pm-model 3/' > %s", m, m3);
+    ck_assert_int_eq(system(cmd), 0);
+    snprintf(args, sizeof args, "%s %s --json", m3, b);
+    ck_assert_msg(run("%s eval %s%s", args, "") == 0, "%s", out);
+    ck_assert_msg(strstr(out, "does not name the column its term e'*aux1 reads") != NULL &&
+                      strstr(out, "column 2, 'hum', is taken") != NULL, "%s", out);
+    /* compare, OLD a model file and a run */
+    snprintf(args, sizeof args, "%s %s --json", m, b);
+    ck_assert_msg(run("%s compare %s%s", args, "") == 0, "%s", out);
+    ck_assert_msg(strstr(out, "\"moved\": []") != NULL, "%s", out);
+    snprintf(args, sizeof args, "%s %s --add \"aux:press:e'\" --json", a, b);
+    ck_assert_msg(run("%s compare %s%s", args, "") == 0, "%s", out);
+    ck_assert_msg(strstr(out, "\"moved\": []") != NULL, "%s", out);
+    ck_assert_double_lt(tu_json_num(out, "rms_as_is_arcsec"), 2.0);
+
+    /* --pier split: each file its side */
+    snprintf(args, sizeof args, "%s --pier split --save %s", a, sp);
+    ck_assert_msg(run("%s fit %s%s", args, "") == 0, "%s", out);
+    f = fopen(a, "r");
+    ck_assert_ptr_nonnull(f);
+    while (fgets(cmd, sizeof cmd, f))
+        n_east += cmd[0] != '#' && strstr(cmd, " E ") != NULL;
+    fclose(f);
+    ck_assert_int_gt(n_east, 20);
+    ck_assert_int_lt(n_east, 130);
+    snprintf(args, sizeof args, "%s-east %s --json", sp, a);
+    ck_assert_msg(run("%s eval %s%s", args, "") == 0, "%s", out);
+    ck_assert_int_eq((int)tu_json_num(out, "n_obs"), n_east);
+    ck_assert_msg(strstr(out, "pier side east (normal) only") != NULL, "%s", out);
+    snprintf(args, sizeof args, "%s-west %s --json", sp, a);
+    ck_assert_msg(run("%s eval %s%s", args, "") == 0, "%s", out);
+    ck_assert_int_eq((int)tu_json_num(out, "n_obs"), 150 - n_east);
+}
+END_TEST
+
 static Suite *suite(void)
 {
     Suite *s = suite_create("pmfit");
@@ -444,6 +563,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_pmfit_explain_refraction_words);
     tcase_add_test(tc, test_pmfit_explain_few_points_order0);
     tcase_add_test(tc, test_pmfit_eval_missing_input_and_long_comment);
+    tcase_add_test(tc, test_pmfit_columns_by_name);
     tcase_set_timeout(tc, 60);
     suite_add_tcase(s, tc);
     return s;

@@ -904,17 +904,32 @@ void print_robust_hint(const FitOut &f, const std::vector<Obs> &obs, const std::
                 ROBUST_DEFAULT_CLIP, s.size() == 1 ? "" : "s", lines.c_str(), path.c_str());
 }
 
-int cmd_eval(const Options &o, const std::vector<Obs> &obs, int mount)
+int cmd_eval(const Options &o, const Run &run_in)
 {
     FitOut f;
     char err[1024];
-    if (pmmodel_load(o.model.c_str(), &f.model, err, sizeof err) != 0)
+    pmmodel_info info;
+    if (pmmodel_load_info(o.model.c_str(), &f.model, &info, err, sizeof err) != 0)
         die(err, 1);
+    const int mount = run_in.mount;
     if (f.model.mount != mount)
         die(o.model + " is a model of an " +
                 (f.model.mount == PM_MOUNT_ALTAZ ? "alt-az" : "equatorial") + " mount, " +
                 o.run + " a run of an " + (mount == PM_MOUNT_ALTAZ ? "alt-az" : "equatorial") +
                 " one", 1);
+    // the run as the model reads it: its columns by name, its pier side
+    std::vector<std::string> columns, notes;
+    for (int j = 0; j < PM_MAX_AUX; j++)
+        columns.push_back(info.input[j]);
+    Run run;
+    try {
+        run = run_for_model(run_in, f.model, columns, info.pier, o.model, &notes);
+    } catch (const std::exception &x) {
+        die(x.what(), 1);
+    }
+    for (const std::string &n : notes)
+        std::fprintf(stderr, "pmfit: note: %s\n", n.c_str());
+    const std::vector<Obs> &obs = run.obs;
     std::vector<int> all(obs.size());
     for (size_t i = 0; i < obs.size(); i++)
         all[i] = (int)i;
@@ -1064,8 +1079,7 @@ int cmd_compare(const Options &o, const Run &run)
         fail_fit(os.fit, o.model + " (the old run)");
     Comparison c;
     try {
-        c = compare_models(os.model, os.err, run, os.is_run ? &os.fit : nullptr,
-                           os.is_run ? &os.run : nullptr);
+        c = compare_old(os, run, o.model);
     } catch (const std::exception &x) {
         die(o.model + " vs " + o.run + ": " + x.what(), 1);
     }
@@ -1546,7 +1560,7 @@ int run_main(int argc, char **argv)
     const std::vector<std::string> &aux_names = run.aux_names;
     int mount = run.mount;
     if (o.cmd == "eval")
-        return cmd_eval(o, obs, mount);
+        return cmd_eval(o, run);
     if (o.cmd == "compare")
         return cmd_compare(o, run);
     if (o.cmd == "explain")
@@ -1662,9 +1676,24 @@ int run_main(int argc, char **argv)
                                      : std::string()) +
                            (undetermined[k].empty() ? "" : "\nwarning: " + undetermined[k]);
         char e[1024];
+        // what the model file says beyond the model: the names of the
+        // columns its terms read (another run may have them in another
+        // order) and, split, its pier side
+        pmmodel_info info =
+            model_info(fits[k].model, aux_names, fits.size() == 1 ? 0 : (k == 0 ? 1 : -1));
+        std::string inputs_note;
+        for (int j = 0; j < PM_MAX_AUX; j++)
+            if (info.input[j][0])
+                inputs_note += "\npm_context.aux[" + std::to_string(j) + "]: the run's column '" +
+                               info.input[j] + "'" +
+                               (std::string(info.input[j]) == "dec_dir" && run.dec_dir_derived
+                                    ? " (the sign of the axis-2 move from the previous "
+                                      "position, derived)"
+                                    : "");
         // a write that fails now still lets the report below be printed
         if (!o.save.empty() &&
-            pmmodel_save((o.save + suffix).c_str(), &fits[k].model, note.c_str(), e, sizeof e) != 0)
+            pmmodel_save_info((o.save + suffix).c_str(), &fits[k].model, &info, note.c_str(), e,
+                              sizeof e) != 0)
             write_errors.push_back(e);
         if (!o.tpoint_terms.empty()) {
             if (pmtp_write((o.tpoint_terms + suffix).c_str(), &fits[k].model, fits[k].res.err,
@@ -1675,7 +1704,7 @@ int run_main(int argc, char **argv)
         if (!o.emit_c.empty()) {
             std::string prefix = fits.size() == 1 ? "pm_fitted" : (k == 0 ? "pm_east" : "pm_west");
             if (pmmodel_emit_c((o.emit_c + suffix).c_str(), &fits[k].model, prefix.c_str(),
-                               note.c_str(), e, sizeof e) != 0)
+                               (note + inputs_note).c_str(), e, sizeof e) != 0)
                 write_errors.push_back(e);
         }
     }

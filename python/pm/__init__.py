@@ -284,7 +284,10 @@ class Model(_pm.Model):
     whole: the model is prepared again, and left unchanged if that fails),
     ``terms`` (dicts), ``order``,
     ``n_terms``, ``mount``, ``latitude`` (radians, used by refraction and
-    tube-flexure terms).
+    tube-flexure terms), ``inputs`` ({j: column name}: the run column each
+    ``aux[:, j]`` the model reads is, where a fit or a version-4 model file
+    says so; ``save`` writes it and ``compare`` finds the columns by it) and
+    ``pier_side`` (0; +1 or -1 for a model of one pier side, ``split=True``).
     """
 
     def __init__(self, order=1, mount="equatorial", latitude=0.0):

@@ -108,3 +108,50 @@ def test_compare_equals_pmfit(tmp_path):
         pm.compare(bad, SIM)
     with pytest.raises(pm.ArgumentError, match="--add"):
         pm.compare(SIM, SIM, add="nonsense")
+
+
+def _with_columns(src, dst, names):
+    """src's records with the columns hum and press added in the order of
+    names (press absent when not named), the encoder Dec off by 3" per hPa."""
+    rng = __import__("numpy").random.default_rng(5)
+    out = []
+    for line in open(src):
+        line = line.rstrip("\n")
+        if line.startswith("# tau"):
+            out.append(line + " " + " ".join(names))
+            continue
+        if line.startswith("#") or not line.strip():
+            out.append(line)
+            continue
+        f = line.split()
+        hum, press = 50 + 30 * rng.random(), 1000 + 20 * rng.random()
+        f[1] = "%.10f" % (float(f[1]) + 3.0 * (press - 1010) / 3600)
+        val = {"hum": "%.6f" % hum, "press": "%.6f" % press}
+        out.append(" ".join(f + [val[n] for n in names]))
+    dst.write_text("\n".join(out) + "\n")
+    return str(dst)
+
+
+def test_model_columns_by_name(tmp_path):
+    """A fit's model knows the names of the columns it reads; a saved and
+    loaded model keeps them; compare on a run with the columns in another
+    order is the compare on the same columns (pmfit's, too); a split fit's
+    models know their pier side."""
+    a = _with_columns(SIM, tmp_path / "a.dat", ["hum", "press"])
+    b = _with_columns(SIM, tmp_path / "b.dat", ["press", "hum"])
+    c = _with_columns(SIM, tmp_path / "c.dat", ["hum"])
+    f = pm.fit_run(a, add=["aux:press:e'"])
+    assert f.model.inputs == {1: "press"} and f.model.pier_side == 0
+    path = tmp_path / "m.pm"
+    f.model.save(str(path))
+    m = pm.load_model(str(path))
+    assert m.inputs == {1: "press"} and m.copy().inputs == {1: "press"}
+    got = pm.compare(m, b)
+    assert got["moved"] == []
+    assert got["rms_as_is_arcsec"] == pytest.approx(pm.compare(m, a)["rms_as_is_arcsec"], rel=1e-9)
+    assert got == cli("compare", path, b, "--json")
+    assert pm.compare(a, b, add=["aux:press:e'"])["moved"] == []
+    with pytest.raises(pm.Error, match="reads the column 'press'"):
+        pm.compare(m, c)
+    east, west = pm.fit_run(a, split=True)
+    assert (east.model.pier_side, west.model.pier_side) == (1, -1)

@@ -274,7 +274,10 @@ std::string comparison_json(const Comparison &c)
          num(c.cv_rezero) + ", \"refit\": " + num(c.cv_refit) +
          "}, \"old_predicted_sigma_arcsec\": {\"at_new_points\": " + num(c.old_pred_new) +
          ", \"at_old_points\": " + num(c.old_pred_old) + "}, \"advice\": \"" +
-         json_escape(c.advice) + "\"}";
+         json_escape(c.advice) + "\", \"notes\": [";
+    for (size_t k = 0; k < c.notes.size(); k++)
+        j += std::string(k ? ", " : "") + "\"" + json_escape(c.notes[k]) + "\"";
+    j += "]}";
     return j;
 }
 
@@ -282,6 +285,8 @@ void print_comparison(const Comparison &c, const std::string &old_name, const st
 {
     std::printf("pmfit compare %s %s: %ld observations, %d terms\n\n", old_name.c_str(),
                 run_name.c_str(), c.n_obs, c.n_terms);
+    for (const std::string &n : c.notes)
+        std::printf("  note: %s\n\n", n.c_str());
     std::printf("  the old model on the new run, no refit: RMS %.3f\" per axis (a refit: sigma "
                 "%.3f\")\n", c.rms_as_is, c.sigma_refit);
     std::printf("\n  terms that moved (beyond 3 sigma of the %s):\n",
@@ -320,6 +325,7 @@ OldSide old_from_run(const Run &run, int order, const std::vector<std::string> &
         o.model = o.fit.model;
         o.err.assign(o.fit.res.err, o.fit.res.err + o.fit.model.n_terms);
     }
+    o.inputs = o.run.aux_names;
     return o;
 }
 
@@ -332,12 +338,26 @@ OldSide load_old(const std::string &path, int order, const std::vector<std::stri
     if (kind < 0)
         throw std::runtime_error(err);
     if (kind == 1) {
-        if (pmmodel_load(path.c_str(), &o.model, err, sizeof err) != 0)
+        pmmodel_info info;
+        if (pmmodel_load_info(path.c_str(), &o.model, &info, err, sizeof err) != 0)
             throw std::runtime_error(err);
+        for (int j = 0; j < PM_MAX_AUX; j++)
+            o.inputs.push_back(info.input[j]);
+        o.pier = info.pier;
         return o;
     }
     return old_from_run(load_run(path, refraction, skip_bad, format, equinox), order, adds,
                         max_passes);
+}
+
+Comparison compare_old(const OldSide &os, const Run &run, const std::string &old_name)
+{
+    std::vector<std::string> notes;
+    Run r = run_for_model(run, os.model, os.inputs, os.pier, old_name, &notes);
+    Comparison c = compare_models(os.model, os.err, r, os.is_run ? &os.fit : nullptr,
+                                  os.is_run ? &os.run : nullptr);
+    c.notes = notes;
+    return c;
 }
 
 } // namespace pmhost

@@ -34,6 +34,7 @@ struct Comparison {
     // the new run's points and at its own; NaN for a model file
     double old_pred_new = NAN, old_pred_old = NAN;
     std::string advice;
+    std::vector<std::string> notes; // how the run was read for the old model (run_for_model)
     pm_model refit, rezeroed;
 };
 
@@ -53,6 +54,10 @@ struct OldSide {
     std::vector<double> err;   // the run's fit's 1-sigma errors; empty for a model file
     FitOut fit;                // a run: its fit; check fit.status (the caller words a failure)
     Run run;                   // a run: the run
+    // the columns the model reads as ctx.aux[j] (a run's names; a model
+    // file's input lines, "" where it has none) and its pier side (0: both)
+    std::vector<std::string> inputs;
+    int pier = 0;
 };
 // Throws std::runtime_error with the file's message when OLD cannot be
 // opened or read (its file:line).
@@ -63,6 +68,10 @@ OldSide load_old(const std::string &path, int order, const std::vector<std::stri
 OldSide old_from_run(const Run &run, int order, const std::vector<std::string> &adds,
                      int max_passes);
 
+// compare_models of OLD on the new run, read as OLD's model reads a run
+// (run_for_model: its columns by name, its pier side); old_name for the
+// messages.  Throws std::runtime_error as compare_models and run_for_model.
+Comparison compare_old(const OldSide &os, const Run &run, const std::string &old_name);
 std::string comparison_json(const Comparison &c);
 void print_comparison(const Comparison &c, const std::string &old_name, const std::string &run_name);
 

@@ -132,6 +132,7 @@ void derive_directions(Run &r)
     if (!have_dec_dir && (int)r.aux_names.size() < PM_MAX_AUX && r.obs.size() > 1) {
         int j = (int)r.aux_names.size();
         r.aux_names.push_back("dec_dir");
+        r.dec_dir_derived = true;
         r.obs[0].ctx.aux[j] = 0;
         for (size_t i = 1; i < r.obs.size(); i++)
             r.obs[i].ctx.aux[j] = move_sign(r.obs[i - 1].ed, r.obs[i].ed, cut2, true);
@@ -635,6 +636,102 @@ pm_model build_model(int order, const std::vector<std::string> &adds,
             add_side_harmonic(b, a);
     }
     return b.m;
+}
+
+Run run_for_model(const Run &run, const pm_model &m, const std::vector<std::string> &inputs,
+                  int pier, const std::string &model_name, std::vector<std::string> *notes)
+{
+    Run r = run;
+    r.aux_names.assign(PM_MAX_AUX, std::string());
+    std::vector<bool> used(PM_MAX_AUX, false);
+    std::vector<std::string> readers(PM_MAX_AUX);
+    for (int i = m.n_base; i < m.n_terms; i++) {
+        const int j = m.term[i].aux - PM_AUX_USER;
+        if (m.term[i].kind == PM_TERM_AUX && j >= 0 && j < PM_MAX_AUX) {
+            readers[(size_t)j] += (used[(size_t)j] ? ", " : "") + term_name(m, i);
+            used[(size_t)j] = true;
+        }
+    }
+    auto columns = [&run]() {
+        std::string c;
+        for (const std::string &n : run.aux_names)
+            c += (c.empty() ? "" : ", ") + n;
+        return c.empty() ? std::string("none") : c;
+    };
+    for (size_t j = 0; j < (size_t)PM_MAX_AUX; j++) {
+        const std::string name = j < inputs.size() ? inputs[j] : std::string();
+        long from = -1;
+        if (used[j] && name.empty()) {
+            /* a model file that does not name its inputs: by position, said */
+            from = (long)j;
+            if (j < run.aux_names.size() && notes)
+                notes->push_back(model_name + " does not name the column its term" +
+                                 (readers[j].find(',') != std::string::npos ? "s " : " ") +
+                                 readers[j] +
+                                 (readers[j].find(',') != std::string::npos ? " read" : " reads") +
+                                 " (a model file of before version 4): " +
+                                 run.path + "'s auxiliary column " + std::to_string(j + 1) +
+                                 ", '" + run.aux_names[j] + "', is taken for it");
+        } else if (used[j]) {
+            for (size_t q = 0; q < run.aux_names.size() && from < 0; q++)
+                if (run.aux_names[q] == name)
+                    from = (long)q;
+            if (from < 0)
+                throw std::runtime_error(model_name + ": its term" +
+                                         (readers[j].find(',') != std::string::npos ? "s " : " ") +
+                                         readers[j] +
+                                         (readers[j].find(',') != std::string::npos ? " read"
+                                                                                    : " reads") +
+                                         " the column '" + name + "', which " +
+                                         run.path + " does not have (its auxiliary columns: " +
+                                         columns() + ")");
+            if (from >= PM_MAX_AUX)
+                throw std::runtime_error(model_name + ": " + run.path + "'s column '" + name +
+                                         "' is its auxiliary column " + std::to_string(from + 1) +
+                                         "; the core reads the first " +
+                                         std::to_string(PM_MAX_AUX) +
+                                         " (PM_MAX_AUX): put it among them");
+        }
+        if (from >= 0 && (size_t)from < run.aux_names.size())
+            r.aux_names[j] = run.aux_names[(size_t)from];
+        for (size_t i = 0; i < r.obs.size(); i++)
+            r.obs[i].ctx.aux[j] = from >= 0 ? run.obs[i].ctx.aux[from] : NAN;
+    }
+    while (!r.aux_names.empty() && r.aux_names.back().empty())
+        r.aux_names.pop_back();
+    if (pier) {
+        const char *side = pier > 0 ? "east (normal)" : "west (beyond the pole)";
+        std::vector<Obs> keep;
+        for (const Obs &ob : r.obs)
+            if (ob.pier == pier)
+                keep.push_back(ob);
+        if (keep.empty())
+            throw std::runtime_error(model_name + " is a model of the pier side " + side +
+                                     " only (pmfit fit --pier split), and " + run.path +
+                                     " has no record of that side");
+        if (notes && keep.size() < r.obs.size())
+            notes->push_back(model_name + " is a model of the pier side " + side +
+                             " only (pmfit fit --pier split): the " +
+                             std::to_string(keep.size()) + " records of that side are used, " +
+                             std::to_string(r.obs.size() - keep.size()) + " others not");
+        r.obs = keep;
+    }
+    return r;
+}
+
+pmmodel_info model_info(const pm_model &m, const std::vector<std::string> &aux_names, int pier)
+{
+    pmmodel_info info;
+    std::memset(&info, 0, sizeof info);
+    info.pier = pier;
+    for (int i = m.n_base; i < m.n_terms; i++) {
+        const size_t j = (size_t)(m.term[i].aux - PM_AUX_USER);
+        if (m.term[i].kind == PM_TERM_AUX && m.term[i].aux >= PM_AUX_USER &&
+            j < (size_t)PM_MAX_AUX && j < aux_names.size() &&
+            aux_names[j].size() < PMMODEL_NAME_MAX)
+            std::memcpy(info.input[j], aux_names[j].c_str(), aux_names[j].size() + 1);
+    }
+    return info;
 }
 
 // The model without its side-specific added terms (for the pier F-test).

@@ -7,6 +7,7 @@
 #define PM_FITRUN_HPP
 
 #include "pm.h"
+#include "modelfile.h"
 #include "runfile.h"
 
 #include <string>
@@ -45,6 +46,7 @@ struct Run {
     std::vector<std::string> aux_names;
     std::vector<std::string> notes; // reader warnings, skipped records
     bool dir_derived = false;       // slew directions from the sequence
+    bool dec_dir_derived = false;   // the input "dec_dir" too (derive_directions)
 };
 
 // Read a run (pmrun_read); without a direction column the slew direction on
@@ -80,6 +82,23 @@ pm_model build_model(int order, const std::vector<std::string> &adds,
                      const std::vector<std::string> &aux_names);
 // The model without its side-specific added terms.
 pm_model without_side_terms(const pm_model &m);
+
+// The run as model m (of model_name) reads it, for evaluating a model
+// fitted on another run.  inputs[j]: the name of the column m reads as
+// ctx.aux[j] ("" where not known: a version-3 model file); each such
+// column is looked up in run by its name and moved to slot j, so a run
+// whose columns come in another order (or lack one a fit derived, as
+// "dec_dir" from the sequence) is read right.  pier: 0, or the one pier
+// side (+1 east, -1 west) m was fitted to: the records of that side only.
+// What was done by position or left out is said in *notes.  Throws
+// std::runtime_error ("model_name: ...") when the run lacks a named
+// column or has no record of the side.
+Run run_for_model(const Run &run, const pm_model &m, const std::vector<std::string> &inputs,
+                  int pier, const std::string &model_name, std::vector<std::string> *notes);
+// What a model file of m fitted on a run with auxiliary columns aux_names
+// (pier: 0, or the one side it was fitted to) says beyond the model
+// (pmmodel_info): the names of the columns its terms read.
+pmmodel_info model_info(const pm_model &m, const std::vector<std::string> &aux_names, int pier);
 
 // The Gauss-Newton passes a fit may take: pmfit fit's, and every host
 // tool's by default (explain's candidate fits too, so that explain fits

@@ -1,6 +1,7 @@
 // hostutil.cpp - helpers shared by the host-side tools.
 #include "hostutil.hpp"
 
+#include <cctype>
 #include <cerrno>
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -281,6 +282,16 @@ void parallel_for(size_t n, const std::function<void(size_t)> &f)
         th.join();
     if (first)
         std::rethrow_exception(first);
+}
+
+bool valid_column_name(const std::string &s)
+{
+    if (s.empty() || !(std::isalpha((unsigned char)s[0]) || s[0] == '_'))
+        return false;
+    for (char c : s)
+        if (!(std::isalnum((unsigned char)c) || c == '_' || c == '.' || c == '-'))
+            return false;
+    return true;
 }
 
 } // namespace pmhost

@@ -22,6 +22,10 @@ int write_atomic(const std::string &path, const std::string &text, char *err, si
 // '#' comment starts "pm-model") rather than a run?  Returns 1 or 0, or -1
 // with "path: cannot open: reason" in err.  (pmfit compare OLD, report
 // --compare OLD: OLD is either.)
+// A column name of the named-column format (docs/formats.md): letters,
+// digits, '_', '.', '-', not empty, a letter or '_' first.
+bool valid_column_name(const std::string &s);
+
 int is_model_file(const std::string &path, char *err, size_t errlen);
 
 // printf into a std::string, of any length.

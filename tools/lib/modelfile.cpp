@@ -126,8 +126,65 @@ static bool preparable(const pm_model *m, const char *path, const char *who, cha
     return false;
 }
 
+// Does the model read its user input j (a term on PM_AUX_USER + j)?
+static bool reads_input(const pm_model *m, int j)
+{
+    for (int i = m->n_base; i < m->n_terms; i++)
+        if (m->term[i].kind == PM_TERM_AUX && m->term[i].aux == PM_AUX_USER + j)
+            return true;
+    return false;
+}
+
+// The info's lines of a version-4 file ("" when it says nothing of this
+// model), or false with err when a name cannot be written.
+static bool info_lines(const pm_model *m, const pmmodel_info *info, const char *path,
+                       std::string *lines, char *err, size_t errlen)
+{
+    lines->clear();
+    if (!info)
+        return true;
+    if (info->pier < -1 || info->pier > 1) {
+        set_err(err, errlen, std::string(path) + ": pmmodel_save_info: pier " +
+                                 std::to_string(info->pier) + " (expected 0, +1 or -1)");
+        return false;
+    }
+    std::vector<std::string> used;
+    for (int j = 0; j < PM_MAX_AUX; j++) {
+        const char *nm = info->input[j];
+        size_t len = strnlen(nm, PMMODEL_NAME_MAX);
+        if (len == 0 || !reads_input(m, j))
+            continue;
+        std::string name(nm, len);
+        if (len == PMMODEL_NAME_MAX || !pmhost::valid_column_name(name)) {
+            set_err(err, errlen, std::string(path) + ": pmmodel_save_info: input " +
+                                     std::to_string(j) + ": '" + name.substr(0, 80) +
+                                     "' is not a column name (letters, digits, '_', '.', '-', "
+                                     "a letter or '_' first, under " +
+                                     std::to_string(PMMODEL_NAME_MAX) + " bytes)");
+            return false;
+        }
+        for (const std::string &u : used)
+            if (u == name) {
+                set_err(err, errlen, std::string(path) + ": pmmodel_save_info: two inputs "
+                                         "named '" + name + "'");
+                return false;
+            }
+        used.push_back(name);
+        *lines += "input " + std::to_string(j) + " " + name + "\n";
+    }
+    if (info->pier)
+        *lines += std::string("pier ") + (info->pier > 0 ? "east" : "west") + "\n";
+    return true;
+}
+
 extern "C" int pmmodel_save(const char *path, const pm_model *m, const char *comment,
                             char *err, size_t errlen)
+{
+    return pmmodel_save_info(path, m, nullptr, comment, err, errlen);
+}
+
+extern "C" int pmmodel_save_info(const char *path, const pm_model *m, const pmmodel_info *info,
+                                 const char *comment, char *err, size_t errlen)
 {
     if (!path || !m || m->n_terms < 6 || m->n_terms > PM_MAX_TERMS) {
         set_err(err, errlen, "pmmodel_save: invalid arguments");
@@ -135,13 +192,19 @@ extern "C" int pmmodel_save(const char *path, const pm_model *m, const char *com
     }
     if (!preparable(m, path, "pmmodel_save", err, errlen))
         return -1;
+    std::string extra;
+    if (!info_lines(m, info, path, &extra, err, errlen))
+        return -1;
     std::string out;
     comment_lines(out, comment, "# ");
-    out += "pm-model 3\n";
+    /* (version 3 where there is nothing more to say: a reader of before
+    ** version 4 reads it as before) */
+    out += extra.empty() ? "pm-model 3\n" : "pm-model 4\n";
     out += std::string("mount ") + (m->mount == PM_MOUNT_ALTAZ ? "altaz" : "equatorial") + "\n";
     out += "order " + std::to_string(m->order) + "\n";
     if (m->latitude != 0)
         out += "latitude " + fmt17(m->latitude) + "\n";
+    out += extra;
     out += "terms " + std::to_string(m->n_terms) + "\n";
     out += "# name k l m value_rad\n";
     for (int i = 0; i < m->n_terms; i++) {
@@ -172,8 +235,13 @@ struct Loader {
     int got = 0;   // terms read
     double latitude = 0;
     pm_model m;
+    pmmodel_info info;          // version 4's input and pier lines
     std::vector<int> term_line; // line of each term, for the term-list check
-    Loader() { std::memset(&m, 0, sizeof m); }
+    Loader()
+    {
+        std::memset(&m, 0, sizeof m);
+        std::memset(&info, 0, sizeof info);
+    }
 };
 
 // A term that an older file's version evaluated elsewhere: version 1 the
@@ -208,6 +276,42 @@ bool moved_term(const Loader &L, int kind, long k, long l, double v, bool added)
     return k == 3 || k == 4;
 }
 
+// Version 4's "input J NAME" (the run column read as pm_context.aux[J])
+// and "pier east|west" (a one-side model) lines: "" or why not.
+std::string info_line(Loader &L, const std::vector<std::string> &tok)
+{
+    if (L.version < 4)
+        return "an '" + tok[0] + "' line in a 'pm-model " + std::to_string(L.version) +
+               "' file (version 4 has them)";
+    if (tok[0] == "pier") {
+        if (tok.size() != 2 || (tok[1] != "east" && tok[1] != "west"))
+            return "expected 'pier east' or 'pier west' (a model of one pier side)";
+        if (L.info.pier)
+            return "a second 'pier' line";
+        L.info.pier = tok[1] == "east" ? 1 : -1;
+        return "";
+    }
+    long j;
+    if (tok.size() != 3 || !parse_int(tok[1], 0, 1000, &j))
+        return "expected 'input J NAME': the run column NAME read as the context's aux[J]";
+    if (j >= PM_MAX_AUX)
+        return "input " + tok[1] + " is beyond this build's PM_MAX_AUX = " +
+               std::to_string(PM_MAX_AUX) + " inputs (0.." + std::to_string(PM_MAX_AUX - 1) +
+               ")";
+    if (tok[2].size() >= PMMODEL_NAME_MAX || !pmhost::valid_column_name(tok[2]))
+        return "input name '" + tok[2].substr(0, 80) + "' is not a column name (letters, "
+               "digits, '_', '.', '-', a letter or '_' first, under " +
+               std::to_string(PMMODEL_NAME_MAX) + " bytes)";
+    if (L.info.input[j][0])
+        return "a second name for input " + tok[1];
+    for (int q = 0; q < PM_MAX_AUX; q++)
+        if (tok[2] == L.info.input[q])
+            return "input " + tok[1] + " is named '" + tok[2] + "' as input " +
+                   std::to_string(q) + " is";
+    std::memcpy(L.info.input[j], tok[2].c_str(), tok[2].size() + 1);
+    return "";
+}
+
 // The header's lines, one state each: "" when the line is right, else why.
 std::string header_line(Loader &L, const std::vector<std::string> &tok)
 {
@@ -215,8 +319,9 @@ std::string header_line(Loader &L, const std::vector<std::string> &tok)
     case Loader::HEADER:
         if (tok.size() != 2 || tok[0] != "pm-model")
             return "expected 'pm-model 3' (is this a pm model file?)";
-        if (tok[1] != "1" && tok[1] != "2" && tok[1] != "3")
-            return "model file version '" + tok[1] + "' not supported (expected 3, or 2 or 1)";
+        if (tok[1] != "1" && tok[1] != "2" && tok[1] != "3" && tok[1] != "4")
+            return "model file version '" + tok[1] + "' not supported (expected 4 or 3, or 2 "
+                   "or 1)";
         L.version = tok[1][0] - '0';
         L.state = Loader::MOUNT;
         return "";
@@ -241,6 +346,8 @@ std::string header_line(Loader &L, const std::vector<std::string> &tok)
                 return "bad latitude '" + tok[1] + "' (expected radians, |lat| <= pi/2)";
             return "";
         }
+        if (tok[0] == "input" || tok[0] == "pier")
+            return info_line(L, tok);
         if (tok.size() != 2 || tok[0] != "terms" || !parse_int(tok[1], 6, 100000, &L.nterms))
             return "expected 'terms P' with an integer P >= 6";
         if (L.nterms > PM_MAX_TERMS)
@@ -378,6 +485,12 @@ std::string check_term_list(Loader &L)
 
 extern "C" int pmmodel_load(const char *path, pm_model *out, char *err, size_t errlen)
 {
+    return pmmodel_load_info(path, out, nullptr, err, errlen);
+}
+
+extern "C" int pmmodel_load_info(const char *path, pm_model *out, pmmodel_info *info, char *err,
+                                 size_t errlen)
+{
     if (!path || !out) {
         set_err(err, errlen, "pmmodel_load: invalid arguments");
         return -1;
@@ -439,7 +552,10 @@ extern "C" int pmmodel_load(const char *path, pm_model *out, char *err, size_t e
                              "added terms must be valid for the mount and order)");
         return -1;
     }
+    /* (a name of an input no term reads is kept: harmless, as in the file) */
     *out = m;
+    if (info)
+        *info = L.info;
     return 0;
 }
 

@@ -5,9 +5,11 @@
 **  The model file format (docs/formats.md, "Model files"):
 **
 **     # any comment
-**     pm-model 2                  (version 1 read as docs/formats.md says)
+**     pm-model 3                  (versions 1, 2 read as docs/formats.md says)
 **     mount equatorial            (or altaz)
 **     order 2
+**     input 0 humidity            (version 4 only: pmmodel_info below)
+**     pier east                   (version 4 only)
 **     terms 46
 **     term c' 3 0 0 1.2345678901234567e-03
 **     ...                         (name k l m value-in-radians, %.17g)
@@ -42,6 +44,43 @@ int pmmodel_save(const char *path, const pm_model *m, const char *comment,
 **  expected"; *m is unchanged on error.
 */
 int pmmodel_load(const char *path, pm_model *m, char *err, size_t errlen);
+
+/* Longest name of an input column, with its NUL. */
+#define PMMODEL_NAME_MAX 64
+
+/*
+**  pmmodel_info - what a model file says beyond the model (version 4):
+**     input[j]  the name of the run's column the model reads as
+**               pm_context.aux[j] (its terms' PM_AUX_USER + j); "" where
+**               the file does not say (a version-3 file, or a column
+**               not used).  A host evaluating the model on another run
+**               finds the column by this name, not by its position:
+**               a run whose columns come in another order has the
+**               same column at another index.
+**     pier      0: a model of both pier sides; +1 (east, normal) or -1
+**               (west, beyond the pole): a model fitted to that side's
+**               records only (pmfit fit --pier split), which points
+**               only there.
+**  Zero it (memset) for "nothing more to say".
+*/
+typedef struct pmmodel_info {
+    char input[PM_MAX_AUX][PMMODEL_NAME_MAX];
+    int pier;
+} pmmodel_info;
+
+/*
+**  pmmodel_save_info / pmmodel_load_info - pmmodel_save and pmmodel_load
+**  with the information above (info NULL: none; the file is then version
+**  3, as is one whose info names nothing the model uses and gives no pier
+**  side).  A name must be a column name of the named-column format
+**  (letters, digits, '_', '.', '-', not a digit first) shorter than
+**  PMMODEL_NAME_MAX; two inputs may not share one.  pmmodel_load_info
+**  clears *info, then fills what the file says (*info unchanged on error).
+*/
+int pmmodel_save_info(const char *path, const pm_model *m, const pmmodel_info *info,
+                      const char *comment, char *err, size_t errlen);
+int pmmodel_load_info(const char *path, pm_model *m, pmmodel_info *info, char *err,
+                      size_t errlen);
 
 /*
 **  pmmodel_emit_c - write a C89 header holding the model as constant data

@@ -237,8 +237,7 @@ void stage_compare(Data &d)
     d.old_what = os.is_run ? fmt("the run %s (fitted at order %d)", old.c_str(), d.o.order)
                            : "the model file " + old;
     try {
-        d.cmp = compare_models(os.model, os.err, d.run, os.is_run ? &os.fit : nullptr,
-                               os.is_run ? &os.run : nullptr);
+        d.cmp = compare_old(os, d.run, old);
     } catch (const std::exception &x) {
         throw std::runtime_error(old + " vs " + d.run.path + ": " + x.what());
     }
@@ -845,8 +844,12 @@ void summary(Page &p, const Data &d)
     if (!undetermined.empty())
         p.body += "<br><b>warning</b>: " + h(undetermined);
     p.body += "</dd>\n";
-    if (d.have_cmp)
-        p.body += "<dt>since before</dt><dd>" + h(d.cmp.advice) + "</dd>\n";
+    if (d.have_cmp) {
+        p.body += "<dt>since before</dt><dd>" + h(d.cmp.advice);
+        for (const std::string &n : d.cmp.notes)
+            p.body += "<br>note: " + h(n);
+        p.body += "</dd>\n";
+    }
     p.body += "</dl>\n";
     if (!d.run.notes.empty()) {
         p.body += "<p>Notes from reading the run:</p>\n<ul>\n";

@@ -2,6 +2,7 @@
 // 2016) and the named-column format ("# tau delta T D pier temp ..." header
 // plus "# key: value" metadata).  docs/formats.md, sections 1 and 2.
 #include "runfile_internal.hpp"
+#include "hostutil.hpp"
 
 #include <cmath>
 #include <cstring>
@@ -33,17 +34,7 @@ bool known_column(const std::string &lname, Col &kind)
     return false;
 }
 
-bool valid_aux_name(const std::string &s)
-{
-    if (s.empty()) return false;
-    char c0 = s[0];
-    if (!((c0 >= 'A' && c0 <= 'Z') || (c0 >= 'a' && c0 <= 'z') || c0 == '_')) return false;
-    for (char c : s)
-        if (!((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') ||
-              c == '_' || c == '.' || c == '-'))
-            return false;
-    return true;
-}
+bool valid_aux_name(const std::string &s) { return pmhost::valid_column_name(s); }
 
 class ColumnParser : public FormatParser {
 public:
