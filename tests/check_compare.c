@@ -209,7 +209,8 @@ END_TEST
 ** 20" of refraction, at latitudes 47 and 30 deg.  Refitted at the model's
 ** latitude, the refraction term's elevations were wrong and cot(el) "moved"
 ** by 18" (95 sigma); at the run's latitude nothing moves, and the advice
-** names both latitudes. */
+** names both latitudes; pmfit eval, which evaluates the model as it is,
+** notes the two latitudes. */
 START_TEST(test_compare_other_site)
 {
     char cmd[2048];
@@ -238,6 +239,15 @@ START_TEST(test_compare_other_site)
     /* the same site: no word of latitudes */
     snprintf(cmd, sizeof cmd, "cd %s && %s compare north.pm north.dat --add refraction --json", dir,
              tu_pmfit_path());
+    ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
+    ck_assert_ptr_null(strstr(out, "fitted at latitude"));
+    /* eval evaluates the model as it is, and says where it was fitted (it
+    ** said nothing) */
+    snprintf(cmd, sizeof cmd, "cd %s && %s eval north.pm south.dat", dir, tu_pmfit_path());
+    ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
+    ck_assert_msg(strstr(out, "north.pm was fitted at latitude +47.0000 deg, south.dat is at "
+                              "+30.0000 deg: evaluated as the model is") != NULL, "%s", out);
+    snprintf(cmd, sizeof cmd, "cd %s && %s eval north.pm north.dat", dir, tu_pmfit_path());
     ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
     ck_assert_ptr_null(strstr(out, "fitted at latitude"));
 }

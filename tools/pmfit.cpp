@@ -927,6 +927,19 @@ int cmd_eval(const Options &o, const Run &run_in)
     } catch (const std::exception &x) {
         die(x.what(), 1);
     }
+    // the model's elevation-dependent terms (refraction, tube flexure) read
+    // the elevation at the model's latitude: at another site's run they
+    // point for the wrong sky (as the model would in that mount's firmware)
+    bool zenith = false;
+    for (int i = f.model.n_base; i < f.model.n_terms; i++)
+        zenith = zenith || f.model.term[i].kind == PM_TERM_ZENITH;
+    if (zenith && mount != PM_MOUNT_ALTAZ && std::isfinite(run.latitude) &&
+        std::fabs(run.latitude - f.model.latitude) > 1e-6)
+        notes.push_back(fmt("%s was fitted at latitude %+.4f deg, %s is at %+.4f deg: evaluated "
+                            "as the model is, its elevation-dependent terms (refraction, tube "
+                            "flexure) at its own latitude; pmfit compare refits at the run's",
+                            o.model.c_str(), f.model.latitude * 180 / PI, o.run.c_str(),
+                            run.latitude * 180 / PI));
     for (const std::string &n : notes)
         std::fprintf(stderr, "pmfit: note: %s\n", n.c_str());
     const std::vector<Obs> &obs = run.obs;
