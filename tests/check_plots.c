@@ -27,28 +27,6 @@ static void path_in(char *buf, size_t len, const char *name)
     snprintf(buf, len, "%s/%s", tmpdir, name);
 }
 
-/* The whole file, NUL-terminated (caller frees), or NULL. */
-static char *slurp(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    char *s;
-    long n;
-    if (!f)
-        return NULL;
-    fseek(f, 0, SEEK_END);
-    n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    s = malloc((size_t)n + 1);
-    if (s && fread(s, 1, (size_t)n, f) != (size_t)n) {
-        free(s);
-        s = NULL;
-    }
-    if (s)
-        s[n] = 0;
-    fclose(f);
-    return s;
-}
-
 /* A small well-formedness check: declarations and comments skipped, every
 ** start tag closed by the matching end tag, one root, quoted attributes, no
 ** raw '<' or unescaped '&' in text.  Returns 1 if well-formed. */
@@ -121,7 +99,7 @@ static char *check_svg(const char *name, const char *want)
     char path[400], cmd[600];
     char *s;
     path_in(path, sizeof path, name);
-    s = slurp(path);
+    s = tu_slurp(path);
     ck_assert_msg(s != NULL, "%s was not written", path);
     ck_assert_msg(strncmp(s, "<?xml", 5) == 0 || strncmp(s, "<svg", 4) == 0, "%s: not an SVG", path);
     ck_assert_msg(strstr(s, "<svg") != NULL && strstr(s, "</svg>") != NULL, "%s: no svg element", path);

@@ -178,24 +178,6 @@ START_TEST(test_pmfit_cli_errors)
 }
 END_TEST
 
-/* The whole of a file (malloc'd; NULL if it cannot be read). */
-static char *slurp_file(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    char *buf;
-    long n;
-    if (!f)
-        return NULL;
-    fseek(f, 0, SEEK_END);
-    n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    buf = (char *)malloc((size_t)n + 1);
-    ck_assert_ptr_nonnull(buf);
-    buf[fread(buf, 1, (size_t)n, f)] = 0;
-    fclose(f);
-    return buf;
-}
-
 static void put_file(const char *path, const char *text)
 {
     FILE *f = fopen(path, "w");
@@ -216,7 +198,7 @@ START_TEST(test_pmfit_output_not_input)
     snprintf(runp, sizeof runp, "%s/run.dat", tmpdir);
     snprintf(cmd, sizeof cmd, "cp '%s/examples/sim_gem.dat' '%s'", top ? top : ".", runp);
     ck_assert_int_eq(system(cmd), 0);
-    before = slurp_file(runp);
+    before = tu_slurp(runp);
     ck_assert_ptr_nonnull(before);
     ck_assert_int_eq(run("%s fit %s --residuals %s", runp, runp), 1);
     ck_assert_msg(strstr(out, "it is the input RUN (nothing was done)") != NULL, "%s", out);
@@ -235,7 +217,7 @@ START_TEST(test_pmfit_output_not_input)
     snprintf(args, sizeof args, "%s %s --residuals %s", model, runp, model);
     ck_assert_int_eq(run("%s eval %s%s", args, ""), 1);
     ck_assert_msg(strstr(out, "the input MODEL") != NULL, "%s", out);
-    after = slurp_file(runp);
+    after = tu_slurp(runp);
     ck_assert_ptr_nonnull(after);
     ck_assert_str_eq(after, before);
     free(after);
@@ -270,7 +252,7 @@ START_TEST(test_pmfit_output_targets)
     ck_assert_int_eq(lstat(path, &st), 0);
     ck_assert_msg(S_ISLNK(st.st_mode), "--residuals replaced the symbolic link");
     snprintf(path, sizeof path, "%s/target.txt", tmpdir);
-    text = slurp_file(path);
+    text = tu_slurp(path);
     ck_assert_ptr_nonnull(text);
     ck_assert_msg(strncmp(text, "# residuals of pmfit fit", 24) == 0, "%.200s", text);
     free(text);
@@ -279,7 +261,7 @@ START_TEST(test_pmfit_output_targets)
     put_file(path, "mine\n");
     snprintf(args, sizeof args, "%s --save %s/m.pm", runp, tmpdir);
     ck_assert_int_eq(run("%s fit %s%s", args, ""), 0);
-    text = slurp_file(path);
+    text = tu_slurp(path);
     ck_assert_ptr_nonnull(text);
     ck_assert_str_eq(text, "mine\n");
     free(text);
@@ -304,7 +286,7 @@ START_TEST(test_pmfit_output_targets)
         put_file(path, "read-only\n");
         ck_assert_int_eq(chmod(path, 0444), 0);
         ck_assert_int_eq(run("%s fit %s --residuals %s", runp, path), 1);
-        text = slurp_file(path);
+        text = tu_slurp(path);
         ck_assert_ptr_nonnull(text);
         ck_assert_str_eq(text, "read-only\n");
         free(text);
@@ -330,7 +312,7 @@ START_TEST(test_pmfit_undetermined)
     ck_assert_msg(strstr(out, "warning: the stars do not determine this model between them") !=
                       NULL, "%s", out);
     ck_assert_msg(strstr(out, "pmfit: warning: the stars do not determine") != NULL, "%s", out);
-    text = slurp_file(model);
+    text = tu_slurp(model);
     ck_assert_ptr_nonnull(text);
     ck_assert_msg(strstr(text, "# warning: the stars do not determine") != NULL, "%.400s", text);
     free(text);

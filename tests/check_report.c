@@ -53,25 +53,6 @@ static void teardown(void)
         fprintf(stderr, "check_report: could not remove %s\n", tmp);
 }
 
-/* The whole file, NUL-terminated (NULL if absent). */
-static char *slurp(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    char *s;
-    long n;
-    if (!f)
-        return NULL;
-    fseek(f, 0, SEEK_END);
-    n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    s = malloc((size_t)n + 1);
-    ck_assert_ptr_nonnull(s);
-    ck_assert_int_eq((long)fread(s, 1, (size_t)n, f), n);
-    s[n] = 0;
-    fclose(f);
-    return s;
-}
-
 static const char *top(void)
 {
     const char *t = getenv("PM_TOP");
@@ -202,7 +183,7 @@ static char *checked_report(const char *run, const char *args, const char *name,
     char *html;
     ck_assert_msg(report(run, args, name) == 0, "pmfit report %s failed: %s", args, out);
     snprintf(path, sizeof path, "%s/%s", tmp, name);
-    html = slurp(path);
+    html = tu_slurp(path);
     ck_assert_ptr_nonnull(html);
     check_page(html, what, min_figures, compare);
     return html;
@@ -260,7 +241,7 @@ START_TEST(test_report_example)
     snprintf(cmd, sizeof cmd, "--horizon '%s/examples/horizon.hrz' --min-el 25", top());
     ck_assert_msg(report(run, cmd, "sim_hz.html") == 0, "pmfit report failed: %s", out);
     snprintf(path, sizeof path, "%s/sim_hz.html", tmp);
-    html = slurp(path);
+    html = tu_slurp(path);
     ck_assert_ptr_nonnull(html);
     ck_assert_msg(strstr(html, "above elevation 25&deg; and the horizon of ") != NULL, "horizon not said");
     snprintf(cmd, sizeof cmd, "'%s' plan '%s' --next 5 --json --horizon '%s/examples/horizon.hrz' --min-el 25",
@@ -359,7 +340,7 @@ static void unchanged(const char *name, const char *content)
     char path[512];
     char *s;
     snprintf(path, sizeof path, "%s/%s", tmp, name);
-    s = slurp(path);
+    s = tu_slurp(path);
     ck_assert_ptr_nonnull(s);
     ck_assert_str_eq(s, content);
     free(s);
@@ -513,7 +494,7 @@ static void check_in_browser(const char *browser, const char *name, int min_figu
     snprintf(png, sizeof png, "%s/%s/tests/report_%s.png", top(), b ? b : "build", name);
     ck_assert_int_eq(browse(browser, name, png), 0);
     snprintf(path, sizeof path, "%s/%s.dom", tmp, name);
-    dom = slurp(path);
+    dom = tu_slurp(path);
     ck_assert_ptr_nonnull(dom);
     ck_assert_msg(strlen(dom) > 1000, "%s: the browser gave no DOM: %.300s", name, dom);
     check_page(dom, name, min_figures, compare);
@@ -607,7 +588,7 @@ START_TEST(test_report_realdata)
         snprintf(path, sizeof path, "%s.html", name);
         ck_assert_msg(report(run, "--order 2", path) == 0, "pmfit report %s failed: %s", runs[k], out);
         snprintf(path, sizeof path, "%s/%s.html", tmp, name);
-        html = slurp(path);
+        html = tu_slurp(path);
         ck_assert_ptr_nonnull(html);
         check_page(html, runs[k], 9, 0);
         free(html);

@@ -1,7 +1,7 @@
 /*
 **  tu_tool.h - helpers for the suites that run build/pmfit: the program's
 **  path, running a command with its output captured, a number from JSON
-**  output, a temporary directory removed at exit.  Include after defining
+**  output, a file's whole text, a temporary directory removed at exit.  Include after defining
 **  _POSIX_C_SOURCE 200809L (popen, mkdtemp).
 */
 #ifndef PM_TU_TOOL_H
@@ -23,6 +23,27 @@ static inline const char *tu_pmfit_path(void)
     const char *b = getenv("PM_BUILD");
     snprintf(path, sizeof path, "%s/%s/pmfit", top ? top : ".", b ? b : "build");
     return path;
+}
+
+/* The whole of a file, NUL-terminated (the caller frees it); NULL if it
+** cannot be opened.  A file that opens but cannot be read fails the test. */
+static inline char *tu_slurp(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    char *s;
+    long n;
+    if (!f)
+        return NULL;
+    ck_assert_int_eq(fseek(f, 0, SEEK_END), 0);
+    n = ftell(f);
+    ck_assert_int_ge(n, 0);
+    ck_assert_int_eq(fseek(f, 0, SEEK_SET), 0);
+    s = (char *)malloc((size_t)n + 1);
+    ck_assert_ptr_nonnull(s);
+    ck_assert_uint_eq(fread(s, 1, (size_t)n, f), (size_t)n);
+    s[n] = 0;
+    fclose(f);
+    return s;
 }
 
 /* Run a shell command with stdout and stderr captured into out (len bytes,
