@@ -849,27 +849,10 @@ struct Fit {
 // Why a fit failed, in the words pmfit fit uses.
 [[noreturn]] void fail_fit(const FitOut &f, const std::string &what, int max_iter)
 {
-    const pm_model &m = f.model;
-    std::string msg = what + ": " + status_name(f.status) + " (" + status_text(f.status) + ")";
-    std::string bad;
-    if (f.status == PM_ERR_SINGULAR && f.bad_term >= 0) {
-        bad = term_name(m, f.bad_term);
-        msg += ": term " + bad + ", " + meaning(m, f.bad_term) +
-               ", is a combination of the terms before it for this sky coverage" +
-               (f.bad_term >= m.n_base ? std::string(" and model") : std::string()) +
-               "; lower the order, drop the term or add points";
-    }
-    if (f.status == PM_ERR_DIVERGED && f.corr_i >= 0) {
-        char buf[64];
-        std::snprintf(buf, sizeof buf, "%.6f", f.corr);
-        msg += " in " + std::to_string(max_iter) + " passes: the sky coverage hardly separates " +
-               term_name(m, f.corr_j) + " from " + term_name(m, f.corr_i) + " (correlation " + buf +
-               "); lower the order or use both pier sides";
-    }
-    if (f.status == PM_ERR_TOO_FEW)
-        msg += ": P = " + std::to_string(m.n_terms) + " terms need at least " +
-               std::to_string(m.n_terms / 2 + 1) + " observations (2N > P); there are " +
-               std::to_string(f.res.n_obs);
+    const std::string bad = f.status == PM_ERR_SINGULAR && f.bad_term >= 0
+                                ? term_name(f.model, f.bad_term) : std::string();
+    const std::string msg = what + ": " + status_name(f.status) + " (" + status_text(f.status) +
+                            ")" + fit_failure_detail(f, max_iter, "the order");
     throw Failure{f.status == PM_ERR_NONFINITE ? K_NONFINITE : K_FIT, (int)f.status, msg, bad};
 }
 

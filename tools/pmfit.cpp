@@ -757,28 +757,7 @@ void print_json_fit(const FitOut &f, const std::string &extra)
 
 void fail_fit(const FitOut &f, const std::string &what)
 {
-    std::string msg = what + ": " + pm_status_text(f.status);
-    const pm_model &m = f.model; // the model that was fitted (unchanged on error)
-    if (f.status == PM_ERR_SINGULAR && f.bad_term >= 0) {
-        msg += " (term " + term_name(m, f.bad_term) + ", " + meaning(m, f.bad_term) +
-               ": a combination of the terms before it for this sky coverage" +
-               (f.bad_term >= m.n_base ? std::string(" and model") : std::string()) +
-               "; lower --order, drop the term or add points)";
-    }
-    if (f.status == PM_ERR_DIVERGED && f.corr_i >= 0) {
-        char buf[64];
-        std::snprintf(buf, sizeof buf, "%.6f", f.corr);
-        msg += " in " + std::to_string(MAX_PASSES) +
-               " passes: the sky coverage hardly separates " + term_name(m, f.corr_j) +
-               " from " + term_name(m, f.corr_i) + " (correlation " + buf + "); lower --order or " +
-               (m.mount == PM_MOUNT_ALTAZ ? "add stars over more of the sky"
-                                          : "use both pier sides");
-    }
-    if (f.status == PM_ERR_TOO_FEW)
-        msg += " (P = " + std::to_string(m.n_terms) + " terms need at least " +
-               std::to_string(m.n_terms / 2 + 1) + " observations, 2N > P; there are " +
-               std::to_string(f.res.n_obs) + "; lower --order)";
-    die(msg, 1);
+    die(what + ": " + pm_status_text(f.status) + fit_failure_detail(f, MAX_PASSES, "--order"), 1);
 }
 
 } // namespace

@@ -734,6 +734,36 @@ pmmodel_info model_info(const pm_model &m, const std::vector<std::string> &aux_n
     return info;
 }
 
+std::string fit_failure_detail(const FitOut &f, int passes, const std::string &order)
+{
+    const pm_model &m = f.model; // the model that was fitted (unchanged on error)
+    char buf[64];
+    switch (f.status) {
+    case PM_ERR_SINGULAR:
+        if (f.bad_term < 0)
+            return "";
+        return " (term " + term_name(m, f.bad_term) + ", " + meaning(m, f.bad_term) +
+               ": a combination of the terms before it for this sky coverage" +
+               (f.bad_term >= m.n_base ? " and model" : "") + "; lower " + order +
+               ", drop the term or add points)";
+    case PM_ERR_DIVERGED:
+        if (f.corr_i < 0)
+            return "";
+        std::snprintf(buf, sizeof buf, "%.6f", f.corr);
+        return " in " + std::to_string(passes) + " passes: the sky coverage hardly separates " +
+               term_name(m, f.corr_j) + " from " + term_name(m, f.corr_i) + " (correlation " +
+               buf + "); lower " + order + " or " +
+               (m.mount == PM_MOUNT_ALTAZ ? "add stars over more of the sky"
+                                          : "use both pier sides");
+    case PM_ERR_TOO_FEW:
+        return " (P = " + std::to_string(m.n_terms) + " terms need at least " +
+               std::to_string(m.n_terms / 2 + 1) + " observations, 2N > P; there are " +
+               std::to_string(f.res.n_obs) + "; lower " + order + ")";
+    default:
+        return "";
+    }
+}
+
 // The model without its side-specific added terms (for the pier F-test).
 pm_model without_side_terms(const pm_model &m)
 {

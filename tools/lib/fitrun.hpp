@@ -132,6 +132,14 @@ pm_status residuals(FitOut &f, const std::vector<Obs> &obs, const std::vector<in
 bool row_covariance(const FitOut &f, const pm_context &ctx, double eh, double ed, double ah,
                     double ad, double v[3], double r[2]);
 
+// What more than its status (pm_status_text) is known of why fit f failed,
+// in the words every host tool uses: the term that is a combination of the
+// terms before it, the pair the sky coverage hardly separates (after
+// `passes` passes), the observations P terms need.  order: how the caller's
+// user lowers the order ("--order", "the order").  "" where nothing more
+// is known; else text to append to "WHAT: STATUS TEXT".
+std::string fit_failure_detail(const FitOut &f, int passes, const std::string &order);
+
 // The F distribution's upper tail (and its natural log, which does not
 // underflow for huge F), and the nested-model F-test.
 double inc_beta(double a, double b, double x);

@@ -177,37 +177,11 @@ struct Data {
     }
 };
 
-const char *status_words(pm_status s)
-{
-    switch (s) {
-    case PM_ERR_TOO_FEW: return "too few observations for the number of terms";
-    case PM_ERR_SINGULAR: return "a term cannot be determined from these observations";
-    case PM_ERR_DIVERGED: return "the fit did not converge";
-    case PM_ERR_NONFINITE: return "non-finite input";
-    case PM_ERR_CAPACITY: return "beyond the compiled capacity";
-    default: return "the fit failed";
-    }
-}
-
 // The fit's failure in the words pmfit fit uses.
-[[noreturn]] void fit_failed(const FitOut &f, const std::string &what)
+[[noreturn]] void fit_failed(const FitOut &f, const std::string &what, int passes)
 {
-    std::string msg = what + ": " + status_words(f.status);
-    const pm_model &m = f.model;
-    if (f.status == PM_ERR_SINGULAR && f.bad_term >= 0)
-        msg += " (term " + term_name(m, f.bad_term) + ", " + meaning(m, f.bad_term) +
-               ": a combination of the terms before it for this sky coverage; lower --order, "
-               "drop the term or add points)";
-    if (f.status == PM_ERR_DIVERGED && f.corr_i >= 0)
-        msg += fmt(": the sky coverage hardly separates %s from %s (correlation %.6f); lower "
-                   "--order or %s",
-                   term_name(m, f.corr_j).c_str(), term_name(m, f.corr_i).c_str(), f.corr,
-                   m.mount == PM_MOUNT_ALTAZ ? "add stars over more of the sky"
-                                             : "use both pier sides");
-    if (f.status == PM_ERR_TOO_FEW)
-        msg += fmt(" (P = %d terms need at least %d observations, 2N > P; there are %ld; lower "
-                   "--order)", m.n_terms, m.n_terms / 2 + 1, f.res.n_obs);
-    throw std::runtime_error(msg);
+    throw std::runtime_error(what + ": " + pm_status_text(f.status) +
+                             fit_failure_detail(f, passes, "--order"));
 }
 
 
@@ -221,7 +195,7 @@ void stage_fit(Data &d)
                                  d.run.aux_names);
     d.fit = do_fit(d.run.obs, d.all, start, d.o.max_passes);
     if (d.fit.status != PM_OK)
-        fit_failed(d.fit, d.run.path);
+        fit_failed(d.fit, d.run.path, d.o.max_passes);
     d.emap = error_map(d.run, d.fit, 0);
 }
 
@@ -233,7 +207,7 @@ void stage_compare(Data &d)
     OldSide os = load_old(old, d.o.order, d.o.adds, d.o.refraction, d.o.skip_bad, d.o.format,
                           d.o.equinox, d.o.max_passes);
     if (os.is_run && os.fit.status != PM_OK)
-        fit_failed(os.fit, old + " (the old run)");
+        fit_failed(os.fit, old + " (the old run)", d.o.max_passes);
     d.old_what = os.is_run ? fmt("the run %s (fitted at order %d)", old.c_str(), d.o.order)
                            : "the model file " + old;
     try {
