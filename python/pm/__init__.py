@@ -342,8 +342,18 @@ class Model(_pm.Model):
     def add_term(self, kind, k=0, l=0, m=0, side=0, aux=0, param=0.0, value=0.0):
         """Append a term (pm_model_add_term; fields as pm_term in include/pm.h,
         kind 0 SH, 1 FOURIER, 2 SECTORAL, 3 ZENITH, 4 AUX); its index."""
-        return self._add_term(int(kind), int(k), int(l), int(m), int(side), int(aux),
-                              float(param), float(value))
+        def one(name, v, conv):
+            a = conv(name, v)
+            if a.shape != ():
+                raise ArgumentError("%s: expected one number, got shape %s" % (name, a.shape))
+            return a.item()
+        ints = [one(n, v, _as_int) for n, v in (("kind", kind), ("k", k), ("l", l), ("m", m),
+                                                ("side", side), ("aux", aux))]
+        param, value = one("param", param, _as_float), one("value", value, _as_float)
+        for name, v in (("param", param), ("value", value)):
+            if not _np.isfinite(v):
+                raise NonFiniteError("%s is %r: expected a finite number" % (name, v))
+        return self._add_term(*ints, param, value)
 
     def apply(self, enc_ha, enc_dec, *, pier=None, temp_c=None, time_h=None, dir=None, aux=None,
               threads=None):

@@ -350,3 +350,25 @@ def test_nasty_values_do_not_crash():
         pass
     m.apply(np.zeros(0), np.zeros(0))
     assert m.apply(np.zeros((0, 3)), 0.1)[0].shape == (0, 3)
+
+
+def test_add_term_fields_are_checked():
+    """Model.add_term took int(k) and float(param): k=1.5 added a term on
+    base vector 1 without a word, param=1j raised a bare TypeError.  Each
+    field is now one real number of its kind, named when it is not; the model
+    is unchanged."""
+    m = pm.Model()
+    n = m.n_terms
+    for kw, exc, words in [
+            (dict(k=1.5), pm.ArgumentError, "k: expected integers"),
+            (dict(k=None), pm.ArgumentError, "k is None"),
+            (dict(k=[1, 2]), pm.ArgumentError, "k: expected one number"),
+            (dict(param=1j), pm.ArgumentError, "param is 1j"),
+            (dict(value="x"), pm.ArgumentError, "value: expected numbers"),
+            (dict(param=float("nan")), pm.NonFiniteError, "param is nan"),
+            (dict(value=float("inf")), pm.NonFiniteError, "value is inf")]:
+        with pytest.raises(exc, match=words):
+            m.add_term(4, **dict(dict(k=3, aux=3), **kw))
+        assert m.n_terms == n
+    assert m.add_term(4, k=np.int64(3), aux=3, param=np.float32(2.0), value=1e-6) == n
+    assert m.terms[n]["k"] == 3 and m.terms[n]["param"] == 2.0
