@@ -60,7 +60,7 @@ static void make_point(double ha, double dec, pmplan_target *t)
     t->x_deg = ha;
     t->y_deg = dec;
     t->el_deg = elevation(ha, dec);
-    t->side = ha > 0 ? -1 : 1;
+    t->side = ha > 0 ? 1 : -1; /* the normal pointing state looks west (ASCOM) */
     t->after_arcsec = 0;
 }
 
@@ -534,24 +534,63 @@ END_TEST
 
 /* Pier sides: meridian -- beyond the pole exactly west of the meridian;
 ** both -- either side within the limit, and the plan uses both there. */
+/* The meridian rule: without a run ASCOM's normal pointing state (pier +1,
+** pierEast) takes the sky west of the meridian, beyond the pole the east;
+** with a run, the run's own (it was hard-coded the other way round, so on
+** the real German runs every target away from the meridian was proposed on
+** a side the mount never used there, and the predicted error was of that
+** mirrored sky: 235" where the fit's map said 47"). */
+static void sides_follow(const char *run, int normal_west, int n_want)
+{
+    static cli_target t[120];
+    char args[1024];
+    int i, n, far = 0;
+    snprintf(args, sizeof args, "%s --next %d --json --grid 4", run, n_want);
+    ck_assert_msg(plan_cli(args) == 0, "%s", out);
+    n = parse_targets(out, t, 120);
+    ck_assert_int_eq(n, n_want);
+    for (i = 0; i < n; i++)
+        if (fabs(t[i].x) > 15 + 1e-9) {
+            far++;
+            ck_assert_msg(t[i].side == (t[i].x > 0 ? normal_west : -normal_west),
+                          "%s: target %d at HA %+.2f deg on side %+d", run, i, t[i].x,
+                          t[i].side);
+        }
+    printf("check_plan: sides %s: %d of %d targets beyond 15 deg of the meridian, each on the "
+           "side the %s takes there\n", run[0] ? run : "(no run)", far, n,
+           run[0] ? "run" : "normal pointing state");
+    ck_assert_int_gt(far, n / 3);
+}
+
 START_TEST(test_plan_sides)
 {
     static cli_target t[120];
     int i, n, crossed = 0;
+    char path[512], sim[512];
+    const char *top = getenv("PM_TOP");
     ck_assert_int_eq(plan_cli("--next 80 --json --sides meridian"), 0);
     n = parse_targets(out, t, 120);
     for (i = 0; i < n; i++)
-        ck_assert_int_eq(t[i].side, t[i].x > 0 ? -1 : 1);
+        ck_assert_int_eq(t[i].side, t[i].x > 0 ? 1 : -1);
     ck_assert_int_eq(plan_cli("--next 120 --json --sides both --meridian-limit 20 --grid 4"), 0);
     n = parse_targets(out, t, 120);
     ck_assert_int_eq(n, 120);
     for (i = 0; i < n; i++) {
-        ck_assert(t[i].side > 0 ? t[i].x <= 20 + 1e-9 : t[i].x >= -20 - 1e-9);
-        crossed += t[i].side != (t[i].x > 0 ? -1 : 1);
+        ck_assert(t[i].side > 0 ? t[i].x >= -20 - 1e-9 : t[i].x <= 20 + 1e-9);
+        crossed += t[i].side != (t[i].x > 0 ? 1 : -1);
     }
     printf("check_plan: --sides both: %d of 120 targets past the meridian on the other side\n",
            crossed);
     ck_assert_int_gt(crossed, 0);
+    /* a run's own convention: pmsim flips west of the meridian (the other
+    ** way round from ASCOM's), the real German runs east */
+    sides_follow("", 1, 40);
+    snprintf(sim, sizeof sim, "%s/examples/sim_gem.dat", top ? top : ".");
+    sides_follow(sim, -1, 40);
+    if (tu_real_run("celestial/gem-28.dat", path, sizeof path))
+        sides_follow(path, 1, 40);
+    if (tu_real_run("celestial/cgx-l-data.dat", path, sizeof path))
+        sides_follow(path, 1, 40);
 }
 END_TEST
 

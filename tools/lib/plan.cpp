@@ -351,6 +351,18 @@ int nearest_side(const std::vector<SkyPlace> &taken, double x, double y, int dfl
     return side;
 }
 
+// The side of the meridian the run takes on its normal pier side (+1 west,
+// -1 east; PlanOptions::normal_west): a vote of its places beyond the
+// meridian limit, where a German mount has no choice; dflt without any.
+int run_normal_west(const std::vector<SkyPlace> &taken, double limit_deg, int dflt)
+{
+    long vote = 0;
+    for (const SkyPlace &p : taken)
+        if (std::fabs(p.x) > limit_deg && p.side != 0)
+            vote += (p.x > 0 ? 1 : -1) * p.side;
+    return vote > 0 ? 1 : vote < 0 ? -1 : dflt;
+}
+
 // The sides a place is taken on under the options' rules (one or two).
 std::vector<int> sides_for(const PlanOptions &o, const std::vector<SkyPlace> &taken, double x,
                            double y)
@@ -359,7 +371,7 @@ std::vector<int> sides_for(const PlanOptions &o, const std::vector<SkyPlace> &ta
         return {0};
     if (!o.gem)
         return {1};
-    int meridian = x > 0 ? -1 : 1;
+    int meridian = (x > 0 ? 1 : -1) * (o.normal_west < 0 ? -1 : 1);
     switch (o.sides) {
     case SIDES_MERIDIAN:
         return {meridian};
@@ -533,9 +545,10 @@ std::string horizon_text(const PlanOptions &o)
 
 } // namespace
 
-Plan plan_targets(const Run &taken, const PlanOptions &o)
+Plan plan_targets(const Run &taken, const PlanOptions &opt)
 {
-    check_options(o);
+    check_options(opt);
+    PlanOptions o = opt;
     Plan plan;
     pm_model m = planning_model(taken, o, plan.note);
     pm_context ctx = mean_context(taken);
@@ -554,6 +567,8 @@ Plan plan_targets(const Run &taken, const PlanOptions &o)
         p.d.ctx.pier = p.side;
         done.push_back(p);
     }
+    if (o.mount != PM_MOUNT_ALTAZ && o.gem)
+        o.normal_west = run_normal_west(done, o.meridian_limit_deg, o.normal_west);
     std::vector<SkyPlace> sky = sky_places(o, 4, done, ctx);
     if (sky.empty())
         throw std::runtime_error("plan: no usable sky " + horizon_text(o) + " at this latitude");

@@ -23,13 +23,15 @@ typedef struct pmplan_target {
 
 /* Pier-side rules of a German mount (pmplan_options.sides). */
 #define PMPLAN_SIDES_RUN 0      /* as the run used it nearby (else the meridian rule) */
-#define PMPLAN_SIDES_MERIDIAN 1 /* east of the meridian normal, west beyond the pole */
+#define PMPLAN_SIDES_MERIDIAN 1 /* the meridian rule: the normal side west of the meridian
+                                   (ASCOM's normal pointing state; the run's own side of it
+                                   where the run shows one), beyond the pole east */
 #define PMPLAN_SIDES_BOTH 2     /* within meridian_limit_deg of it on either side */
 
 typedef struct pmplan_options {
     int order;            /* the model's harmonic order */
     int altaz;            /* 1: alt-az mount (with a run: the run's mount, whatever this says) */
-    int gem;              /* equatorial: 1 German (flips west of the meridian), 0 fork */
+    int gem;              /* equatorial: 1 German (flips at the meridian), 0 fork */
     double latitude_deg;
     double min_el_deg;    /* the horizon */
     double grid_deg;      /* candidate spacing */

@@ -20,7 +20,8 @@ namespace pmhost {
 enum PlanSides {
     SIDES_RUN,      // within meridian_limit_deg of the meridian the side the run used
                     // nearby (the meridian rule when nothing is taken); beyond, the meridian rule
-    SIDES_MERIDIAN, // east of the meridian the normal side, west of it beyond the pole
+    SIDES_MERIDIAN, // the meridian rule: the normal side on its side of the meridian, the
+                    // other side beyond the pole (normal_west below)
     SIDES_BOTH      // within meridian_limit_deg of the meridian either side (the plan chooses)
 };
 
@@ -45,7 +46,15 @@ struct PlanOptions {
     double grid_deg = 6;           // candidate grid spacing (no catalogue)
     std::vector<CatalogueStar> stars; // candidates from a catalogue (empty: the grid)
     SkyTime when;                  // where the catalogue's stars are
-    bool gem = true;               // equatorial: a German mount (flips west of the meridian)
+    bool gem = true;               // equatorial: a German mount (flips at the meridian)
+    // The side of the meridian a German mount takes on its normal pier side
+    // (+1, encoder declination within +-90 deg): +1 west (HA > 0: the tube
+    // east of the pier looking west, ASCOM's pierEast "normal pointing
+    // state", as the real runs of ../shared/data do), -1 east (a mount that
+    // counts its declination the other way round; pmsim's runs).  With a run
+    // plan_targets takes the run's own (the sides of its places beyond
+    // meridian_limit_deg), this where the run does not show one.
+    int normal_west = 1;
     PlanSides sides = SIDES_RUN;
     double meridian_limit_deg = 15; // how far past the meridian either side reaches
     bool d_optimal = false;        // maximise det(A) instead of minimising the mean variance
