@@ -38,6 +38,7 @@ reports as amplitude_arcsec):
 
   ha_periodic (az_periodic)  th1 += A cos(G*enc1 + phase)     enc1 = the encoder reading
   dec_periodic (el_periodic) th2 += A cos(G*enc2 + phase)     as written in the file
+                             (either more than once: gears on one axis, each its own G)
   refraction                 the observed place is R*cot(el) nearer the zenith than
                              where the gimbal points (times --zenith-sign, default +1:
                              positive = toward the zenith, docs/model.md)
@@ -325,8 +326,10 @@ def gen(params):
             raise ValueError("aniso_params: unknown %s (known: %s)" % (bad, ", ".join(ANISO_PARAMS)))
     effects = [parse_effect(e) for e in P["effects"]]
     names = [e["name"] for e in effects]
-    if len(set(names)) != len(names):
-        raise ValueError("each effect at most once")
+    once = [x for x in names if x not in ("ha_periodic", "dec_periodic")]
+    if len(set(once)) != len(once):
+        raise ValueError("each effect at most once (a periodic one on an axis as often as "
+                         "it has gears, each with its own :G)")
     if "pier_side" in names and P["mount"] != "gem":
         raise ValueError("pier_side needs --mount gem")
     if "pier_side" in names and P["coverage"] == "pier_east":
@@ -373,8 +376,11 @@ def gen(params):
     # effects: parameters (own streams)
     eff = {}
     truth_eff = []
-    for e in effects:
-        r = stream(seed, "effect:" + e["name"])
+    for k, e in enumerate(effects):
+        # (a second periodic effect on one axis draws from its own stream;
+        # the first keeps the stream it always had)
+        again = sum(1 for f in effects[:k] if f["name"] == e["name"])
+        r = stream(seed, "effect:" + e["name"] + ("#%d" % again if again else ""))
         name, A = e["name"], e["size"]
         x = {"name": name, "size_arcsec": A, "explain_effect": name}
         if name in ("ha_periodic", "dec_periodic"):
@@ -406,7 +412,10 @@ def gen(params):
             x.update(explain_amplitude_arcsec=None,
                      note="degree-2 distortion; pmfit's amplitude is the RMS its order-2 terms "
                           "add beyond order 1, only part of this")
-        eff[name] = e
+        if name in ("ha_periodic", "dec_periodic"):
+            eff.setdefault(name, []).append(e)
+        else:
+            eff[name] = e
         truth_eff.append(x)
 
     # anisotropic distortion coefficients (unit scale, normalised below),
@@ -438,11 +447,9 @@ def gen(params):
         x2 = np.zeros(n)
         coll = np.zeros(n)
         if with_effects:
-            if "ha_periodic" in eff:
-                e = eff["ha_periodic"]
+            for e in eff.get("ha_periodic", []):
                 x1 += e["size"] * AS * np.cos(e["G"] * enc1 + e["phase_deg"] * DEG)
-            if "dec_periodic" in eff:
-                e = eff["dec_periodic"]
+            for e in eff.get("dec_periodic", []):
                 x2 += e["size"] * AS * np.cos(e["G"] * enc2 + e["phase_deg"] * DEG)
             for nm, xv in (("temperature", temp), ("time_drift", time_h)):
                 if nm in eff:

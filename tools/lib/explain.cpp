@@ -742,13 +742,26 @@ void periodic_candidates(const Run &run, const State &st, const ExplainOptions &
                          std::vector<Candidate> &cands)
 {
     double sg2 = st.cur.f.res.sigma * st.cur.f.res.sigma;
+    const pm_model &m = st.cur.f.model;
     for (int comp = 0; comp < 2; comp++) {
         const char *prefix = comp ? "dec_periodic:" : "ha_periodic:";
-        bool already = false;
-        for (const std::string &a : st.adds)
-            already = already || a.rfind(prefix, 0) == 0;
         Periodogram pg = periodogram(run, st.cur.f, comp, opt, sg2);
-        if (already || !(pg.peak_g > 0))
+        if (!(pg.peak_g > 0))
+            continue;
+        // A periodic term already on this axis (found, or given with --add)
+        // is no reason not to look for another: a worm and a second gear, or
+        // a worm's second harmonic (until stop 39 the axis was not looked at
+        // again, and a run with both said "nothing significant is left
+        // out").  Only the period the model already holds is not offered.
+        bool held = false;
+        for (int i = m.n_base; i < m.n_terms; i++) {
+            const pm_term &t = m.term[i];
+            const bool on_axis = (t.kind == PM_TERM_FOURIER && t.k == (comp ? PM_BASE_E : PM_BASE_C)) ||
+                                 (t.kind == PM_TERM_SECTORAL && !comp);
+            held = held || (on_axis && std::fabs(pg.peak_g - t.param) <
+                                           std::max(0.5, 0.005 * t.param));
+        }
+        if (held)
             continue;
         Fit chosen;
         const bool scan = opt_is_scan(opt, comp);
