@@ -213,10 +213,19 @@ void pm_indi_describe(const pm_indi_result *r, long n, long skipped, char *buf, 
         std::snprintf(buf, len, "no sync points: no correction%s", extra);
         break;
     case PM_INDI_OFFSET:
-        std::snprintf(buf, len,
-                      "%ld sync point(s) over %.1f deg: index offsets only (order 0 needs %d points "
-                      "over %.0f deg)%s",
-                      n, r->spread * 180.0 / kPi, PM_SH_TERMS(0), PM_INDI_SPREAD_L0 * 180.0 / kPi, extra);
+        if (r->chosen_order < 0) /* too few points, or too little sky, for order 0 */
+            std::snprintf(buf, len,
+                          "%ld sync point(s) over %.1f deg: index offsets only (order 0 needs %d "
+                          "points over %.0f deg)%s",
+                          n, r->spread * 180.0 / kPi, PM_SH_TERMS(0), PM_INDI_SPREAD_L0 * 180.0 / kPi,
+                          extra);
+        else /* enough of both: the order 0 fit itself failed (extra says why) */
+            std::snprintf(buf, len,
+                          "%ld sync point(s) over %.1f deg: index offsets only, the order 0 fit "
+                          "failed: these points do not determine it (all on one declination or "
+                          "hour-angle circle, or one altitude? add sync points spread over both "
+                          "axes)%s",
+                          n, r->spread * 180.0 / kPi, extra);
         break;
     default: {
         char cv[160] = "";

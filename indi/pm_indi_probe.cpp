@@ -240,9 +240,18 @@ int main(int argc, char **argv)
                   (int)!p->TransformCelestialToTelescope(5, 10, NAN, tdv) +
                   (int)!p->TransformTelescopeToCelestial(TelescopeDirectionVector(0, 0, 0), r1, r2) +
                   (int)!p->TransformTelescopeToCelestial(TelescopeDirectionVector(NAN, 0, 1), r1, r2);
+    /* The known mount's axis-2 encoder reads 0.25 deg high (O2), so within
+    ** about that of the north pole (eq) or the zenith (altaz) it reads
+    ** beyond 90 deg, which a direction vector cannot carry: refused.  A
+    ** degree away it is not. */
+    double zra = std::fmod(lst(jd_now) / D2R / 15.0 + 24.0, 24.0);
+    int near_refused = (int)!p->TransformCelestialToTelescope(altaz ? zra : 7.5, altaz ? LAT - 0.02 : 89.98,
+                                                              0, tdv);
+    int near_ok = (int)p->TransformCelestialToTelescope(altaz ? zra : 7.5, altaz ? LAT - 1.5 : 88.5, 0, tdv);
     fflush(stdout);
-    printf("\nprobe: %s targets %d failed %d worst_goto_arcsec %.3e worst_back_arcsec %.3e bad_refused %d/5\n",
-           argv[2], q, fails, worst_goto, worst_back, refused);
+    printf("\nprobe: %s targets %d failed %d worst_goto_arcsec %.3e worst_back_arcsec %.3e bad_refused %d/5 "
+           "near_refused %d near_ok %d\n",
+           argv[2], q, fails, worst_goto, worst_back, refused, near_refused, near_ok);
     destroy(p);
     dlclose(h);
     return 0;

@@ -306,6 +306,18 @@ bool PmMathPlugin::TransformCelestialToTelescope(const double RightAscension, co
              st == PM_WARN_UNREACHABLE ? "" : pm_status_text(st));
         return false;
     }
+    if (std::fabs(e2) > kPi / 2) {
+        /* Within the model's axis-2 index of the pole (the zenith), where
+        ** the encoder reads beyond +-90 deg: a direction vector folds that
+        ** to the position across the pole, which the model's mount points
+        ** elsewhere (twice the excess away). */
+        note("TransformCelestialToTelescope: RA %.6f h Dec %.6f deg: the mount's %s encoder would "
+             "read %.4f deg there, beyond %s 90, which an INDI direction vector cannot carry (it "
+             "would be read as the position across the %s, %.1f arcmin from the target): refused",
+             RightAscension, Declination, altaz() ? "altitude" : "declination", e2 / kDeg,
+             e2 > 0 ? "+" : "-", altaz() ? "zenith" : "pole", 2 * (std::fabs(e2) - kPi / 2) / kDeg * 60);
+        return false;
+    }
     if (st == PM_WARN_NOT_CONVERGED)
         note("TransformCelestialToTelescope: inverse not converged to 1e-13 rad at RA %.6f h Dec %.6f deg "
              "(best position used)", RightAscension, Declination);

@@ -336,6 +336,14 @@ START_TEST(test_pm_indi_fit_ring_singular_falls_back)
     ck_assert_int_eq(r.fallbacks, 2);
     ck_assert_msg(strlen(r.bad_term) > 0, "the singular term is named");
     ck_assert_int_eq(pm_model_prepare(&m), PM_OK);
+    {   /* the log line says the fit failed, not that there were too few points
+        ** over too little sky (it said "order 0 needs 6 points over 10 deg"
+        ** of 30 points over 87 deg) */
+        char buf[512];
+        pm_indi_describe(&r, 30, 0, buf, sizeof buf);
+        ck_assert_msg(strstr(buf, "the order 0 fit failed") && !strstr(buf, "needs") &&
+                          strstr(buf, "order lowered 2 time(s)"), "got: %s", buf);
+    }
 }
 END_TEST
 
@@ -474,7 +482,8 @@ static void probe(const char *mode)
 {
     char cmd[2048], line[64];
     const char *out, *s;
-    int st, targets = -1, failed = -1, refused = -1, nsync = -1, init = -1;
+    int st, targets = -1, failed = -1, refused = -1, nsync = -1, init = -1, near_refused = -1,
+        near_ok = -1;
     double goto_err = -1, back_err = -1;
     snprintf(cmd, sizeof cmd,
              "cd '%s' && LD_PRELOAD=build/indi/libpm_indi_testshim.so PM_INDI_FROZEN_JD=2460310.75 "
@@ -487,9 +496,15 @@ static void probe(const char *mode)
                   "no sync line:\n%s", out);
     snprintf(line, sizeof line, "probe: %s targets", mode);
     s = strstr(out, line);
-    ck_assert_msg(s && sscanf(s + strlen(line), "%d failed %d worst_goto_arcsec %lf worst_back_arcsec %lf bad_refused %d",
-                              &targets, &failed, &goto_err, &back_err, &refused) == 5,
+    ck_assert_msg(s && sscanf(s + strlen(line), "%d failed %d worst_goto_arcsec %lf worst_back_arcsec %lf bad_refused "
+                              "%d/5 near_refused %d near_ok %d",
+                              &targets, &failed, &goto_err, &back_err, &refused, &near_refused, &near_ok) == 7,
                   "no result line:\n%s", out);
+    /* within the axis-2 index of the pole or zenith: refused, saying why (it
+    ** returned the folded vector: 2x the excess off, without a word) */
+    ck_assert_int_eq(near_refused, 1);
+    ck_assert_int_eq(near_ok, 1);
+    ck_assert_msg(strstr(out, "which an INDI direction vector cannot carry"), "no reason given:\n%s", out);
     printf("plugin (%s): %d sync points, %d targets: GOTO worst %.2e\", reverse worst %.2e\"\n", mode, nsync,
            targets, goto_err, back_err);
     ck_assert_int_eq(init, 1);
