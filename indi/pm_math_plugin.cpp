@@ -312,7 +312,7 @@ bool PmMathPlugin::TransformCelestialToTelescope(const double RightAscension, co
         ** to the position across the pole, which the model's mount points
         ** elsewhere (twice the excess away). */
         note("TransformCelestialToTelescope: RA %.6f h Dec %.6f deg: the mount's %s encoder would "
-             "read %.4f deg there, beyond %s 90, which an INDI direction vector cannot carry (it "
+             "read %.4f deg there, beyond %s90, which an INDI direction vector cannot carry (it "
              "would be read as the position across the %s, %.1f arcmin from the target): refused",
              RightAscension, Declination, altaz() ? "altitude" : "declination", e2 / kDeg,
              e2 > 0 ? "+" : "-", altaz() ? "zenith" : "pole", 2 * (std::fabs(e2) - kPi / 2) / kDeg * 60);
