@@ -528,6 +528,30 @@ START_TEST(test_pmfit_columns_by_name)
 }
 END_TEST
 
+/* explain on an equatorial run without a latitude cannot try refraction
+** and tube flexure (their elevation needs it): it says so, in the text and
+** the JSON (it said nothing, and a 5" refraction was named higher_order). */
+START_TEST(test_pmfit_explain_says_what_it_cannot_try)
+{
+    char path[300], cmd[1200];
+    const char *top = getenv("PM_TOP");
+    make_tmpdir();
+    snprintf(path, sizeof path, "%s/nolat.dat", tmpdir);
+    snprintf(cmd, sizeof cmd, "grep -v '^# latitude' %s/examples/sim_gem.dat > %s",
+             top ? top : ".", path);
+    ck_assert_int_eq(system(cmd), 0);
+    ck_assert_msg(run("%s explain %s%s", path, "") == 0, "%s", out);
+    ck_assert_msg(strstr(out, "not tried: refraction and tube flexure") != NULL, "%s", out);
+    ck_assert_msg(run("%s explain %s --json%s", path, "") == 0, "%s", out);
+    ck_assert_msg(strstr(out, "\"not_tried\": [{\"effect\": \"refraction\", \"why\": \"the run "
+                              "gives no latitude\"}, {\"effect\": \"tube_flexure\"") != NULL,
+                  "%.3000s", out);
+    snprintf(path, sizeof path, "%s/examples/sim_gem.dat", top ? top : ".");
+    ck_assert_msg(run("%s explain %s --json%s", path, "") == 0, "%s", out);
+    ck_assert_msg(strstr(out, "\"not_tried\": []") != NULL, "%.3000s", out);
+}
+END_TEST
+
 static Suite *suite(void)
 {
     Suite *s = suite_create("pmfit");
@@ -546,6 +570,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_pmfit_explain_few_points_order0);
     tcase_add_test(tc, test_pmfit_eval_missing_input_and_long_comment);
     tcase_add_test(tc, test_pmfit_columns_by_name);
+    tcase_add_test(tc, test_pmfit_explain_says_what_it_cannot_try);
     tcase_set_timeout(tc, 60);
     suite_add_tcase(s, tc);
     return s;

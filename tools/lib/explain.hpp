@@ -156,6 +156,10 @@ std::vector<Interpretation> interpret(const Run &run, const FitOut &f);
 // The report (explain_report.cpp): one JSON object (docs/formats.md), or
 // text on stdout.
 std::string explain_json(const Run &run, const Explanation &ex, int order);
+// The candidate effects the run cannot have tried, and so not found: an
+// equatorial run without a latitude cannot try refraction and tube flexure
+// (the JSON's "not_tried", a line of the text).
+std::vector<std::string> not_tried(const Run &run);
 // "significant, not modelled" in words: its sizes and what would fit it.
 std::string unmodelled_text(const Unmodelled &u);
 void print_explain_text(const Run &run, const Explanation &ex, int order, bool added,

@@ -92,6 +92,15 @@ std::string left_out_lines(const Run &run, const Explanation &ex)
 
 } // namespace
 
+std::vector<std::string> not_tried(const Run &run)
+{
+    // (physical_candidates: the elevation of an equatorial run needs its
+    // latitude)
+    if (run.mount == PM_MOUNT_EQUATORIAL && std::isnan(run.latitude))
+        return {"refraction", "tube_flexure"};
+    return {};
+}
+
 std::string explain_json(const Run &run, const Explanation &ex, int order)
 {
     std::string j = "\"baseline\": {\"order\": " + std::to_string(order) +
@@ -133,6 +142,11 @@ std::string explain_json(const Run &run, const Explanation &ex, int order)
              num(u.sigma_before_arcsec) + ", \"cv_before_arcsec\": " +
              num(u.cv_before_arcsec) + "}";
     }
+    j += "], \"not_tried\": [";
+    const std::vector<std::string> nt = not_tried(run);
+    for (size_t i = 0; i < nt.size(); i++)
+        j += std::string(i ? ", " : "") + "{\"effect\": " + str(nt[i]) +
+             ", \"why\": \"the run gives no latitude\"}";
     return j + "], \"final\": {\"sigma_arcsec\": " + num(ex.final_sigma_arcsec) +
            ", \"cv_rms_arcsec\": " + num(ex.final_cv_rms_arcsec) +
            ", \"n_params\": " + std::to_string(ex.final_n_params) + "}";
@@ -283,6 +297,11 @@ void print_explain_text(const Run &run, const Explanation &ex, int order, bool a
     for (const Finding &f : ex.findings)
         std::printf("  %-22s %5d %10.3f %s\n", ("+ " + f.effect).c_str(), f.n_params_after,
                     f.sigma_after_arcsec, cv_cell(f.cv_rms_after_arcsec).c_str());
+    const std::vector<std::string> nt = not_tried(run);
+    if (!nt.empty())
+        std::printf("\n  not tried: refraction and tube flexure, which depend on the elevation: "
+                    "the run gives no\n  latitude (add a line '# latitude: DEG' to a column "
+                    "file)\n");
     std::printf("\n  pmfit fit %s --order %d", run.path.c_str(), ex.final_order);
     for (const std::string &a : ex.final_adds)
         std::printf(a.find('\'') == std::string::npos ? " --add '%s'" : " --add \"%s\"", a.c_str());
