@@ -907,6 +907,32 @@ START_TEST(test_plan_degenerate_run)
 }
 END_TEST
 
+/* A run that fits but does not determine the model over the sky (the first
+** 13 points of the bundled run, 22 terms): the note says so, and the text
+** does not say there are fewer points than half the terms (it did, and of
+** 12 points "too few for the 22-term model", while pmfit fit fitted them). */
+START_TEST(test_plan_undetermined_words)
+{
+    char args[1024], cmd[1024];
+    const char *top = getenv("PM_TOP");
+    snprintf(cmd, sizeof cmd, "head -n 18 %s/examples/sim_gem.dat > %s/s13.dat",
+             top ? top : ".", tmpdir_once());
+    ck_assert_int_eq(system(cmd), 0);
+    snprintf(args, sizeof args, "%s/s13.dat --next 2", tmpdir_once());
+    ck_assert_msg(plan_cli(args) == 0, "%s", out);
+    ck_assert_msg(strstr(out, "the run's 13 points fit the 22-term model but do not determine it "
+                              "over the sky") != NULL && !strstr(out, "fewer points than half"),
+                  "%s", out);
+    snprintf(cmd, sizeof cmd, "head -n 11 %s/examples/sim_gem.dat > %s/s6.dat", top ? top : ".",
+             tmpdir_once());
+    ck_assert_int_eq(system(cmd), 0);
+    snprintf(args, sizeof args, "%s/s6.dat --next 2", tmpdir_once());
+    ck_assert_msg(plan_cli(args) == 0, "%s", out);
+    ck_assert_msg(strstr(out, "the run's 6 points are too few for the 22-term model") != NULL,
+                  "%s", out);
+}
+END_TEST
+
 static Suite *suite(void)
 {
     Suite *s = suite_create("plan");
@@ -923,6 +949,7 @@ static Suite *suite(void)
     tcase_add_test(t, test_plan_d_score);
     tcase_add_test(t, test_plan_bad_inputs);
     tcase_add_test(t, test_plan_degenerate_run);
+    tcase_add_test(t, test_plan_undetermined_words);
     suite_add_tcase(s, t);
     return s;
 }

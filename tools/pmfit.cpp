@@ -1034,7 +1034,8 @@ int cmd_plan(const Options &o)
         std::printf("  predicted error over the sky now: %.3f\" (1 sigma per axis, mean)\n",
                     p.before_arcsec);
     else
-        std::printf("  the model is not determined yet (fewer points than half its terms)\n");
+        std::printf("  the model is not determined yet%s\n",
+                    p.note.empty() ? " (fewer points than half its terms)" : " (the note above)");
     std::printf("  next targets (in this order):\n");
     for (size_t k = 0; k < p.targets.size(); k++) {
         const Target &t = p.targets[k];

@@ -457,7 +457,7 @@ pm_model planning_model(const Run &taken, const PlanOptions &o, std::string &not
     std::vector<int> all(taken.obs.size());
     for (size_t i = 0; i < all.size(); i++)
         all[i] = (int)i;
-    if (2 * (long)taken.obs.size() > (long)m.n_terms + 2) {
+    if (2 * (long)taken.obs.size() > (long)m.n_terms) { /* (pmfit fit's rule, 2N > P) */
         FitOut f = do_fit(taken.obs, all, m);
         if (f.status == PM_OK)
             return f.model;
@@ -595,6 +595,12 @@ Plan plan_targets(const Run &taken, const PlanOptions &opt)
     double f0 = design_criterion(m, dt, ds);
     plan.before_arcsec =
         determines(m, dt, ds) ? o.noise_arcsec * std::sqrt(std::max(0.0, f0)) : NAN;
+    if (!std::isfinite(plan.before_arcsec) && !dt.empty() && plan.note.empty())
+        // (the points fit, but some combination of the terms is fixed by no
+        // point: the error over the sky is unbounded, not "too few points")
+        plan.note = "the run's " + std::to_string(dt.size()) + " points fit the " +
+                    std::to_string(m.n_terms) + "-term model but do not determine it over the " +
+                    "sky (a combination of its terms that no point fixes)";
     std::vector<double> crit, secs;
     const DesignPlace *start = dt.empty() ? nullptr : &dt.back();
     std::vector<int> order =
