@@ -552,6 +552,38 @@ START_TEST(test_pmfit_explain_says_what_it_cannot_try)
 }
 END_TEST
 
+/* The commands the tools print are runnable as printed: a run's path with a
+** space is quoted (explain's "pmfit fit ..." line, the report page's fit
+** and plan commands; the page listed "--add ..." for the effects). */
+START_TEST(test_pmfit_printed_commands_quote)
+{
+    char path[300], page[300], cmd[1400];
+    const char *top = getenv("PM_TOP");
+    char *html;
+    make_tmpdir();
+    snprintf(path, sizeof path, "%s/my run.dat", tmpdir);
+    snprintf(page, sizeof page, "%s/page.html", tmpdir);
+    snprintf(cmd, sizeof cmd, "cp %s/examples/sim_gem.dat '%s'", top ? top : ".", path);
+    ck_assert_int_eq(system(cmd), 0);
+    snprintf(cmd, sizeof cmd, "%s explain '%s'", tu_pmfit_path(), path);
+    ck_assert_int_eq(tu_capture(cmd, out, sizeof out), 0);
+    snprintf(cmd, sizeof cmd, "pmfit fit '%s' --order", path);
+    ck_assert_msg(strstr(out, cmd) != NULL, "%s", out);
+    snprintf(cmd, sizeof cmd, "%s report '%s' --add \"aux:dec_dir:e'\" -o '%s'", tu_pmfit_path(),
+             path, page);
+    ck_assert_int_eq(tu_capture(cmd, out, sizeof out), 0);
+    html = tu_slurp(page);
+    ck_assert_ptr_nonnull(html);
+    snprintf(cmd, sizeof cmd, "pmfit plan &apos;%s&apos; --next 5 --order 1 --min-el 15 --add "
+             "&quot;aux:dec_dir:e&apos;&quot;</code>", path);
+    ck_assert_msg(strstr(html, cmd) != NULL, "no '%s' in the page", cmd);
+    snprintf(cmd, sizeof cmd, "pmfit fit &apos;%s&apos; --order 1 --add &quot;aux:dec_dir:e&apos;"
+             "&quot;", path);
+    ck_assert_msg(strstr(html, cmd) != NULL, "no '%s' in the page", cmd);
+    free(html);
+}
+END_TEST
+
 static Suite *suite(void)
 {
     Suite *s = suite_create("pmfit");
@@ -571,6 +603,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_pmfit_eval_missing_input_and_long_comment);
     tcase_add_test(tc, test_pmfit_columns_by_name);
     tcase_add_test(tc, test_pmfit_explain_says_what_it_cannot_try);
+    tcase_add_test(tc, test_pmfit_printed_commands_quote);
     tcase_set_timeout(tc, 60);
     suite_add_tcase(s, tc);
     return s;

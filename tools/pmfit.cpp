@@ -882,7 +882,7 @@ void print_robust_hint(const FitOut &f, const std::vector<Obs> &obs, const std::
                 "sigmas, line%s\n    %s\n  failed plate solves or wrong stars? pmfit fit %s "
                 "--robust fits without them\n  (docs/robust.md)\n",
                 s.size(), s.size() == 1 ? "" : "s", s.size() == 1 ? "es" : "",
-                ROBUST_DEFAULT_CLIP, s.size() == 1 ? "" : "s", lines.c_str(), path.c_str());
+                ROBUST_DEFAULT_CLIP, s.size() == 1 ? "" : "s", lines.c_str(), shell_word(path).c_str());
 }
 
 int cmd_eval(const Options &o, const Run &run_in)

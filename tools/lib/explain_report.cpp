@@ -302,9 +302,9 @@ void print_explain_text(const Run &run, const Explanation &ex, int order, bool a
         std::printf("\n  not tried: refraction and tube flexure, which depend on the elevation: "
                     "the run gives no\n  latitude (add a line '# latitude: DEG' to a column "
                     "file)\n");
-    std::printf("\n  pmfit fit %s --order %d", run.path.c_str(), ex.final_order);
+    std::printf("\n  pmfit fit %s --order %d", shell_word(run.path).c_str(), ex.final_order);
     for (const std::string &a : ex.final_adds)
-        std::printf(a.find('\'') == std::string::npos ? " --add '%s'" : " --add \"%s\"", a.c_str());
+        std::printf(" --add %s", add_word(a).c_str());
     std::vector<int> bad;
     for (const Finding &f : ex.findings)
         if (f.effect == "outlier")

@@ -284,6 +284,27 @@ void parallel_for(size_t n, const std::function<void(size_t)> &f)
         std::rethrow_exception(first);
 }
 
+std::string shell_word(const std::string &s)
+{
+    static const char safe[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789"
+                               "_-./:=,+@%^";
+    if (!s.empty() && s.find_first_not_of(safe) == std::string::npos)
+        return s;
+    if (s.find('\'') == std::string::npos)
+        return "'" + s + "'";
+    if (s.find_first_of("\"$`\\!") == std::string::npos)
+        return "\"" + s + "\"";
+    std::string o = "'";
+    for (char c : s)
+        o += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return o + "'";
+}
+
+std::string add_word(const std::string &spec)
+{
+    return spec.find('\'') == std::string::npos ? "'" + spec + "'" : shell_word(spec);
+}
+
 bool valid_column_name(const std::string &s)
 {
     if (s.empty() || !(std::isalpha((unsigned char)s[0]) || s[0] == '_'))

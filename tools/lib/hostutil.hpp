@@ -22,6 +22,14 @@ int write_atomic(const std::string &path, const std::string &text, char *err, si
 // '#' comment starts "pm-model") rather than a run?  Returns 1 or 0, or -1
 // with "path: cannot open: reason" in err.  (pmfit compare OLD, report
 // --compare OLD: OLD is either.)
+// s as one word of a POSIX shell command line: as it is where every
+// character is safe, else quoted ('...', or "..." around a ', or '...'
+// with each ' written '\'').  For the commands the tools print to be
+// copied (a run's path with a space, a '<').
+std::string shell_word(const std::string &s);
+// An --add EFFECT as pmfit prints it: always quoted (EFFECT may hold ').
+std::string add_word(const std::string &spec);
+
 // A column name of the named-column format (docs/formats.md): letters,
 // digits, '_', '.', '-', not empty, a letter or '_' first.
 bool valid_column_name(const std::string &s);

@@ -177,6 +177,15 @@ struct Data {
     }
 };
 
+// " --add 'E'" for each of the page's --add effects.
+std::string plan_adds(const std::vector<std::string> &adds)
+{
+    std::string o;
+    for (const std::string &a : adds)
+        o += " --add " + add_word(a);
+    return o;
+}
+
 // The fit's failure in the words pmfit fit uses.
 [[noreturn]] void fit_failed(const FitOut &f, const std::string &what, int passes)
 {
@@ -668,9 +677,9 @@ void section_explain(Page &p, const Data &d)
     }
     p.body += "<h3>Findings</h3>\n";
     explain_findings(p, d);
-    std::string cmd = fmt("pmfit fit %s --order %d", d.run.path.c_str(), ex.final_order);
+    std::string cmd = fmt("pmfit fit %s --order %d", shell_word(d.run.path).c_str(), ex.final_order);
     for (const std::string &a : ex.final_adds)
-        cmd += (a.find('\'') == std::string::npos ? " --add '" + a + "'" : " --add \"" + a + "\"");
+        cmd += " --add " + add_word(a);
     para(p, "The explained model: <code>" + h(cmd) + "</code>");
     figure(p, "Residuals on the sky (arcsec, scale arrow in the legend) of the baseline (left) and of the "
               "explained model (right), on the same axes and arrow scale: " + h(d.xlabel()) + " and " +
@@ -716,10 +725,11 @@ void section_plan(Page &p, const Data &d)
                 d.o.horizon.empty() ? "" : (" and the horizon of " + h(d.o.horizon)).c_str(),
                 d.fit.model.n_terms, d.plan_opt.noise_arcsec, d.plan_opt.grid_deg,
                 arcsec_text(pl.before_arcsec).c_str()) +
-                h(fmt("pmfit plan %s --next %d --order %d --min-el %g%s%s", d.run.path.c_str(), d.o.next,
-                      d.o.order, d.o.min_el_deg, d.o.horizon.empty() ? "" : " --horizon ",
-                      d.o.horizon.c_str())) +
-                (d.o.adds.empty() ? "" : " --add &hellip;") + "</code>.");
+                h(fmt("pmfit plan %s --next %d --order %d --min-el %g%s%s", shell_word(d.run.path).c_str(),
+                      d.o.next, d.o.order, d.o.min_el_deg, d.o.horizon.empty() ? "" : " --horizon ",
+                      d.o.horizon.empty() ? "" : shell_word(d.o.horizon).c_str()) +
+                  plan_adds(d.o.adds)) +
+                "</code>.");
     std::vector<std::vector<std::string>> rows;
     std::vector<std::pair<double, double>> marks;
     std::vector<std::string> labels;
