@@ -550,8 +550,17 @@ struct Model {
         return out;
     }
 
+    // A string the C call would cut at its first NUL: refused, named.
+    static void no_nul(const char *what, const std::optional<std::string> &s)
+    {
+        if (s && s->find('\0') != std::string::npos)
+            fail(K_ARGUMENT, std::string(what) + ": holds a NUL character at " +
+                                 std::to_string(s->find('\0')) + " (the file would end it there)");
+    }
+
     void save(const std::string &path, std::optional<std::string> comment) const
     {
+        no_nul("comment", comment);
         char err[1024];
         if (pmmodel_save_info(path.c_str(), &m, &info, comment ? comment->c_str() : nullptr, err,
                               sizeof err) != 0)
@@ -561,6 +570,8 @@ struct Model {
     void emit_c(const std::string &path, const std::string &prefix,
                 std::optional<std::string> comment) const
     {
+        no_nul("comment", comment);
+        no_nul("prefix", prefix);
         char err[1024];
         if (pmmodel_emit_c(path.c_str(), &m, prefix.c_str(), comment ? comment->c_str() : nullptr,
                            err, sizeof err) != 0)
@@ -1061,7 +1072,10 @@ std::string plan_run(const std::shared_ptr<RunData> &d, const std::string &mount
     bool timed = !std::isnan(lst) || !utc.empty();
     if (catalogue.empty() && (timed || !std::isnan(lon)))
         fail(K_ARGUMENT, "lst, utc and lon place the stars of a catalogue; give catalogue= too");
-    if (!catalogue.empty() && (!std::isnan(lst)) == !utc.empty())
+    if (!catalogue.empty() && !std::isnan(lst) && !utc.empty())
+        fail(K_ARGUMENT, "catalogue: lst and utc both given: the time is one of them (lst, or "
+                         "utc with lon)");
+    if (!catalogue.empty() && std::isnan(lst) && utc.empty())
         fail(K_ARGUMENT, "catalogue: needs the time: lst (local sidereal time, hours) or utc "
                          "('YYYY-MM-DDTHH:MM') with lon (degrees east), one of them");
     po.order = order;

@@ -107,9 +107,12 @@ def _mount_id(mount):
 
 def _path(path, what="path"):
     try:
-        return _os.fspath(path)
+        p = _os.fspath(path)
     except TypeError:
         raise ArgumentError("%s: expected a file name, got %r" % (what, path)) from None
+    if ("\0" if isinstance(p, str) else b"\0") in p:  # the C call would cut it there
+        raise ArgumentError("%s: %r holds a NUL character" % (what, p))
+    return p
 
 
 def _index(a, i):
@@ -137,6 +140,10 @@ def _as_float(name, value, what="numbers"):
                 raise ArgumentError("%s%s is %r: expected a real number (complex values; "
                                     "take .real to drop the imaginary part)" % (
                                         name, _index(a, i), x))
+    elif a.dtype.kind in "USb":  # text and truth values are not numbers (numpy makes them so)
+        raise ArgumentError("%s: expected %s, got %s values (%r%s)" % (
+            name, what, {"U": "text", "S": "bytes", "b": "boolean"}[a.dtype.kind],
+            a.reshape(-1)[0].item() if a.size else "", ", ..." if a.size > 1 else ""))
     elif a.dtype.kind == "c":
         if not a.size:
             raise ArgumentError("%s: expected real numbers, got %s" % (name, a.dtype))
@@ -516,6 +523,10 @@ class Run:
                 raise ArgumentError("%s: expected a 1-D array, got shape %s" % (n, a.shape))
             if not _np.isfinite(a).all():
                 raise _first_bad(n, a)
+        bad = _np.flatnonzero(_np.abs(arrays[3][1]) > _np.pi / 2)
+        if bad.size:  # (as invert; the fit refused it later as a bare PM_ERR_ARG)
+            raise ArgumentError("app_dec: point %d is %r, beyond +-pi/2 (an apparent "
+                                "declination or elevation)" % (bad[0], float(arrays[3][1][bad[0]])))
         extra = []
         if pier is not None:
             extra.append(("pier", _as_int("pier", pier, (-1, 0, 1))))
@@ -852,9 +863,9 @@ def simulate(truth, *, n=200, seed=1, latitude=47.0, el_limit=15.0, noise=1.0, f
     would write."""
     if not isinstance(truth, Model):
         raise ArgumentError("truth: expected a pm.Model, got %r" % (truth,))
-    for name, v in (("n", n), ("seed", seed)):
-        if isinstance(v, bool) or not isinstance(v, (int, _np.integer)) or v < 0:
-            raise ArgumentError("%s: expected an integer >= 0, got %r" % (name, v))
+    for name, v, lo in (("n", n, 1), ("seed", seed, 0)):
+        if isinstance(v, bool) or not isinstance(v, (int, _np.integer)) or v < lo:
+            raise ArgumentError("%s: expected an integer >= %d, got %r" % (name, lo, v))
     effs = []
     for e in ([effects] if isinstance(effects, str) else effects):
         if isinstance(e, str):

@@ -372,3 +372,33 @@ def test_add_term_fields_are_checked():
         assert m.n_terms == n
     assert m.add_term(4, k=np.int64(3), aux=3, param=np.float32(2.0), value=1e-6) == n
     assert m.terms[n]["k"] == 3 and m.terms[n]["param"] == 2.0
+
+
+def test_inputs_the_c_calls_would_misread(tmp_path):
+    """What the C side would read as something else is refused, named:
+    a NUL in a path, a comment or a prefix (the C string ends there: the
+    comment was cut, the path another file); an apparent declination beyond
+    +-pi/2 in Run.from_arrays (the fit refused it later as a bare
+    PM_ERR_ARG); text and booleans as numbers (numpy turns them into
+    numbers).  And the messages say what is wrong: n=0 is below 1 like
+    n=-1; lst and utc together are two times, not none."""
+    m = pm.Model()
+    with pytest.raises(pm.ArgumentError, match="comment: holds a NUL character at 1"):
+        m.save(str(tmp_path / "a.pm"), comment="a\x00b")
+    with pytest.raises(pm.ArgumentError, match="NUL"):
+        m.save(str(tmp_path / "a.pm") + "\x00.txt")
+    with pytest.raises(pm.ArgumentError, match="prefix: holds a NUL"):
+        m.emit_c(str(tmp_path / "a.h"), prefix="pm\x00x")
+    assert not list(tmp_path.iterdir())
+    with pytest.raises(pm.ArgumentError, match=r"app_dec: point 1 is 2.0, beyond \+-pi/2"):
+        pm.Run.from_arrays([0.1, 0.2], [0.3, 0.4], [0.1, 0.2], [0.3, 2.0])
+    with pytest.raises(pm.ArgumentError, match="enc_ha: expected numbers, got text"):
+        m.apply("0.1", 0.2)
+    with pytest.raises(pm.ArgumentError, match="enc_ha: expected numbers, got boolean"):
+        m.apply(np.array([True, False]), 0.2)
+    for n in (0, -1):
+        with pytest.raises(pm.ArgumentError, match="n: expected an integer >= 1"):
+            pm.simulate(m, n=n)
+    with pytest.raises(pm.ArgumentError, match="lst and utc both given"):
+        pm.plan(latitude=0.8, lst=3, utc="2026-01-01T00:00", lon=5,
+                catalogue=os.path.join(TOP, "examples", "bright_stars.txt"))
