@@ -14,6 +14,7 @@
 #include "pm.h"
 #include "apply_lanes.h"
 #include "compare.hpp"
+#include "errormap.hpp"
 #include "explain.hpp"
 #include "fitrun.hpp"
 #include "hostutil.hpp"
@@ -789,6 +790,8 @@ struct Fit {
     std::string title;
     std::vector<int> lines;       // file line of each fitted observation
     pmmodel_info info{};          // the run's columns the model reads, its side
+    std::string error_map;        // pmfit fit --json's "error_map" object
+    std::string undetermined;     // its warning where the stars do not determine the model
 
     Model model() const
     {
@@ -878,6 +881,15 @@ std::unique_ptr<Fit> fit_points(const Run &run, const std::vector<int> &use, con
         fail_fit(f->out, what, max_iter);
     f->title = title;
     f->info = model_info(f->out.model, run.aux_names, pier);
+    // the predicted error map and the undetermined-fit warning, as pmfit fit
+    // (its JSON's "error_map", its warning)
+    try {
+        ErrorMap em = error_map(run, f->out, pier);
+        f->error_map = error_map_json(em, f->out.res.sigma * RAD2AS);
+        f->undetermined = undetermined_warning(em, f->out.res.sigma * RAD2AS);
+    } catch (const std::runtime_error &) {
+        /* no covariance: no map (pmfit fit has none then either) */
+    }
     for (int i : f->out.idx)
         f->lines.push_back(run.obs[i].line);
     return f;
@@ -1354,6 +1366,8 @@ PYBIND11_MODULE(_pm, mod)
         .def_property_readonly("iterations", [](const Fit &f) { return f.out.res.iterations; })
         .def_property_readonly("converged", [](const Fit &f) { return f.out.res.converged != 0; })
         .def_property_readonly("title", [](const Fit &f) { return f.title; })
+        .def_property_readonly("_error_map", [](const Fit &f) { return f.error_map; })
+        .def_property_readonly("undetermined", [](const Fit &f) { return f.undetermined; })
         .def_property_readonly("max_correlation", &Fit::max_correlation)
         .def("_pointing_sigma", &Fit::pointing_sigma);
     mod.def("fit_run", &fit_run);

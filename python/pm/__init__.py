@@ -625,19 +625,24 @@ class FitResult:
     ``residuals`` (observed minus model, shape (N, 2), radians), ``index``
     (the observations fitted, into the run), ``lines`` (their file lines),
     ``max_correlation`` (the most correlated pair of terms), ``f_test`` (the
-    pier-side F-test of a joint fit with side-specific terms, or None)."""
+    pier-side F-test of a joint fit with side-specific terms, or None),
+    ``error_map`` (pmfit fit --json's: the predicted error over the sky) and
+    ``undetermined`` (pmfit's warning where the stars do not determine the
+    model between them, else ""; fit_run also issues it as a
+    PointingWarning)."""
 
     def __init__(self, c, f_test=None):
         self._c = c
         self.model = Model._wrap(c.model)
         for k in ("names", "coefficients", "errors", "covariance", "residuals", "index",
                   "lines", "sigma", "chi2", "rms", "n_obs", "n_params", "iterations",
-                  "converged", "title", "max_correlation"):
+                  "converged", "title", "max_correlation", "undetermined"):
             v = getattr(c, k)
             if isinstance(v, _np.ndarray):
                 v.setflags(write=False)
             setattr(self, k, v)
         self.f_test = f_test
+        self.error_map = _json.loads("{%s}" % c._error_map)["error_map"] if c._error_map else None
 
     @property
     def correlation(self):
@@ -673,6 +678,8 @@ class FitResult:
             d["max_correlation"] = {"terms": [a, b], "value": r}
         if self.f_test is not None:
             d["pier_f_test"] = dict(self.f_test)
+        if self.error_map is not None:
+            d["error_map"] = dict(self.error_map)
         return d
 
 
@@ -706,6 +713,9 @@ def fit_run(run, *, order=1, add=(), split=False, max_iter=2000):
     if not isinstance(max_iter, (int, _np.integer)) or isinstance(max_iter, bool):
         raise ArgumentError("max_iter: expected an integer")
     fits, f_test = _pm.fit_run(r._data, _order(order), _adds(add), bool(split), int(max_iter))
+    for c in fits:
+        if c.undetermined:
+            _warnings.warn("%s: %s" % (c.title, c.undetermined), PointingWarning, stacklevel=2)
     if split:
         return SplitFit(FitResult(fits[0]), FitResult(fits[1]), f_test)
     return FitResult(fits[0], f_test)

@@ -6,6 +6,7 @@ apply and invert (against pm_ref), model files (both directions), explain
 ones of $PM_DATA_DIR."""
 import json
 import os
+import warnings
 
 import numpy as np
 import pytest
@@ -195,7 +196,12 @@ def test_fit_from_arrays_equals_fit_of_file(sim_dir, tmp_path):
 def test_pier_split_matches_pmfit(name, sim_dir, tmp_path):
     run = resolve(name, sim_dir)
     pmfit_save(run, tmp_path, "--pier", "split")
-    s = pm.fit_run(run, split=True)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        s = pm.fit_run(run, split=True)
+    out = json.loads(run_cmd(PMFIT, "fit", run, "--pier", "split", "--json").stdout)
+    # (gem-28's west side is undetermined between its stars: pmfit warns, so does pm)
+    assert len(caught) == sum(out["sides"][k]["error_map"]["undetermined"] for k in ("east", "west"))
     for side, res in (("east", s.east), ("west", s.west)):
         _, _, terms = parse_model_file(str(tmp_path / "c.pm") + "-" + side)
         assert_bits(res.coefficients, [v for _, v in terms], side)
@@ -316,3 +322,24 @@ def test_read_run_columns(tmp_path):
     assert np.allclose(np.degrees(r.app_dec), [20.02, 45.01, -10.03], atol=1e-12)
     with pytest.raises(ValueError):
         r.enc_ha[0] = 1.0  # read-only: the run stays what was read
+
+
+def test_error_map_and_undetermined_match_pmfit(tmp_path):
+    """FitResult.error_map and to_dict()["error_map"] are pmfit fit --json's
+    (to_dict lacked it), and where the stars do not determine the model
+    between them fit_run warns as pmfit does (the warning was lost)."""
+    run = os.path.join(TOP, "examples", "sim_gem.dat")
+    out = json.loads(run_cmd(PMFIT, "fit", run, "--json").stdout)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        res = pm.fit_run(run)
+    assert res.undetermined == ""
+    assert res.to_dict()["error_map"] == out["error_map"]
+    few = tmp_path / "few.dat"
+    few.write_text("".join(open(run).readlines()[:18]))   # 13 points, 22 terms
+    out = json.loads(run_cmd(PMFIT, "fit", few, "--json").stdout)
+    assert out["error_map"]["undetermined"] is True
+    with pytest.warns(pm.PointingWarning, match="do not determine this model"):
+        res = pm.fit_run(str(few))
+    assert res.to_dict()["error_map"] == out["error_map"]
+    assert res.error_map["undetermined"] is True and "do not determine" in res.undetermined
