@@ -1183,8 +1183,8 @@ void write_explain_plots(const std::string &dir, const Run &run, const Explanati
     const FitOut &b = ex.baseline;
     for (size_t k = 0; k < ex.findings.size(); k++) {
         const Finding &f = ex.findings[k];
-        pmplot::Series s1{"axis 1 (along HA/az)", {}, {}, false};
-        pmplot::Series s2{"axis 2 (along Dec/el)", {}, {}, false};
+        pmplot::Series s1{altaz ? "along azimuth" : "along hour angle", {}, {}, false};
+        pmplot::Series s2{altaz ? "along elevation" : "along declination", {}, {}, false};
         std::string xlab;
         for (size_t j = 0; j < b.idx.size(); j++) {
             const Obs &o = run.obs[b.idx[j]];
