@@ -474,7 +474,11 @@ pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
 **     enc_dec  double*           encoder axis 2, on the requested side:
 **                                enc_dec - e' in [-pi/2, pi/2] for
 **                                PM_SIDE_NORMAL, in (pi/2, 3pi/2) for
-**                                PM_SIDE_FLIPPED
+**                                PM_SIDE_FLIPPED; with
+**                                PM_WARN_UNREACHABLE the nearest
+**                                position, which may be on the pole
+**                                itself (enc_dec - e' = +-pi/2, the
+**                                boundary of both sides)
 **  Returned (function value):
 **              pm_status   PM_OK; PM_WARN_NOT_CONVERGED; PM_WARN_UNREACHABLE;
 **                          PM_ERR_ARG; PM_ERR_NONFINITE; PM_ERR_STATE
