@@ -64,11 +64,13 @@ pm_status start_model(pm_model *m, int mount, int order, const pm_model *src, do
 
 /* Leave-one-out rms per axis (Note 1 of pm_indi_fit). */
 double loo_rms(const pm_fit *fit, const pm_fit_result *fr, const pm_model *m, long n, const double *e1,
-               const double *e2, const double *a1, const double *a2)
+               const double *e2, const double *a1, const double *a2, long *worst, double *worst_loo)
 {
     pm_fit_result unit = *fr;
     double sum = 0;
     unit.sigma = 1.0;
+    *worst = -1;
+    *worst_loo = 0;
     for (long i = 0; i < n; i++) {
         double s, cov[3], r[2];
         if (pm_fit_pointing_sigma(fit, &unit, m, nullptr, e1[i], e2[i], &s, cov) != PM_OK ||
@@ -77,7 +79,12 @@ double loo_rms(const pm_fit *fit, const pm_fit_result *fr, const pm_model *m, lo
         double h = 0.5 * (cov[0] + cov[2]);
         if (!(h < 0.999))
             return HUGE_VAL;
-        sum += (r[0] * r[0] + r[1] * r[1]) / ((1 - h) * (1 - h));
+        const double e = (r[0] * r[0] + r[1] * r[1]) / ((1 - h) * (1 - h));
+        sum += e;
+        if (std::sqrt(e / 2) > *worst_loo) {
+            *worst_loo = std::sqrt(e / 2);
+            *worst = i;
+        }
     }
     return n > 0 ? std::sqrt(sum / (2.0 * (double)n)) : 0.0;
 }
@@ -156,7 +163,10 @@ pm_status pm_indi_fit(int mount, long n, const double *enc1, const double *enc2,
     std::vector<pm_model> fitted(PM_INDI_MAX_ORDER + 1);
     double sig[PM_INDI_MAX_ORDER + 1] = {0};
     int npar[PM_INDI_MAX_ORDER + 1] = {0};
+    long worst[PM_INDI_MAX_ORDER + 1] = {-1, -1, -1};
+    double worst_loo[PM_INDI_MAX_ORDER + 1] = {0};
     int top = -1;
+    r.worst = -1;
     for (int L = 0; L <= r.chosen_order; L++) {
         pm_model &m = fitted[L];
         const pm_model *lower = L > 0 ? &fitted[L - 1] : nullptr;
@@ -173,7 +183,7 @@ pm_status pm_indi_fit(int mount, long n, const double *enc1, const double *enc2,
                 std::snprintf(r.bad_term, sizeof r.bad_term, "%s", pm_status_text(st));
             break;
         }
-        r.cv[L] = loo_rms(fit, &fr, &m, n, enc1, enc2, app1, app2);
+        r.cv[L] = loo_rms(fit, &fr, &m, n, enc1, enc2, app1, app2, &worst[L], &worst_loo[L]);
         sig[L] = fr.sigma;
         npar[L] = fr.n_par;
         top = L;
@@ -186,6 +196,8 @@ pm_status pm_indi_fit(int mount, long n, const double *enc1, const double *enc2,
             r.order = L;
             r.sigma = sig[L];
             r.n_par = npar[L];
+            r.worst = worst[L];
+            r.worst_loo = worst_loo[L];
         }
     *out = best;
     *res = r;
@@ -245,6 +257,16 @@ void pm_indi_describe(const pm_indi_result *r, long n, long skipped, char *buf, 
                       r->spread * 180.0 / kPi, r->order, r->n_par, r->sigma * arcsec, cv, extra,
                       r->sigma * arcsec > 1800.0 ? " (the sync points disagree by degrees: check the "
                       "site, the time and the sync targets)" : "");
+        if (r->worst >= 0 && r->order >= 0 && r->cv[r->order] > 0 &&
+                r->worst_loo > PM_INDI_WORST_RATIO * r->cv[r->order] &&
+                r->worst_loo * arcsec > 10.0) {
+            size_t k = std::strlen(buf);
+            std::snprintf(buf + k, len - k,
+                          "; the others' fit misses sync point %ld by %.1f arcsec, %.1f times "
+                          "their leave-one-out rms: a wrong sync? (it moves every GOTO; delete it "
+                          "and re-initialise)",
+                          r->worst + 1, r->worst_loo * arcsec, r->worst_loo / r->cv[r->order]);
+        }
         break;
     }
     }

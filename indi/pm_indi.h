@@ -50,7 +50,18 @@ typedef struct pm_indi_result {
     char bad_term[64]; /* why the last given-up fit failed: the term that
                           made it singular, else pm's status in words
                           ("the fit did not converge") */
+    long worst;        /* the point (0-based, of those given; the plugin
+                          turns it into the database entry's) the others'
+                          fit misses most, by its leave-one-out residual
+                          (PM_INDI_FIT), else -1; pm_indi_describe names
+                          it as "sync point worst + 1" */
+    double worst_loo;  /* that residual, rms per axis (radians) */
 } pm_indi_result;
+
+/* A point whose leave-one-out residual is this many times the fit's
+** leave-one-out rms (and over 10" of it) is named in the description: one
+** wrong sync spreads its error over every GOTO. */
+#define PM_INDI_WORST_RATIO 4.0
 
 /*
 **  pm_indi_spread - sky coverage of n positions (axis 1, axis 2, radians):

@@ -234,6 +234,7 @@ bool PmMathPlugin::Initialise(InMemoryDatabase *db)
         return false;
     }
     long skipped = 0;
+    std::vector<long> db_index; /* the database entry of each point fitted */
     for (size_t i = 0; i < points.size(); i++) {
         const AlignmentDatabaseEntry &e = points[i];
         const char *why = nullptr;
@@ -256,6 +257,7 @@ bool PmMathPlugin::Initialise(InMemoryDatabase *db)
             skipped++;
             continue;
         }
+        db_index.push_back((long)i);
         e1.push_back(a1);
         e2.push_back(a2);
         s1v.push_back(s1);
@@ -272,6 +274,8 @@ bool PmMathPlugin::Initialise(InMemoryDatabase *db)
         return false;
     }
     kind_ = r.kind;
+    if (r.worst >= 0 && r.worst < n) /* named by its place in the database */
+        r.worst = db_index[(size_t)r.worst];
     pm_indi_describe(&r, n, skipped, summary_, sizeof summary_);
     note("%s mount: %s", altaz() ? "alt-az" : "equatorial", summary_);
     return true;

@@ -317,6 +317,33 @@ START_TEST(test_pm_indi_fit_near_singular_order_rejected)
 }
 END_TEST
 
+/* One wrong sync among 63 exact ones (its sky position 0.75 deg off in
+** hour angle, a misidentified star): the fit's sigma is hundreds of arcsec
+** and every GOTO moves; the log line names that point (it gave only the
+** sigma, and named nothing below 1800"). */
+START_TEST(test_pm_indi_names_the_wrong_sync)
+{
+    const double k[6] = {0.4 * D2R, -0.25 * D2R, 0.2 * D2R, -0.12 * D2R, 15 * ARCSEC, 0};
+    pm_model m;
+    pm_indi_result r;
+    char buf[1024], want[64];
+    long n = grid(k, 9, 7), bad = 40;
+    a1[bad] += 0.75 * D2R;
+    ck_assert_int_eq(pm_indi_fit(PM_MOUNT_EQUATORIAL, n, e1, e2, a1, a2, &fit, &m, &r), PM_OK);
+    ck_assert_int_eq(r.kind, PM_INDI_FIT);
+    ck_assert_int_eq(r.worst, bad);
+    pm_indi_describe(&r, n, 0, buf, sizeof buf);
+    printf("one wrong sync: %s\n", buf);
+    snprintf(want, sizeof want, "misses sync point %ld by", bad + 1);
+    ck_assert_msg(strstr(buf, want) && strstr(buf, "a wrong sync?"), "got: %s", buf);
+    /* the same points without it: nobody named */
+    a1[bad] -= 0.75 * D2R;
+    ck_assert_int_eq(pm_indi_fit(PM_MOUNT_EQUATORIAL, n, e1, e2, a1, a2, &fit, &m, &r), PM_OK);
+    pm_indi_describe(&r, n, 0, buf, sizeof buf);
+    ck_assert_msg(!strstr(buf, "wrong sync"), "got: %s", buf);
+}
+END_TEST
+
 START_TEST(test_pm_indi_fit_ring_singular_falls_back)
 {
     /* 30 points on one declination: hour-angle index, collimation and
@@ -609,6 +636,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_pm_indi_fit_flexure_needs_order1);
     tcase_add_test(tc, test_pm_indi_fit_near_singular_order_rejected);
     tcase_add_test(tc, test_pm_indi_fit_ring_singular_falls_back);
+    tcase_add_test(tc, test_pm_indi_names_the_wrong_sync);
     tcase_add_test(tc, test_pm_indi_fit_small_patch_offsets);
     tcase_add_test(tc, test_pm_indi_fit_altaz_half_turn);
     tcase_add_test(tc, test_pm_indi_fit_bad_input_untouched);
