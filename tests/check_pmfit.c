@@ -584,6 +584,27 @@ START_TEST(test_pmfit_printed_commands_quote)
 }
 END_TEST
 
+/* A period that is not a whole number of cycles jumps where the raw angle
+** wraps at +-180 deg: explain says so where the run's axis turns through
+** there (a German mount's flipped side near the meridian), not where an
+** empty arc holds the wrap (a fork).  Runs of tests/ref/indep_gen.py, a
+** 187.3-cycle, 3" HA error (the commands in their first lines). */
+START_TEST(test_pmfit_explain_period_seam)
+{
+    char path[512];
+    const char *top = getenv("PM_TOP");
+    snprintf(path, sizeof path, "%s/tests/data/indep_gem_g187_seam.dat", top ? top : ".");
+    ck_assert_msg(run("%s explain %s%s", path, "") == 0, "%s", out);
+    ck_assert_msg(strstr(out, "is not a whole number of cycles, so the term jumps where the raw "
+                              "HA wraps at +-180 deg, which this run's hour-angle axis turns "
+                              "through") != NULL, "%s", out);
+    snprintf(path, sizeof path, "%s/tests/data/indep_fork_g187.dat", top ? top : ".");
+    ck_assert_msg(run("%s explain %s%s", path, "") == 0, "%s", out);
+    ck_assert_msg(strstr(out, "ha_periodic") != NULL && strstr(out, "not a whole number") == NULL,
+                  "%s", out);
+}
+END_TEST
+
 static Suite *suite(void)
 {
     Suite *s = suite_create("pmfit");
@@ -604,6 +625,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_pmfit_columns_by_name);
     tcase_add_test(tc, test_pmfit_explain_says_what_it_cannot_try);
     tcase_add_test(tc, test_pmfit_printed_commands_quote);
+    tcase_add_test(tc, test_pmfit_explain_period_seam);
     tcase_set_timeout(tc, 60);
     suite_add_tcase(s, tc);
     return s;

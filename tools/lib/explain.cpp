@@ -738,6 +738,11 @@ void prefer_integer(const Run &run, const State &st, const char *prefix, double 
     }
 }
 
+// How near a period the model holds a second one on the same axis is not
+// looked for: within this many cycles per revolution, or this fraction of
+// it (periodic_candidates).
+constexpr double HELD_WINDOW_CYCLES = 2.5, HELD_WINDOW_REL = 0.02;
+
 void periodic_candidates(const Run &run, const State &st, const ExplainOptions &opt,
                          std::vector<Candidate> &cands)
 {
@@ -752,17 +757,36 @@ void periodic_candidates(const Run &run, const State &st, const ExplainOptions &
         // is no reason not to look for another: a worm and a second gear, or
         // a worm's second harmonic (until stop 39 the axis was not looked at
         // again, and a run with both said "nothing significant is left
-        // out").  Only the period the model already holds is not offered.
-        bool held = false;
+        // out").  But not next to a period the model holds: what is left
+        // within a few cycles of it is that term's own leftover (a period
+        // between two whole numbers, a term that jumps where the raw angle
+        // wraps, a noise-free run's last digits), not a second gear -- a
+        // German run's 187.3 read as 187 left 1" at 188, and a noise-free
+        // fork's 187.32 left 0.25" at 187 and 0.02" at 186.  The peak is
+        // the highest outside those windows.
+        std::vector<double> held;
         for (int i = m.n_base; i < m.n_terms; i++) {
             const pm_term &t = m.term[i];
-            const bool on_axis = (t.kind == PM_TERM_FOURIER && t.k == (comp ? PM_BASE_E : PM_BASE_C)) ||
-                                 (t.kind == PM_TERM_SECTORAL && !comp);
-            held = held || (on_axis && std::fabs(pg.peak_g - t.param) <
-                                           std::max(0.5, 0.005 * t.param));
+            if ((t.kind == PM_TERM_FOURIER && t.k == (comp ? PM_BASE_E : PM_BASE_C)) ||
+                (t.kind == PM_TERM_SECTORAL && !comp))
+                held.push_back(t.param);
         }
-        if (held)
-            continue;
+        if (!held.empty()) {
+            auto near_held = [&](double g) {
+                for (double p : held)
+                    if (std::fabs(g - p) < std::max(HELD_WINDOW_CYCLES, HELD_WINDOW_REL * p))
+                        return true;
+                return false;
+            };
+            double best_g = 0, best_p = -1;
+            for (size_t k = 0; k < pg.g.size(); k++)
+                if (!near_held(pg.g[k]) && pg.power[k] > best_p)
+                    best_p = pg.power[k], best_g = pg.g[k];
+            if (!(best_g > 0))
+                continue;
+            pg.peak_g = best_g;
+            pg.peak_power = best_p;
+        }
         Fit chosen;
         const bool scan = opt_is_scan(opt, comp);
         if (scan)

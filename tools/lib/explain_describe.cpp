@@ -228,6 +228,36 @@ void describe_periodic(const Run &run, const Candidate &c, const std::vector<int
                       fd.cycles_lo, fd.cycles_hi, PERIOD_RANGE_CHI2, fd.sampled_deg);
         fd.text += buf;
     }
+    // A period that is not a whole number of cycles per revolution jumps
+    // where the raw angle wraps (+-180 deg, as the reader gives it).  Where
+    // the axis turns through that place (its points on both sides of it:
+    // no empty arc around it, as a German mount's flipped side near the
+    // meridian, or an alt-az azimuth run through north) the term is not
+    // continuous where the mount is, and the period read is biased (an
+    // outside probe: 187.3 read as 187, phase off by 28 deg).
+    if (std::fabs(G - std::round(G)) > 1e-6) {
+        std::vector<double> ang;
+        for (int i : c.fit.f.idx)
+            ang.push_back(axis == 1 ? run.obs[(size_t)i].eh : run.obs[(size_t)i].ed);
+        // where the axis never turns (derive_directions' cut): the widest
+        // empty arc where it is over a quarter turn (a German mount's
+        // counterweight-up half); else an equatorial axis does not pass
+        // under the pole (a fork), and an alt-az one turns anywhere
+        double middle = 0;
+        const double gap = widest_gap(ang, &middle);
+        const bool wrap_in_gap = std::fabs(std::remainder(PI - middle, 2 * PI)) < gap / 2;
+        const bool turns_there = gap > 0.5 * PI ? !wrap_in_gap
+                                                : run.mount == PM_MOUNT_ALTAZ && !wrap_in_gap;
+        if (turns_there && gap < 2 * PI) {
+            std::snprintf(buf, sizeof buf,
+                          "; %.6g is not a whole number of cycles, so the term jumps where the "
+                          "%s wraps at +-180 deg, which this run's %s axis turns through: the "
+                          "period and phase read there are not to be trusted (a whole number, or "
+                          "raw angles continuous where the axis turns, are)",
+                          G, axis_word(run, axis, true), axis_word(run, axis, false));
+            fd.text += buf;
+        }
+    }
 }
 
 void describe_outlier(const Run &run, const State &st, const Candidate &c, Finding &fd)
