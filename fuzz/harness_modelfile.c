@@ -51,6 +51,12 @@ static int mf_same_info(const pm_model *m, const pmmodel_info *a, const pmmodel_
     int i;
     if (a->pier != b->pier)
         return pmfz_fail("modelfile: reloaded pier side %d, saved %d", b->pier, a->pier);
+    if (a->has_err != b->has_err)
+        return pmfz_fail("modelfile: reloaded has_err %d, saved %d", b->has_err, a->has_err);
+    for (i = 0; a->has_err && i < m->n_terms; i++)
+        if (memcmp(&a->err[i], &b->err[i], sizeof(double)) != 0)
+            return pmfz_fail("modelfile: reloaded error %d is %.17g, saved %.17g", i, b->err[i],
+                             a->err[i]);
     for (i = m->n_base; i < m->n_terms; i++) {
         int j = m->term[i].aux - PM_AUX_USER;
         if (m->term[i].kind == PM_TERM_AUX && j >= 0 && j < PM_MAX_AUX &&

@@ -117,6 +117,22 @@ xterm e'*aux1 aux 5 0 0 0 4 1010 1e-6
 xterm c'*aux0 aux 3 0 0 0 3 55 -2e-7
 end
 MODEL
+cat > $C/modelfile/v4_errors.pm <<'MODEL'
+# by hand: version 4 with each coefficient's 1-sigma error
+pm-model 4
+mount altaz
+order 0
+errors
+terms 7
+term a 1 0 0 1e-4 2.5e-6
+term b 2 0 0 -2e-4 2.5e-6
+term c' 3 0 0 0.001 1e-5
+term d 4 0 0 0 3e-6
+term e' 5 0 0 -0.0005 1e-6
+term i 6 0 0 3.5e-05 4e-6
+xterm cot(el) zenith 0 0 0 0 0 0 1e-5 2e-6
+end
+MODEL
 printf 'pm-model 2\r\nmount equatorial\r\norder 0\r\nterms 6\r\nterm a 1 0 0 0\r\nterm b 2 0 0 0\r\nterm c 3 0 0 0\r\nterm d 4 0 0 0\r\nterm e 5 0 0 0\r\nterm i 6 0 0 0\r\nend\r\n' \
     > $C/modelfile/crlf_zero.pm
 

@@ -336,6 +336,7 @@ struct Model {
         if (s != PM_OK)
             fail_status(s, "coefficients");
         m = t;
+        info.has_err = 0; /* a fit's errors are not these coefficients' */
     }
 
     void set_latitude(double lat)
@@ -409,6 +410,7 @@ struct Model {
         if (s != PM_OK)
             fail_status(s, "add_term");
         m = c;
+        info.has_err = 0; /* a fit's errors are not this model's */
         return index;
     }
 
@@ -880,7 +882,7 @@ std::unique_ptr<Fit> fit_points(const Run &run, const std::vector<int> &use, con
     if (f->out.status != PM_OK)
         fail_fit(f->out, what, max_iter);
     f->title = title;
-    f->info = model_info(f->out.model, run.aux_names, pier);
+    f->info = model_info(f->out.model, run.aux_names, pier, f->out.res.err);
     // the predicted error map and the undetermined-fit warning, as pmfit fit
     // (its JSON's "error_map", its warning)
     try {
@@ -1153,6 +1155,8 @@ std::string compare_run(const Model *old_model, const std::shared_ptr<RunData> &
             for (int j = 0; j < PM_MAX_AUX; j++)
                 os.inputs.push_back(old_model->info.input[j]);
             os.pier = old_model->info.pier;
+            if (old_model->info.has_err)
+                os.err.assign(old_model->info.err, old_model->info.err + os.model.n_terms);
         } else if (old_run) {
             os = old_from_run(old_run->run, order, adds, passes);
         } else {

@@ -102,6 +102,9 @@ START_TEST(test_compare_simulated_nights)
                strstr(out, "\"advice\""));
         ck_assert_int_eq(moved_count(), 0);
         ck_assert_ptr_nonnull(strstr(out, "still holds"));
+        /* the model file keeps its fit's errors (version 4): they count as
+        ** the run's do (a file without them took its coefficients as exact) */
+        ck_assert_ptr_nonnull(strstr(out, "\"old_errors_counted\": true"));
 
         compare(olds[k], "n3.dat");
         printf("check_compare: %s vs IH + 12\": re-zero c' %.3f\" +- %.3f\"; %s\n", olds[k],

@@ -339,8 +339,8 @@ START_TEST(test_pmmodel_emit_c_compiles_and_loads)
 }
 END_TEST
 
-/* Version 4: the names of the columns a model reads (pm_context.aux[j])
-** and its pier side, written where the model reads a named input or is of
+/* Version 4: the names of the columns a model reads (pm_context.aux[j]),
+** its pier side and its coefficients' errors, written where the model reads a named input or is of
 ** one side (version 3 otherwise), read back; bad lines are errors at
 ** their line; a name that is not a column name is not written. */
 START_TEST(test_pmmodel_info)
@@ -417,6 +417,27 @@ START_TEST(test_pmmodel_info)
         expect_load_error(text, bad[k].line, bad[k].word);
     }
     snprintf(text, sizeof text, "pm-model 3\nmount equatorial\norder 0\ninput 0 hum\n%s", body);
+    expect_load_error(text, "4", "version 4 has them");
+    /* errors: each term line's last field, written and read bit for bit */
+    memset(&in, 0, sizeof in);
+    in.has_err = 1;
+    for (k = 0; k < (size_t)a.n_terms; k++)
+        in.err[k] = 1e-7 * (double)(k + 1) / 3.0;
+    ck_assert_msg(pmmodel_save_info(path, &a, &in, NULL, err, sizeof err) == 0, "%s", err);
+    ck_assert_msg(pmmodel_load_info(path, &b, &got, err, sizeof err) == 0, "%s", err);
+    ck_assert_int_eq(got.has_err, 1);
+    ck_assert(memcmp(got.err, in.err, sizeof(double) * (size_t)a.n_terms) == 0);
+    ck_assert(memcmp(b.coef, a.coef, sizeof(double) * (size_t)a.n_terms) == 0);
+    in.err[3] = -1;
+    ck_assert_int_eq(pmmodel_save_info(path, &a, &in, NULL, err, sizeof err), -1);
+    ck_assert_msg(strstr(err, "not a finite number >= 0") != NULL, "%s", err);
+    snprintf(text, sizeof text, "%serrors\nterms 6\nterm a 1 0 0 0 1e-6\nterm b 2 0 0 0\n", head4);
+    expect_load_error(text, "7", "'errors' line");
+    snprintf(text, sizeof text, "%serrors\nterms 6\nterm a 1 0 0 0 -1e-6\n", head4);
+    expect_load_error(text, "6", "bad error");
+    snprintf(text, sizeof text, "%serrors\nerrors\n", head4);
+    expect_load_error(text, "5", "second 'errors'");
+    snprintf(text, sizeof text, "pm-model 3\nmount equatorial\norder 0\nerrors\n%s", body);
     expect_load_error(text, "4", "version 4 has them");
     snprintf(text, sizeof text, "%sinput 3 x.y-z_\npier east\n%s", head4, body);
     write_text(path, text);

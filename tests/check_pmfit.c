@@ -493,8 +493,12 @@ START_TEST(test_pmfit_columns_by_name)
     ck_assert_msg(strstr(out, "reads the column 'press', which") != NULL &&
                       strstr(out, "hum, dec_dir") != NULL, "%s", out);
     /* a version-3 file: by position, said */
-    snprintf(cmd, sizeof cmd, "grep -v '^input' %s | sed 's/^pm-model 4$/pm-model 3/' > %s", m, m3);
-    ck_assert_int_eq(system(cmd), 0);
+    {   /* the same model written without its information */
+        pm_model mm;
+        char err[512];
+        ck_assert_msg(pmmodel_load(m, &mm, err, sizeof err) == 0, "%s", err);
+        ck_assert_msg(pmmodel_save(m3, &mm, NULL, err, sizeof err) == 0, "%s", err);
+    }
     snprintf(args, sizeof args, "%s %s --json", m3, b);
     ck_assert_msg(run("%s eval %s%s", args, "") == 0, "%s", out);
     ck_assert_msg(strstr(out, "does not name the column its term e'*aux1 reads") != NULL &&

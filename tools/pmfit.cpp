@@ -1674,8 +1674,8 @@ int run_main(int argc, char **argv)
         // what the model file says beyond the model: the names of the
         // columns its terms read (another run may have them in another
         // order) and, split, its pier side
-        pmmodel_info info =
-            model_info(fits[k].model, aux_names, fits.size() == 1 ? 0 : (k == 0 ? 1 : -1));
+        pmmodel_info info = model_info(fits[k].model, aux_names,
+                                       fits.size() == 1 ? 0 : (k == 0 ? 1 : -1), fits[k].res.err);
         std::string inputs_note;
         for (int j = 0; j < PM_MAX_AUX; j++)
             if (info.input[j][0])

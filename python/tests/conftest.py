@@ -49,7 +49,9 @@ def parse_model_file(path):
             elif t[0] == "order":
                 order = int(t[1])
             elif t[0] in ("term", "xterm"):
-                terms.append((t[1], float(t[-1])))
+                # the value: term NAME k l m VALUE, xterm NAME KIND k l m side aux param
+                # VALUE; a version-4 file's 'errors' adds each one's error after it
+                terms.append((t[1], float(t[5] if t[0] == "term" else t[9])))
     return mount, order, terms
 
 

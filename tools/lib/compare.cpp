@@ -344,6 +344,8 @@ OldSide load_old(const std::string &path, int order, const std::vector<std::stri
         for (int j = 0; j < PM_MAX_AUX; j++)
             o.inputs.push_back(info.input[j]);
         o.pier = info.pier;
+        if (info.has_err) /* the fit's errors the file keeps count as a run's do */
+            o.err.assign(info.err, info.err + o.model.n_terms);
         return o;
     }
     return old_from_run(load_run(path, refraction, skip_bad, format, equinox), order, adds,

@@ -719,11 +719,17 @@ Run run_for_model(const Run &run, const pm_model &m, const std::vector<std::stri
     return r;
 }
 
-pmmodel_info model_info(const pm_model &m, const std::vector<std::string> &aux_names, int pier)
+pmmodel_info model_info(const pm_model &m, const std::vector<std::string> &aux_names, int pier,
+                        const double *err)
 {
     pmmodel_info info;
     std::memset(&info, 0, sizeof info);
     info.pier = pier;
+    if (err) {
+        info.has_err = 1;
+        for (int i = 0; i < m.n_terms; i++)
+            info.err[i] = err[i];
+    }
     for (int i = m.n_base; i < m.n_terms; i++) {
         const size_t j = (size_t)(m.term[i].aux - PM_AUX_USER);
         if (m.term[i].kind == PM_TERM_AUX && m.term[i].aux >= PM_AUX_USER &&

@@ -97,8 +97,10 @@ Run run_for_model(const Run &run, const pm_model &m, const std::vector<std::stri
                   int pier, const std::string &model_name, std::vector<std::string> *notes);
 // What a model file of m fitted on a run with auxiliary columns aux_names
 // (pier: 0, or the one side it was fitted to) says beyond the model
-// (pmmodel_info): the names of the columns its terms read.
-pmmodel_info model_info(const pm_model &m, const std::vector<std::string> &aux_names, int pier);
+// (pmmodel_info): the names of the columns its terms read, and where err is
+// given the fit's 1-sigma errors of its coefficients.
+pmmodel_info model_info(const pm_model &m, const std::vector<std::string> &aux_names, int pier,
+                        const double *err = nullptr);
 
 // The Gauss-Newton passes a fit may take: pmfit fit's, and every host
 // tool's by default (explain's candidate fits too, so that explain fits

@@ -174,6 +174,16 @@ static bool info_lines(const pm_model *m, const pmmodel_info *info, const char *
     }
     if (info->pier)
         *lines += std::string("pier ") + (info->pier > 0 ? "east" : "west") + "\n";
+    if (info->has_err) {
+        for (int i = 0; i < m->n_terms; i++)
+            if (!(std::isfinite(info->err[i]) && info->err[i] >= 0)) {
+                set_err(err, errlen, std::string(path) + ": pmmodel_save_info: the error of "
+                                         "term " + name_of(m, i) + " is not a finite number "
+                                         ">= 0");
+                return false;
+            }
+        *lines += "errors\n"; /* (the term lines' last field) */
+    }
     return true;
 }
 
@@ -206,18 +216,20 @@ extern "C" int pmmodel_save_info(const char *path, const pm_model *m, const pmmo
         out += "latitude " + fmt17(m->latitude) + "\n";
     out += extra;
     out += "terms " + std::to_string(m->n_terms) + "\n";
-    out += "# name k l m value_rad\n";
+    const bool errs = info && info->has_err;
+    out += errs ? "# name k l m value_rad error_rad\n" : "# name k l m value_rad\n";
     for (int i = 0; i < m->n_terms; i++) {
-        char buf[256];
+        char buf[320];
         const pm_term &t = m->term[i];
         if (i < m->n_base)
-            std::snprintf(buf, sizeof buf, "term %s %d %d %d %.17g\n", name_of(m, i).c_str(),
+            std::snprintf(buf, sizeof buf, "term %s %d %d %d %.17g", name_of(m, i).c_str(),
                           t.k, t.l, t.m, m->coef[i]);
         else
-            std::snprintf(buf, sizeof buf, "xterm %s %s %d %d %d %d %d %.17g %.17g\n",
+            std::snprintf(buf, sizeof buf, "xterm %s %s %d %d %d %d %d %.17g %.17g",
                           name_of(m, i).c_str(), kind_name(t.kind), t.k, t.l, t.m, t.side, t.aux,
                           t.param, m->coef[i]);
         out += buf;
+        out += errs ? " " + fmt17(info->err[i]) + "\n" : std::string("\n");
     }
     out += "end\n";
     return write_atomic(path, out, err, errlen);
@@ -283,6 +295,14 @@ std::string info_line(Loader &L, const std::vector<std::string> &tok)
     if (L.version < 4)
         return "an '" + tok[0] + "' line in a 'pm-model " + std::to_string(L.version) +
                "' file (version 4 has them)";
+    if (tok[0] == "errors") {
+        if (tok.size() != 1)
+            return "expected 'errors' alone (each term line then ends in its 1-sigma error)";
+        if (L.info.has_err)
+            return "a second 'errors' line";
+        L.info.has_err = 1;
+        return "";
+    }
     if (tok[0] == "pier") {
         if (tok.size() != 2 || (tok[1] != "east" && tok[1] != "west"))
             return "expected 'pier east' or 'pier west' (a model of one pier side)";
@@ -346,7 +366,7 @@ std::string header_line(Loader &L, const std::vector<std::string> &tok)
                 return "bad latitude '" + tok[1] + "' (expected radians, |lat| <= pi/2)";
             return "";
         }
-        if (tok[0] == "input" || tok[0] == "pier")
+        if (tok[0] == "input" || tok[0] == "pier" || tok[0] == "errors")
             return info_line(L, tok);
         if (tok.size() != 2 || tok[0] != "terms" || !parse_int(tok[1], 6, 100000, &L.nterms))
             return "expected 'terms P' with an integer P >= 6";
@@ -441,11 +461,23 @@ std::string file_line(Loader &L, const std::vector<std::string> &tok)
         L.state = Loader::DONE;
         return "";
     }
-    if (tok.size() == 10 && tok[0] == "xterm")
-        return added_term(L, tok);
-    if (tok.size() != 6 || tok[0] != "term")
-        return "expected 'term NAME k l m value', 'xterm ...' or 'end'";
-    return harmonic_term(L, tok);
+    const size_t e = L.info.has_err ? 1 : 0; /* the error field after the value */
+    std::string why;
+    if (tok.size() == 10 + e && tok[0] == "xterm")
+        why = added_term(L, tok);
+    else if (tok.size() != 6 + e || tok[0] != "term")
+        return L.info.has_err ? "expected 'term NAME k l m value error', 'xterm ... value error' "
+                                "or 'end' (the file's 'errors' line: each term ends in its error)"
+                              : "expected 'term NAME k l m value', 'xterm ...' or 'end'";
+    else
+        why = harmonic_term(L, tok);
+    if (why.empty() && e) {
+        double v;
+        if (!parse_double(tok.back(), &v) || v < 0)
+            return "bad error '" + tok.back() + "' (expected a finite number >= 0, radians)";
+        L.info.err[L.got - 1] = v;
+    }
+    return why;
 }
 
 // The harmonic terms must be the set pm_model_init makes for the order, in

@@ -61,11 +61,19 @@ int pmmodel_load(const char *path, pm_model *m, char *err, size_t errlen);
 **               (west, beyond the pole): a model fitted to that side's
 **               records only (pmfit fit --pier split), which points
 **               only there.
+**     has_err, err  the fit's 1-sigma error of each coefficient, written
+**               as a seventh field of each term line (xterm: an
+**               eleventh), so that a later run compared with the model
+**               (pmfit compare) counts the model's own uncertainty, not
+**               the new fit's alone.
 **  Zero it (memset) for "nothing more to say".
 */
 typedef struct pmmodel_info {
     char input[PM_MAX_AUX][PMMODEL_NAME_MAX];
     int pier;
+    int has_err;             /* err below holds the fit's 1-sigma errors */
+    double err[PM_MAX_TERMS]; /* of each coefficient (radians, the model's
+                               term order): a term line's last field */
 } pmmodel_info;
 
 /*
