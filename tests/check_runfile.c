@@ -929,6 +929,28 @@ START_TEST(test_pmrun_read_binary_garbage)
 }
 END_TEST
 
+/* A file with classic Mac line ends (CR only) was one line and "no
+** records"; now it is named as such at line 1.  CR LF is read (the CRs
+** dropped), and a single CR inside a CSV-like field is left to the format. */
+START_TEST(test_pmrun_read_cr_only)
+{
+    static const char text[] = "# latitude: 47\r# tau delta T D\r10 20 10.1 20.1\r"
+                               "11 21 11.1 21.1\r12 22 12.1 22.1\r";
+    static const char crlf[] = "# latitude: 47\r\n# tau delta T D\r\n10 20 10.1 20.1\r\n";
+    char tmp[64];
+    pmrun *run = NULL;
+    char err[512];
+    temp_file(tmp, sizeof tmp, text, sizeof text - 1);
+    tu_read_fails(tmp, NULL, PMRUN_ERR_FORMAT, 1, "classic Mac (CR-only) line ends");
+    unlink(tmp);
+    temp_file(tmp, sizeof tmp, crlf, sizeof crlf - 1);
+    ck_assert_msg(pmrun_read(tmp, NULL, &run, err, sizeof err) == PMRUN_OK, "%s", err);
+    ck_assert_int_eq((int)pmrun_count(run), 1);
+    pmrun_free(run);
+    unlink(tmp);
+}
+END_TEST
+
 START_TEST(test_pmrun_read_line_too_long)
 {
     char tmp[64];
@@ -1199,6 +1221,7 @@ static Suite *runfile_suite(void)
     tcase_add_test(tc, test_pmrun_read_unknown_first_line);
     tcase_add_test(tc, test_pmrun_read_nul_bytes);
     tcase_add_test(tc, test_pmrun_read_binary_garbage);
+    tcase_add_test(tc, test_pmrun_read_cr_only);
     tcase_add_test(tc, test_pmrun_read_line_too_long);
     tcase_add_test(tc, test_pmrun_read_line_at_limit);
     tcase_add_test(tc, test_pmrun_read_skip_bad_records);

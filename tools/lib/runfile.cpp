@@ -3,6 +3,7 @@
 // helpers (messages, tokens, strict numbers).
 #include "runfile_internal.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <climits>
@@ -798,6 +799,11 @@ int read_file(Context &ctx)
                          PMRUN_MAX_LINE, PMRUN_MAX_LINE);
         else if (nul)
             why = "NUL byte in the line (binary data?), expected text";
+        else if (std::count(line.begin(), line.end(), '\r') >= 2)
+            // (one line holding the whole file: it said "no records")
+            why = "carriage returns inside the line: a file with classic Mac (CR-only) line "
+                  "ends? expected lines ending in LF or CR LF (convert it: tr '\\r' '\\n' < "
+                  "FILE > NEW)";
         any_text = true;
         if (!any_line) {
             if (!why.empty() && forced == PMRUN_FORMAT_AUTO) {
