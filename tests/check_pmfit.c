@@ -483,6 +483,10 @@ START_TEST(test_pmfit_columns_by_name)
              "grep -c \"aux\\[1\\]: the run's column 'press'\" %s", m, m, h);
     ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
 
+    /* the table names the term's column (it said "aux input") */
+    snprintf(args, sizeof args, "%s --add \"aux:press:e'\"", a);
+    ck_assert_msg(run("%s fit %s%s", args, "") == 0, "%s", out);
+    ck_assert_msg(strstr(out, "e'*aux1      column 'press' on axis-2 index") != NULL, "%s", out);
     /* b: the columns swapped */
     snprintf(args, sizeof args, "%s %s --json", m, b);
     ck_assert_msg(run("%s eval %s%s", args, "") == 0, "%s", out);

@@ -701,7 +701,7 @@ Options parse_args(int argc, char **argv)
 
 
 void print_table(const char *title, const FitOut &f, const std::vector<Obs> &obs,
-                 const std::string &path)
+                 const std::string &path, const std::vector<std::string> &aux_names)
 {
     const pm_model &m = f.model;
     std::printf("\n%s\n", title);
@@ -715,7 +715,7 @@ void print_table(const char *title, const FitOut &f, const std::vector<Obs> &obs
         double v = m.coef[i] * RAD2AS, e = f.res.err[i] * RAD2AS;
         double z = e > 0 ? std::fabs(v) / e : 0;
         std::printf("  %-12s %-38s %13.2f %10.2f %6.1f%s\n", term_name(m, i).c_str(),
-                    meaning(m, i).c_str(), v, e, z, z >= 3 ? " *" : "");
+                    meaning(m, i, aux_names).c_str(), v, e, z, z >= 3 ? " *" : "");
     }
     if (std::fabs(f.corr) > 0.999)
         std::printf("\n  warning: %s and %s are nearly degenerate for this sky coverage "
@@ -1738,7 +1738,7 @@ int run_main(int argc, char **argv)
         std::printf("pmfit fit %s: %s mount, %zu observations\n", o.run.c_str(),
                     mount == PM_MOUNT_ALTAZ ? "alt-az" : "equatorial", obs.size());
         for (size_t k = 0; k < fits.size(); k++) {
-            print_table(titles[k].c_str(), fits[k], obs, o.run);
+            print_table(titles[k].c_str(), fits[k], obs, o.run, aux_names);
             std::printf("\n%s\n", error_map_text(run, maps[k]).c_str());
             if (!undetermined[k].empty())
                 std::printf("\n  warning: %s.\n", undetermined[k].c_str());

@@ -196,6 +196,17 @@ std::string meaning(const pm_model &m, int i)
            std::to_string(t.m) + ")" + side;
 }
 
+std::string meaning(const pm_model &m, int i, const std::vector<std::string> &aux_names)
+{
+    std::string s = meaning(m, i);
+    const pm_term &t = m.term[i];
+    const size_t j = (size_t)(t.aux - PM_AUX_USER);
+    if (t.kind == PM_TERM_AUX && t.aux >= PM_AUX_USER && j < aux_names.size() &&
+        s.rfind("aux input", 0) == 0)
+        s.replace(0, 9, "column '" + aux_names[j] + "'");
+    return s;
+}
+
 std::string json_escape(const std::string &s)
 {
     std::string o;
