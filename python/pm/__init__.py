@@ -219,7 +219,26 @@ def _points(model, named, pier=None, temp_c=None, time_h=None, dir=None, aux=Non
             raise ArgumentError("the model has terms on the auxiliary inputs %s: pass aux=[...] "
                                 "(one column per input, in order)" % sorted(need_aux))
         if isinstance(aux, dict):
-            aux = list(aux.values())
+            # by the names of the columns the model reads (a fit's, or a
+            # version-4 model file's Model.inputs), else by the dict's order
+            # (its first MAX_AUX): a run whose columns come in another order
+            # than the fit's is read right (by position it fed the humidity
+            # in the pressure's place)
+            names, keys = model.inputs, list(aux.keys())
+            cols = []
+            for j in range(max(need_aux) + 1):
+                if j in names:
+                    if names[j] not in aux:
+                        raise ArgumentError(
+                            "aux: the model reads the column %r as aux[%d]; the dict has no "
+                            "such column (it has %s)" % (names[j], j, ", ".join(map(repr, keys))
+                                                         or "none"))
+                    cols.append(aux[names[j]])
+                elif j < len(keys):
+                    cols.append(aux[keys[j]])
+                else:
+                    cols.append(0.0 if j not in need_aux else None)
+            aux = cols
         aux = list(aux)
         if len(aux) <= max(need_aux) or len(aux) > MAX_AUX:
             raise ArgumentError("aux: the model reads aux[%d]; give %d..%d columns" % (
@@ -575,8 +594,11 @@ class Run:
 
     def inputs(self):
         """The context inputs of the observations, as keyword arguments of
-        Model.apply/invert/residual and FitResult.pointing_sigma."""
-        aux = [self.aux[n] for n in self.aux_names[:MAX_AUX]]
+        Model.apply/invert/residual and FitResult.pointing_sigma; ``aux`` is
+        a dict {column name: values}, which a model reads by the names of
+        its inputs (Model.inputs), so a run whose columns come in another
+        order than the fit's run is read right."""
+        aux = {n: self.aux[n] for n in self.aux_names}
         return {"pier": self.pier, "temp_c": self.temp_c, "time_h": self.time_h,
                 "dir": self.dir, "aux": aux}
 

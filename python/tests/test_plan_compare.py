@@ -5,6 +5,7 @@ bad files raise the package's exceptions with the reason."""
 import json
 import os
 
+import numpy as np
 import pytest
 
 import pm
@@ -155,3 +156,12 @@ def test_model_columns_by_name(tmp_path):
         pm.compare(m, c)
     east, west = pm.fit_run(a, split=True)
     assert (east.model.pier_side, west.model.pier_side) == (1, -1)
+    # Model.residual with run.inputs(): the aux dict is read by the model's
+    # input names (by position it fed b's "press" in "hum"'s place, silently)
+    ra, rb = pm.read_run(a), pm.read_run(b)
+    res_a = m.residual(ra.enc_ha, ra.enc_dec, ra.app_ha, ra.app_dec, **ra.inputs())
+    res_b = m.residual(rb.enc_ha, rb.enc_dec, rb.app_ha, rb.app_dec, **rb.inputs())
+    assert np.array_equal(res_a, res_b)
+    rc = pm.read_run(c)
+    with pytest.raises(pm.ArgumentError, match="reads the column 'press' as aux\\[1\\]"):
+        m.residual(rc.enc_ha, rc.enc_dec, rc.app_ha, rc.app_dec, **rc.inputs())

@@ -159,7 +159,8 @@ def test_physical_terms_match_pmfit(sim_dir, tmp_path):
     inputs = r.inputs()
     a, b = m.apply(r.enc_ha, r.enc_dec, **inputs)
     ctx = [r.pier.astype(float), r.temp_c, r.time_h, r.dir.astype(float)]
-    ctx += [np.nan_to_num(c) for c in inputs["aux"]] + [np.zeros(len(r))] * (4 - len(inputs["aux"]))
+    aux = list(inputs["aux"].values())[:4]   # (a dict by column name; this model reads none)
+    ctx += [np.nan_to_num(c) for c in aux] + [np.zeros(len(r))] * (4 - len(aux))
     ra, rb = ref_apply(saved, r.enc_ha, r.enc_dec, tmp_path, ctx=ctx)
     assert_bits(a, ra, "apply ha with context")
     assert_bits(b, rb, "apply dec with context")
