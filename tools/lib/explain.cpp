@@ -739,9 +739,9 @@ void prefer_integer(const Run &run, const State &st, const char *prefix, double 
 }
 
 // How near a period the model holds a second one on the same axis is not
-// looked for: within this many cycles per revolution, or this fraction of
-// it (periodic_candidates).
-constexpr double HELD_WINDOW_CYCLES = 2.5, HELD_WINDOW_REL = 0.02;
+// looked for: within this many cycles per revolution (periodic_candidates;
+// a relative 2% beside it missed 180 + 177 and 180 + 183).
+constexpr double HELD_WINDOW_CYCLES = 2.5;
 
 void periodic_candidates(const Run &run, const State &st, const ExplainOptions &opt,
                          std::vector<Candidate> &cands)
@@ -772,17 +772,24 @@ void periodic_candidates(const Run &run, const State &st, const ExplainOptions &
                 held.push_back(t.param);
         }
         if (!held.empty()) {
-            auto near_held = [&](double g) {
+            // within `times` held windows of a held period
+            auto near_held = [&](double g, double times) {
                 for (double p : held)
-                    if (std::fabs(g - p) < std::max(HELD_WINDOW_CYCLES, HELD_WINDOW_REL * p))
+                    if (std::fabs(g - p) < times * HELD_WINDOW_CYCLES)
                         return true;
                 return false;
             };
             double best_g = 0, best_p = -1;
             for (size_t k = 0; k < pg.g.size(); k++)
-                if (!near_held(pg.g[k]) && pg.power[k] > best_p)
+                if (!near_held(pg.g[k], 1) && pg.power[k] > best_p)
                     best_p = pg.power[k], best_g = pg.g[k];
-            if (!(best_g > 0))
+            // Where the highest peak is inside a held window, the strongest
+            // periodicity left is that term's neighbour, which this run
+            // cannot tell from it; what stands elsewhere is its leakage and
+            // aliases, not a gear: a held 100 beside a true 101 named a 104
+            // of 0.75" (a noise-free run 104, 108 and five more), and other
+            // runs 514 or 688.  The axis is not searched again then.
+            if (!(best_g > 0) || near_held(pg.peak_g, 1))
                 continue;
             pg.peak_g = best_g;
             pg.peak_power = best_p;
