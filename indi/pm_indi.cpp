@@ -4,6 +4,7 @@
 */
 #include "pm_indi.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -81,8 +82,8 @@ double loo_rms(const pm_fit *fit, const pm_fit_result *fr, const pm_model *m, lo
             return HUGE_VAL;
         const double e = (r[0] * r[0] + r[1] * r[1]) / ((1 - h) * (1 - h));
         sum += e;
-        if (std::sqrt(e / 2) > *worst_loo) {
-            *worst_loo = std::sqrt(e / 2);
+        if (std::sqrt(e) > *worst_loo) { /* (the whole miss, both axes) */
+            *worst_loo = std::sqrt(e);
             *worst = i;
         }
     }
@@ -257,15 +258,23 @@ void pm_indi_describe(const pm_indi_result *r, long n, long skipped, char *buf, 
                       r->spread * 180.0 / kPi, r->order, r->n_par, r->sigma * arcsec, cv, extra,
                       r->sigma * arcsec > 1800.0 ? " (the sync points disagree by degrees: check the "
                       "site, the time and the sync targets)" : "");
-        if (r->worst >= 0 && r->order >= 0 && r->cv[r->order] > 0 &&
-                r->worst_loo > PM_INDI_WORST_RATIO * r->cv[r->order] &&
+        /* the others' leave-one-out miss (rms, both axes), without the
+        ** worst point's own: with it in, the ratio could not pass sqrt(n) */
+        double others = -1;
+        if (r->worst >= 0 && r->order >= 0 && n > 1 && r->cv[r->order] >= 0 &&
+                r->cv[r->order] < 1e6) {
+            const double all2 = 2.0 * (double)n * r->cv[r->order] * r->cv[r->order];
+            others = std::sqrt(std::max(0.0, all2 - r->worst_loo * r->worst_loo) / (double)(n - 1));
+        }
+        if (others >= 0 && r->worst_loo > PM_INDI_WORST_RATIO * others &&
                 r->worst_loo * arcsec > 10.0) {
             size_t k = std::strlen(buf);
             std::snprintf(buf + k, len - k,
                           "; the others' fit misses sync point %ld by %.1f arcsec, %.1f times "
-                          "their leave-one-out rms: a wrong sync? (it moves every GOTO; delete it "
-                          "and re-initialise)",
-                          r->worst + 1, r->worst_loo * arcsec, r->worst_loo / r->cv[r->order]);
+                          "their own leave-one-out miss (rms): a wrong sync? (it moves every GOTO; "
+                          "delete it and re-initialise)",
+                          r->worst + 1, r->worst_loo * arcsec,
+                          others > 0 ? r->worst_loo / others : HUGE_VAL);
         }
         break;
     }

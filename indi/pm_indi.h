@@ -55,12 +55,12 @@ typedef struct pm_indi_result {
                           fit misses most, by its leave-one-out residual
                           (PM_INDI_FIT), else -1; pm_indi_describe names
                           it as "sync point worst + 1" */
-    double worst_loo;  /* that residual, rms per axis (radians) */
+    double worst_loo;  /* that residual, the whole miss (both axes, radians) */
 } pm_indi_result;
 
-/* A point whose leave-one-out residual is this many times the fit's
-** leave-one-out rms (and over 10" of it) is named in the description: one
-** wrong sync spreads its error over every GOTO. */
+/* A point whose leave-one-out miss is this many times the other points'
+** (rms, both axes; and over 10") is named in the description: one wrong
+** sync spreads its error over every GOTO. */
 #define PM_INDI_WORST_RATIO 4.0
 
 /*

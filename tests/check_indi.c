@@ -341,6 +341,24 @@ START_TEST(test_pm_indi_names_the_wrong_sync)
     ck_assert_int_eq(pm_indi_fit(PM_MOUNT_EQUATORIAL, n, e1, e2, a1, a2, &fit, &m, &r), PM_OK);
     pm_indi_describe(&r, n, 0, buf, sizeof buf);
     ck_assert_msg(!strstr(buf, "wrong sync"), "got: %s", buf);
+    {   /* a few sync points, as INDI users take them: the ratio was to a
+        ** leave-one-out rms that held the bad point's own miss, and could not
+        ** pass sqrt(N) = 4 for N <= 16 (an outside probe); and the miss is
+        ** the whole of it (it printed the rms per axis, 424" of a 600" miss) */
+        double miss;
+        n = grid(k, 4, 3); /* 12 points */
+        a1[3] += 600 * ARCSEC / cos(a2[3]);
+        ck_assert_int_eq(pm_indi_fit(PM_MOUNT_EQUATORIAL, n, e1, e2, a1, a2, &fit, &m, &r), PM_OK);
+        pm_indi_describe(&r, n, 0, buf, sizeof buf);
+        printf("one wrong sync of 12: %s\n", buf);
+        ck_assert_msg(strstr(buf, "misses sync point 4 by"), "got: %s", buf);
+        {
+            const char *at = strstr(buf, "misses sync point 4 by ");
+            ck_assert_ptr_nonnull(at);
+            ck_assert_int_eq(sscanf(at + strlen("misses sync point 4 by "), "%lf", &miss), 1);
+        }
+        ck_assert_msg(miss > 450 && miss < 900, "miss %g\"", miss);
+    }
 }
 END_TEST
 

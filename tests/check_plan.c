@@ -589,6 +589,21 @@ START_TEST(test_plan_sides)
     sides_follow(sim, -1, 40);
     if (tu_real_run("celestial/gem-28.dat", path, sizeof path))
         sides_follow(path, 1, 40);
+    {   /* a fork's run planned without --fork: normal-side points on both
+        ** sides of the meridian; every target was put beyond the pole */
+        char cmd[1024];
+        int k, n2;
+        snprintf(cmd, sizeof cmd, "%s simulate %s/fork.dat --fork --seed 5 >/dev/null 2>&1",
+                 tu_pmfit_path(), tmpdir_once());
+        ck_assert_int_eq(system(cmd), 0);
+        snprintf(cmd, sizeof cmd, "%s/fork.dat --next 12 --json", tmpdir_once());
+        ck_assert_msg(plan_cli(cmd) == 0, "%s", out);
+        ck_assert_msg(strstr(out, "a mount that does not flip, planned as one (--fork)"), "%s", out);
+        n2 = parse_targets(out, t, 120);
+        ck_assert_int_eq(n2, 12);
+        for (k = 0; k < n2; k++)
+            ck_assert_int_eq(t[k].side, 1);
+    }
     if (tu_real_run("celestial/cgx-l-data.dat", path, sizeof path))
         sides_follow(path, 1, 40);
 }

@@ -433,7 +433,10 @@ static void write_aux_run(const char *base, const char *path, int order)
         line[strcspn(line, "\n")] = 0;
         if (line[0] == '#') {
             fprintf(f, "%s%s\n", line,
-                    strncmp(line, "# tau", 5) ? "" : order == 0 ? " hum press" : order == 1 ? " press hum" : " hum");
+                    strncmp(line, "# tau", 5) ? ""
+                    : order == 0 ? " hum press"
+                    : order == 1 ? " press hum"
+                    : order == 2 ? " hum" : " w1 w2 w3 w4 hum press");
             continue;
         }
         ck_assert_int_eq(sscanf(line, "%lf %lf%n", &eh, &ed, &used), 2);
@@ -447,8 +450,10 @@ static void write_aux_run(const char *base, const char *path, int order)
             fprintf(f, "%.6f %.6f\n", hum, press);
         else if (order == 1)
             fprintf(f, "%.6f %.6f\n", press, hum);
-        else
+        else if (order == 2)
             fprintf(f, "%.6f\n", hum);
+        else
+            fprintf(f, "1 2 3 4 %.6f %.6f\n", hum, press);
     }
     fclose(in);
     fclose(f);
@@ -491,11 +496,27 @@ START_TEST(test_pmfit_columns_by_name)
     snprintf(args, sizeof args, "%s %s --json", m, b);
     ck_assert_msg(run("%s eval %s%s", args, "") == 0, "%s", out);
     ck_assert_double_eq_tol(tu_json_num(out, "rms_arcsec"), rms_fit, 1e-6);
+    /* a built-in input asked for as a column: said so (it said the run had
+    ** no column 'temp', which it has) */
+    snprintf(args, sizeof args, "%s --add aux:temp", a);
+    ck_assert_int_ne(run("%s fit %s%s", args, ""), 0);
+    ck_assert_msg(strstr(out, "'temp' is a built-in input, not an auxiliary column: --add "
+                              "temperature reads it") != NULL, "%s", out);
+    /* six columns, "press" the sixth (beyond the contexts' four: it was
+    ** "put it among them") */
+    {
+        char d6[300];
+        snprintf(d6, sizeof d6, "%s/d6.dat", tmpdir);
+        write_aux_run(base, d6, 3);
+        snprintf(args, sizeof args, "%s %s --json", m, d6);
+        ck_assert_msg(run("%s eval %s%s", args, "") == 0, "%s", out);
+        ck_assert_double_eq_tol(tu_json_num(out, "rms_arcsec"), rms_fit, 1e-6);
+    }
     /* c: no "press" */
     snprintf(args, sizeof args, "%s %s", m, c);
     ck_assert_int_eq(run("%s eval %s%s", args, ""), 1);
     ck_assert_msg(strstr(out, "reads the column 'press', which") != NULL &&
-                      strstr(out, "hum, dec_dir") != NULL, "%s", out);
+                      strstr(out, "hum, dec_dir (derived from the sequence)") != NULL, "%s", out);
     /* a version-3 file: by position, said */
     {   /* the same model written without its information */
         pm_model mm;

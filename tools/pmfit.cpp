@@ -935,7 +935,7 @@ int cmd_eval(const Options &o, const Run &run_in)
             if (f.model.term[i].kind == PM_TERM_AUX)
                 inputs += (inputs.empty() ? "" : ", ") + term_name(f.model, i);
         die(o.run + ":" + std::to_string(obs[(size_t)all[bad]].line) + ": " + o.model +
-                " cannot be evaluated here (status " + std::to_string((int)rst) + (inputs.empty()
+                " cannot be evaluated here (" + pm_status_text(rst) + (inputs.empty()
                     ? std::string(")")
                     : "): its terms " + inputs + " read an input (temperature, time, slew "
                       "direction or a column) this record does not give") +

@@ -47,8 +47,13 @@ Run run_from_pmrun(const pmrun *run, const std::string &path)
             ob.ctx.aux[j] = p->aux[j];
         r.obs.push_back(ob);
     }
-    for (int j = 0; j < pmrun_n_aux(run); j++)
+    for (int j = 0; j < pmrun_n_aux(run); j++) {
         r.aux_names.push_back(pmrun_aux_name(run, j));
+        std::vector<double> col;
+        for (size_t i = 0; i < pmrun_count(run) && j < PMRUN_MAX_AUX; i++)
+            col.push_back(pmrun_get(run, i)->aux[j]);
+        r.aux_values.push_back(col);
+    }
     derive_directions(r);
     return r;
 }
@@ -136,6 +141,12 @@ void derive_directions(Run &r)
         r.obs[0].ctx.aux[j] = 0;
         for (size_t i = 1; i < r.obs.size(); i++)
             r.obs[i].ctx.aux[j] = move_sign(r.obs[i - 1].ed, r.obs[i].ed, cut2, true);
+        if (r.aux_values.size() == (size_t)j) {
+            std::vector<double> col;
+            for (const Obs &ob : r.obs)
+                col.push_back(ob.ctx.aux[j]);
+            r.aux_values.push_back(col);
+        }
     }
 }
 
@@ -582,8 +593,18 @@ static void add_aux(ModelBuilder &b, const AddSpec &a, pm_term t, const std::vec
         for (size_t q = 0; q < aux_names.size(); q++)
             if (aux_names[q] == a.f[1])
                 j = (int)q;
-        if (j < 0)
+        if (j < 0) {
+            static const char *const builtin[][2] = {{"temp", "temperature"},
+                                                     {"time", "time_drift"},
+                                                     {"dir", "hysteresis"},
+                                                     {"pier", "TERM@E or TERM@W"}};
+            for (const auto &bi : builtin)
+                if (a.f[1] == bi[0])
+                    throw std::runtime_error("--add " + a.spec + ": '" + a.f[1] +
+                                             "' is a built-in input, not an auxiliary column: "
+                                             "--add " + bi[1] + " reads it");
             throw std::runtime_error("--add " + a.spec + ": the run has no column '" + a.f[1] + "'");
+        }
         if (j >= PM_MAX_AUX)
             throw std::runtime_error("--add " + a.spec + ": column '" + a.f[1] + "' is beyond the first " +
                 std::to_string(PM_MAX_AUX) + " auxiliary columns the core takes");
@@ -666,7 +687,8 @@ Run run_for_model(const Run &run, const pm_model &m, const std::vector<std::stri
     auto columns = [&run]() {
         std::string c;
         for (const std::string &n : run.aux_names)
-            c += (c.empty() ? "" : ", ") + n;
+            c += (c.empty() ? "" : ", ") + n +
+                 (n == "dec_dir" && run.dec_dir_derived ? " (derived from the sequence)" : "");
         return c.empty() ? std::string("none") : c;
     };
     for (size_t j = 0; j < (size_t)PM_MAX_AUX; j++) {
@@ -680,7 +702,7 @@ Run run_for_model(const Run &run, const pm_model &m, const std::vector<std::stri
                                  (readers[j].find(',') != std::string::npos ? "s " : " ") +
                                  readers[j] +
                                  (readers[j].find(',') != std::string::npos ? " read" : " reads") +
-                                 " (a model file of before version 4): " +
+                                 " (a version-3 file, or its 'input' line left out): " +
                                  run.path + "'s auxiliary column " + std::to_string(j + 1) +
                                  ", '" + run.aux_names[j] + "', is taken for it");
         } else if (used[j]) {
@@ -696,20 +718,25 @@ Run run_for_model(const Run &run, const pm_model &m, const std::vector<std::stri
                                          " the column '" + name + "', which " +
                                          run.path + " does not have (its auxiliary columns: " +
                                          columns() + ")");
-            if (from >= PM_MAX_AUX)
+            // a column beyond the contexts' first PM_MAX_AUX: from the run's
+            // columns as read (it was an error: "put it among them")
+            if (from >= PM_MAX_AUX && !((size_t)from < run.aux_values.size() &&
+                                        run.aux_values[(size_t)from].size() == run.obs.size()))
                 throw std::runtime_error(model_name + ": " + run.path + "'s column '" + name +
-                                         "' is its auxiliary column " + std::to_string(from + 1) +
-                                         "; the core reads the first " +
-                                         std::to_string(PM_MAX_AUX) +
-                                         " (PM_MAX_AUX): put it among them");
+                                         "' is beyond the first " + std::to_string(PM_MAX_AUX) +
+                                         " auxiliary columns, and this run's values of it are "
+                                         "not at hand");
         }
         if (from >= 0 && (size_t)from < run.aux_names.size())
             r.aux_names[j] = run.aux_names[(size_t)from];
         for (size_t i = 0; i < r.obs.size(); i++)
-            r.obs[i].ctx.aux[j] = from >= 0 ? run.obs[i].ctx.aux[from] : NAN;
+            r.obs[i].ctx.aux[j] = from < 0 ? NAN
+                                  : from < PM_MAX_AUX ? run.obs[i].ctx.aux[from]
+                                                      : run.aux_values[(size_t)from][i];
     }
     while (!r.aux_names.empty() && r.aux_names.back().empty())
         r.aux_names.pop_back();
+    r.aux_values.clear(); /* (the run's own layout, not this one's) */
     if (pier) {
         const char *side = pier > 0 ? "east (normal)" : "west (beyond the pole)";
         std::vector<Obs> keep;

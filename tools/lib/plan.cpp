@@ -551,6 +551,7 @@ Plan plan_targets(const Run &taken, const PlanOptions &opt)
     PlanOptions o = opt;
     Plan plan;
     pm_model m = planning_model(taken, o, plan.note);
+    const bool fit_note = !plan.note.empty(); /* the run's fit said why already */
     pm_context ctx = mean_context(taken);
     std::vector<SkyPlace> done;
     for (const Obs &ob : taken.obs) {
@@ -566,6 +567,28 @@ Plan plan_targets(const Run &taken, const PlanOptions &opt)
         p.d.ctx = ob.ctx;
         p.d.ctx.pier = p.side;
         done.push_back(p);
+    }
+    // A run all on the normal side with points on both sides of the
+    // meridian, beyond where a German mount must flip, is of a mount that
+    // does not flip (a fork, or a German mount run without --fork): planned
+    // as one, said (every target was put beyond the pole on the side the
+    // run never used, the predicted error 20 times the fork's).
+    if (o.mount != PM_MOUNT_ALTAZ && o.gem) {
+        long east = 0, west = 0, flipped = 0;
+        for (const SkyPlace &p : done) {
+            flipped += p.side < 0;
+            if (p.side > 0 && std::fabs(p.x) > o.meridian_limit_deg)
+                (p.x > 0 ? west : east)++;
+        }
+        const long far = east + west;
+        if (flipped == 0 && east >= 3 && west >= 3 && 10 * std::min(east, west) >= far) {
+            o.gem = false;
+            plan.note += std::string(plan.note.empty() ? "" : "; ") + "the run's " +
+                         std::to_string(done.size()) + " points are all on the normal side, " +
+                         std::to_string(east) + " east and " + std::to_string(west) +
+                         " west of the meridian beyond " + fmt("%g", o.meridian_limit_deg) +
+                         " deg: a mount that does not flip, planned as one (--fork)";
+        }
     }
     if (o.mount != PM_MOUNT_ALTAZ && o.gem)
         o.normal_west = run_normal_west(done, o.meridian_limit_deg, o.normal_west);
@@ -595,10 +618,11 @@ Plan plan_targets(const Run &taken, const PlanOptions &opt)
     double f0 = design_criterion(m, dt, ds);
     plan.before_arcsec =
         determines(m, dt, ds) ? o.noise_arcsec * std::sqrt(std::max(0.0, f0)) : NAN;
-    if (!std::isfinite(plan.before_arcsec) && !dt.empty() && plan.note.empty())
+    if (!std::isfinite(plan.before_arcsec) && !dt.empty() && !fit_note)
         // (the points fit, but some combination of the terms is fixed by no
         // point: the error over the sky is unbounded, not "too few points")
-        plan.note = "the run's " + std::to_string(dt.size()) + " points fit the " +
+        plan.note += std::string(plan.note.empty() ? "" : "; ") + "the run's " +
+                     std::to_string(dt.size()) + " points fit the " +
                     std::to_string(m.n_terms) + "-term model but do not determine it over the " +
                     "sky (a combination of its terms that no point fixes)";
     std::vector<double> crit, secs;
