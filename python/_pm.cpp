@@ -1149,14 +1149,10 @@ std::string compare_run(const Model *old_model, const std::shared_ptr<RunData> &
     OldSide os;
     try {
         if (old_model) {
-            os.model = old_model->m;
-            if (pm_model_prepare(&os.model) != PM_OK)
+            pm_model m = old_model->m;
+            if (pm_model_prepare(&m) != PM_OK)
                 fail(K_ARGUMENT, "old: the model cannot be prepared (non-finite coefficients?)");
-            for (int j = 0; j < PM_MAX_AUX; j++)
-                os.inputs.push_back(old_model->info.input[j]);
-            os.pier = old_model->info.pier;
-            if (old_model->info.has_err)
-                os.err.assign(old_model->info.err, old_model->info.err + os.model.n_terms);
+            os = old_from_model(m, old_model->info);
         } else if (old_run) {
             os = old_from_run(old_run->run, order, adds, passes);
         } else {

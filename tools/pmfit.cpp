@@ -899,12 +899,10 @@ int cmd_eval(const Options &o, const Run &run_in)
                 o.run + " a run of an " + (mount == PM_MOUNT_ALTAZ ? "alt-az" : "equatorial") +
                 " one", 1);
     // the run as the model reads it: its columns by name, its pier side
-    std::vector<std::string> columns, notes;
-    for (int j = 0; j < PM_MAX_AUX; j++)
-        columns.push_back(info.input[j]);
+    std::vector<std::string> notes;
     Run run;
     try {
-        run = run_for_model(run_in, f.model, columns, info.pier, o.model, &notes);
+        run = run_for_model(run_in, f.model, model_inputs(info), info.pier, o.model, &notes);
     } catch (const std::exception &x) {
         die(x.what(), 1);
     }

@@ -329,6 +329,17 @@ OldSide old_from_run(const Run &run, int order, const std::vector<std::string> &
     return o;
 }
 
+OldSide old_from_model(const pm_model &m, const pmmodel_info &info)
+{
+    OldSide o;
+    o.model = m;
+    o.inputs = model_inputs(info);
+    o.pier = info.pier;
+    if (info.has_err) /* the fit's errors the file keeps count as a run's do */
+        o.err.assign(info.err, info.err + m.n_terms);
+    return o;
+}
+
 OldSide load_old(const std::string &path, int order, const std::vector<std::string> &adds,
                  bool refraction, bool skip_bad, int format, int equinox, int max_passes)
 {
@@ -341,12 +352,7 @@ OldSide load_old(const std::string &path, int order, const std::vector<std::stri
         pmmodel_info info;
         if (pmmodel_load_info(path.c_str(), &o.model, &info, err, sizeof err) != 0)
             throw std::runtime_error(err);
-        for (int j = 0; j < PM_MAX_AUX; j++)
-            o.inputs.push_back(info.input[j]);
-        o.pier = info.pier;
-        if (info.has_err) /* the fit's errors the file keeps count as a run's do */
-            o.err.assign(info.err, info.err + o.model.n_terms);
-        return o;
+        return old_from_model(o.model, info);
     }
     return old_from_run(load_run(path, refraction, skip_bad, format, equinox), order, adds,
                         max_passes);

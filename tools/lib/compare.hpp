@@ -64,6 +64,9 @@ struct OldSide {
 OldSide load_old(const std::string &path, int order, const std::vector<std::string> &adds,
                  bool refraction, bool skip_bad, int format, int equinox, int max_passes);
 
+// OLD as a model (prepared) and what its file says: its inputs' names, its
+// pier side, its coefficients' errors where it keeps them.
+OldSide old_from_model(const pm_model &m, const pmmodel_info &info);
 // OLD as a run already read: fitted at order + adds (do_fit with max_passes).
 OldSide old_from_run(const Run &run, int order, const std::vector<std::string> &adds,
                      int max_passes);

@@ -693,15 +693,16 @@ Run run_for_model(const Run &run, const pm_model &m, const std::vector<std::stri
     };
     for (size_t j = 0; j < (size_t)PM_MAX_AUX; j++) {
         const std::string name = j < inputs.size() ? inputs[j] : std::string();
+        // "its term X reads" / "its terms X, Y read"
+        const bool several = readers[j].find(',') != std::string::npos;
+        const std::string terms_read = std::string(several ? "terms " : "term ") + readers[j] +
+                                       (several ? " read" : " reads");
         long from = -1;
         if (used[j] && name.empty()) {
             /* a model file that does not name its inputs: by position, said */
             from = (long)j;
             if (j < run.aux_names.size() && notes)
-                notes->push_back(model_name + " does not name the column its term" +
-                                 (readers[j].find(',') != std::string::npos ? "s " : " ") +
-                                 readers[j] +
-                                 (readers[j].find(',') != std::string::npos ? " read" : " reads") +
+                notes->push_back(model_name + " does not name the column its " + terms_read +
                                  " (a version-3 file, or its 'input' line left out): " +
                                  run.path + "'s auxiliary column " + std::to_string(j + 1) +
                                  ", '" + run.aux_names[j] + "', is taken for it");
@@ -710,11 +711,7 @@ Run run_for_model(const Run &run, const pm_model &m, const std::vector<std::stri
                 if (run.aux_names[q] == name)
                     from = (long)q;
             if (from < 0)
-                throw std::runtime_error(model_name + ": its term" +
-                                         (readers[j].find(',') != std::string::npos ? "s " : " ") +
-                                         readers[j] +
-                                         (readers[j].find(',') != std::string::npos ? " read"
-                                                                                    : " reads") +
+                throw std::runtime_error(model_name + ": its " + terms_read +
                                          " the column '" + name + "', which " +
                                          run.path + " does not have (its auxiliary columns: " +
                                          columns() + ")");
@@ -776,6 +773,14 @@ pmmodel_info model_info(const pm_model &m, const std::vector<std::string> &aux_n
             std::memcpy(info.input[j], aux_names[j].c_str(), aux_names[j].size() + 1);
     }
     return info;
+}
+
+std::vector<std::string> model_inputs(const pmmodel_info &info)
+{
+    std::vector<std::string> in;
+    for (int j = 0; j < PM_MAX_AUX; j++)
+        in.push_back(info.input[j]);
+    return in;
 }
 
 std::string fit_failure_detail(const FitOut &f, int passes, const std::string &order)

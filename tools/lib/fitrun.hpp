@@ -109,6 +109,9 @@ Run run_for_model(const Run &run, const pm_model &m, const std::vector<std::stri
 // given the fit's 1-sigma errors of its coefficients.
 pmmodel_info model_info(const pm_model &m, const std::vector<std::string> &aux_names, int pier,
                         const double *err = nullptr);
+// The other way: a model file's input names, one per pm_context.aux[j]
+// ("" where it names none), as run_for_model takes them.
+std::vector<std::string> model_inputs(const pmmodel_info &info);
 
 // The Gauss-Newton passes a fit may take: pmfit fit's, and every host
 // tool's by default (explain's candidate fits too, so that explain fits
