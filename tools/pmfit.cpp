@@ -715,7 +715,7 @@ void print_table(const char *title, const FitOut &f, const std::vector<Obs> &obs
         double v = m.coef[i] * RAD2AS, e = f.res.err[i] * RAD2AS;
         double z = e > 0 ? std::fabs(v) / e : 0;
         std::printf("  %-12s %-38s %13.2f %10.2f %6.1f%s\n", term_name(m, i).c_str(),
-                    meaning(m, i, aux_names).c_str(), v, e, z, z >= 3 ? " *" : "");
+                    meaning(m, i, &aux_names).c_str(), v, e, z, z >= 3 ? " *" : "");
     }
     if (std::fabs(f.corr) > 0.999)
         std::printf("\n  warning: %s and %s are nearly degenerate for this sky coverage "

@@ -167,7 +167,7 @@ int term_index(const pm_model &m, const std::string &name, int n)
 }
 
 // Physical meaning of a term, for the table.
-std::string meaning(const pm_model &m, int i)
+std::string meaning(const pm_model &m, int i, const std::vector<std::string> *aux_names)
 {
     const pm_term &t = m.term[i];
     bool altaz = m.mount == PM_MOUNT_ALTAZ;
@@ -195,27 +195,21 @@ std::string meaning(const pm_model &m, int i)
     case PM_TERM_ZENITH:
         return std::string(t.l == 0 ? "refraction-like cot(el)" : "tube flexure cos(el)") + side;
     case PM_TERM_AUX: {
-        const char *in = t.aux == PM_AUX_TEMP ? "temperature"
-                         : t.aux == PM_AUX_TIME ? "time drift"
-                         : t.aux == PM_AUX_DIR ? "hysteresis (slew dir)" : "aux input";
-        return std::string(in) + " on " + base[t.k] + " [per unit]" + side;
+        const size_t j = (size_t)(t.aux - PM_AUX_USER);
+        const std::string in =
+            t.aux == PM_AUX_TEMP ? "temperature"
+            : t.aux == PM_AUX_TIME ? "time drift"
+            : t.aux == PM_AUX_DIR ? "hysteresis (slew dir)"
+            : aux_names && t.aux >= PM_AUX_USER && j < aux_names->size()
+                ? "column '" + (*aux_names)[j] + "'"
+                : "aux input";
+        return in + " on " + base[t.k] + " [per unit]" + side;
     }
     }
     if (t.l == 0)
         return std::string(base[t.k]) + side;
     return std::string(base[t.k]) + " varying as Y(" + std::to_string(t.l) + "," +
            std::to_string(t.m) + ")" + side;
-}
-
-std::string meaning(const pm_model &m, int i, const std::vector<std::string> &aux_names)
-{
-    std::string s = meaning(m, i);
-    const pm_term &t = m.term[i];
-    const size_t j = (size_t)(t.aux - PM_AUX_USER);
-    if (t.kind == PM_TERM_AUX && t.aux >= PM_AUX_USER && j < aux_names.size() &&
-        s.rfind("aux input", 0) == 0)
-        s.replace(0, 9, "column '" + aux_names[j] + "'");
-    return s;
 }
 
 std::string json_escape(const std::string &s)

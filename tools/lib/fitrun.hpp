@@ -77,10 +77,11 @@ std::string term_name(const pm_model &m, int i);
 // The index of the term named `name` (term_name) among the first n terms
 // of m (all of them where n < 0), -1 if none.
 int term_index(const pm_model &m, const std::string &name, int n = -1);
-std::string meaning(const pm_model &m, int i);
-// The same, a term on a user input named by its column (aux_names[j] for
-// pm_context.aux[j]: "column 'press' on Dec index"), not "aux input".
-std::string meaning(const pm_model &m, int i, const std::vector<std::string> &aux_names);
+// With aux_names (the run's columns, aux_names[j] for pm_context.aux[j]) a
+// term on a user input is named by its column ("column 'press' on ..."),
+// else "aux input".
+std::string meaning(const pm_model &m, int i,
+                    const std::vector<std::string> *aux_names = nullptr);
 std::string json_escape(const std::string &s);
 
 // The harmonic set of `order` plus the effects `adds` (pmfit fit --add

@@ -277,7 +277,7 @@ void section_fit(Page &p, const Data &d)
     for (int i = 0; i < m.n_terms; i++) {
         double v = m.coef[i] * RAD2AS, e = f.res.err[i] * RAD2AS, z = e > 0 ? std::fabs(v) / e : 0;
         std::string sig = num(z, 1) + (z >= 3 ? " *" : "");
-        rows.push_back({"<code>" + h(term_name(m, i)) + "</code>", h(meaning(m, i, d.run.aux_names)), num(v, 2), num(e, 2),
+        rows.push_back({"<code>" + h(term_name(m, i)) + "</code>", h(meaning(m, i, &d.run.aux_names)), num(v, 2), num(e, 2),
                         z >= 3 ? "<b>" + sig + "</b>" : sig});
     }
     table(p, "The fitted terms. * = significant at 3&sigma; (|value| / 1&sigma; &ge; 3).",
