@@ -251,6 +251,58 @@ START_TEST(test_inject_misuse)
 }
 END_TEST
 
+/* flip_gem with an auxiliary column 'hum' (deterministic values 10..70) */
+static void with_column(const char *src, const char *dst)
+{
+    FILE *in = fopen(src, "r"), *o = fopen(dst, "w");
+    char line[1024];
+    int i = 0;
+    ck_assert_ptr_nonnull(in);
+    ck_assert_ptr_nonnull(o);
+    while (fgets(line, sizeof line, in)) {
+        size_t n = strcspn(line, "\r\n");
+        line[n] = 0;
+        if (!strncmp(line, "# tau", 5))
+            fprintf(o, "%s hum\n", line);
+        else if (line[0] == '#' || !line[0])
+            fprintf(o, "%s\n", line);
+        else
+            fprintf(o, "%s %.3f\n", line, 40 + 30 * sin(1.7 * i++));
+    }
+    fclose(in);
+    ck_assert_int_eq(fclose(o), 0);
+}
+
+/* An effect on the run's own column (aux:NAME) is injected as pmfit fit
+** --add aux:NAME reads it (the simulator's truth knows no column names: it
+** said the run has no column 'hum'), and fit's JSON names the column of
+** the terms it calls c'*aux0 and e'*aux0. */
+START_TEST(test_inject_own_column)
+{
+    char src[512], col[512], dst[512], cmd[2048];
+    const char *p;
+    int found = 0;
+    setup();
+    flip_path(src, sizeof src);
+    snprintf(col, sizeof col, "%s/hum.dat", tmpdir);
+    snprintf(dst, sizeof dst, "%s/hum_in.dat", tmpdir);
+    with_column(src, col);
+    ck_assert_msg(inject(col, "aux:hum=0.25", NULL, dst) == 0, "%s", out);
+    ck_assert(max_moved(col, dst) > 5);
+    snprintf(cmd, sizeof cmd, "%s fit --add aux:hum --json '%s'", tu_pmfit_path(), dst);
+    ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
+    for (p = out; (p = strstr(p, "\"column\": \"hum\", \"value_arcsec\": ")) != NULL; p++) {
+        double v = atof(p + strlen("\"column\": \"hum\", \"value_arcsec\": "));
+        ck_assert_msg(fabs(v - 0.25) < 0.01, "%s", out);
+        found++;
+    }
+    ck_assert_msg(found == 2, "%s", out);
+    /* a column the run lacks is named */
+    ck_assert(inject(src, "aux:hum=0.25", NULL, dst) != 0);
+    ck_assert_msg(strstr(out, "no column 'hum'") != NULL, "%s", out);
+}
+END_TEST
+
 static double sag_reading(const char *path)
 {
     pmx_result r;
@@ -311,6 +363,7 @@ static Suite *suite(void)
     tcase_add_test(t, test_inject_and_back);
     tcase_add_test(t, test_inject_found);
     tcase_add_test(t, test_inject_misuse);
+    tcase_add_test(t, test_inject_own_column);
     tcase_add_test(t, test_inject_sag_read_back);
     suite_add_tcase(s, t);
     return s;

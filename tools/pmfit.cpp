@@ -738,17 +738,26 @@ void print_table(const char *title, const FitOut &f, const std::vector<Obs> &obs
     }
 }
 
-void print_json_fit(const FitOut &f, const std::string &extra)
+// (aux_names: the run's auxiliary columns; a term on one of them gets
+// "column": its name, which the term's name, c'*aux0, does not say)
+void print_json_fit(const FitOut &f, const std::string &extra,
+                    const std::vector<std::string> &aux_names)
 {
     const pm_model &m = f.model;
     std::printf("{\"n_obs\": %ld, \"n_params\": %d, \"order\": %d, \"sigma_arcsec\": %.6f, "
                 "\"rms_arcsec\": %.6f, \"iterations\": %d, \"terms\": [",
                 f.res.n_obs, f.res.n_par, m.order, f.res.sigma * RAD2AS, f.rms * RAD2AS,
                 f.res.iterations);
-    for (int i = 0; i < m.n_terms; i++)
-        std::printf("%s{\"name\": \"%s\", \"value_arcsec\": %.6f, \"error_arcsec\": %.6f}",
-                    i ? ", " : "", json_escape(term_name(m, i)).c_str(), m.coef[i] * RAD2AS,
-                    f.res.err[i] * RAD2AS);
+    for (int i = 0; i < m.n_terms; i++) {
+        const pm_term &t = m.term[i];
+        std::string col;
+        if (t.kind == PM_TERM_AUX && t.aux >= PM_AUX_USER &&
+            (size_t)(t.aux - PM_AUX_USER) < aux_names.size())
+            col = ", \"column\": \"" + json_escape(aux_names[t.aux - PM_AUX_USER]) + "\"";
+        std::printf("%s{\"name\": \"%s\"%s, \"value_arcsec\": %.6f, \"error_arcsec\": %.6f}",
+                    i ? ", " : "", json_escape(term_name(m, i)).c_str(), col.c_str(),
+                    m.coef[i] * RAD2AS, f.res.err[i] * RAD2AS);
+    }
     std::printf("]");
     if (f.corr_i >= 0)
         std::printf(", \"max_correlation\": {\"terms\": [\"%s\", \"%s\"], \"value\": %.6f}",
@@ -1717,7 +1726,7 @@ int run_main(int argc, char **argv)
         if (fits.size() == 1) {
             std::string r = rj(0), em = error_map_json(maps[0], fits[0].res.sigma * RAD2AS);
             r = r.empty() ? em : r + ", " + em;
-            print_json_fit(fits[0], fjson + (fjson.empty() ? "" : ", ") + r);
+            print_json_fit(fits[0], fjson + (fjson.empty() ? "" : ", ") + r, aux_names);
         } else {
             std::printf("{\"pier\": \"split\", %s%s\"sides\": {\"east\": ", fjson.c_str(),
                         fjson.empty() ? "" : ", ");
@@ -1726,9 +1735,9 @@ int run_main(int argc, char **argv)
                 return (r.empty() ? "" : r + ", ") +
                        error_map_json(maps[k], fits[k].res.sigma * RAD2AS);
             };
-            print_json_fit(fits[0], with_map(0));
+            print_json_fit(fits[0], with_map(0), aux_names);
             std::printf(", \"west\": ");
-            print_json_fit(fits[1], with_map(1));
+            print_json_fit(fits[1], with_map(1), aux_names);
             std::printf("}}");
         }
         std::printf("\n");

@@ -90,6 +90,7 @@ struct Finding {
     // (as pmfit fit --json lists its terms); none for outliers, higher_order
     struct Coefficient {
         std::string name;
+        std::string column; // the run's column of a term on one (name says aux0), else empty
         double value_arcsec = 0, error_arcsec = 0;
     };
     std::vector<Coefficient> coefficients;

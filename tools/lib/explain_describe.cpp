@@ -171,13 +171,17 @@ std::string values_of(const Run &run, const pm_model &m, const pm_fit_result &re
 
 // The terms newi of a finding's fit, as the finding's coefficients (the
 // values its text gives, to JSON's precision).
-void set_coefficients(const pm_model &m, const pm_fit_result &res, const std::vector<int> &newi,
-                      Finding &fd)
+void set_coefficients(const Run &run, const pm_model &m, const pm_fit_result &res,
+                      const std::vector<int> &newi, Finding &fd)
 {
     fd.coefficients.clear();
     for (int i : newi) {
         Finding::Coefficient c;
         c.name = term_name(m, i);
+        const pm_term &t = m.term[i];
+        if (t.kind == PM_TERM_AUX && t.aux >= PM_AUX_USER &&
+            (size_t)(t.aux - PM_AUX_USER) < run.aux_names.size())
+            c.column = run.aux_names[(size_t)(t.aux - PM_AUX_USER)];
         c.value_arcsec = arcsec(m.coef[i]);
         c.error_arcsec = arcsec(res.err[i]);
         fd.coefficients.push_back(c);
@@ -201,7 +205,7 @@ void describe_periodic(const Run &run, const Candidate &c, const std::vector<int
     double ec = res.err[newi[0]], es = res.err[newi[1]];
     double A = std::hypot(cc, ss);
     int axis = effect == "ha_periodic" ? 1 : 2;
-    set_coefficients(m, res, newi, fd);
+    set_coefficients(run, m, res, newi, fd);
     fd.cycles_per_rev = G;
     fd.amplitude_arcsec = arcsec(A);
     fd.amplitude_err_arcsec = arcsec(A > 0 ? std::hypot(cc * ec, ss * es) / A : std::hypot(ec, es));
@@ -307,7 +311,7 @@ void describe_pier(const Run &run, const State &st, const Candidate &c,
         if (run.obs[i].pier < 0)
             west.push_back(i);
     fd.amplitude_arcsec = arcsec(rms_of(model_difference(run, west, z, m)));
-    set_coefficients(m, c.fit.f.res, newi, fd);
+    set_coefficients(run, m, c.fit.f.res, newi, fd);
     char buf[700];
     std::snprintf(buf, sizeof buf,
                   "the pointing differs across the meridian flip (pier side) by %.2f\" RMS on the "
@@ -364,7 +368,7 @@ void describe_family(const Run &run, const Candidate &c, const std::vector<int> 
     for (int i : newi)
         if (std::fabs(m.coef[i]) > std::fabs(m.coef[big]))
             big = i;
-    set_coefficients(m, c.fit.f.res, newi, fd);
+    set_coefficients(run, m, c.fit.f.res, newi, fd);
     fd.amplitude_arcsec = big >= 0 ? arcsec(std::fabs(m.coef[big])) : 0;
     fd.amplitude_err_arcsec = big >= 0 ? arcsec(c.fit.f.res.err[big]) : 0;
     char buf[700];

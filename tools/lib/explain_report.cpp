@@ -56,6 +56,8 @@ std::string finding_json(const Finding &f)
     j += "], \"coefficients\": [";
     for (size_t k = 0; k < f.coefficients.size(); k++)
         j += std::string(k ? ", " : "") + "{\"name\": " + str(f.coefficients[k].name) +
+             (f.coefficients[k].column.empty() ? std::string()
+                                               : ", \"column\": " + str(f.coefficients[k].column)) +
              ", \"value_arcsec\": " + num(f.coefficients[k].value_arcsec) +
              ", \"error_arcsec\": " + num(f.coefficients[k].error_arcsec) + "}";
     j += "]";

@@ -96,6 +96,26 @@ std::vector<int> move_outliers(std::vector<Obs> &obs, int n, double arcsec, unsi
     return moved;
 }
 
+// aux:NAME[:BASES]: the run's own column NAME times the base vectors, arcsec
+// per unit of it, about the column's mean (as pmfit fit --add aux:NAME fits
+// it).  pmsim_add_effect cannot: its truth knows no column names.
+void add_column_effect(pm_model &truth, const std::string &effect, double arcsec, const Run &run,
+                       const std::vector<Obs> &obs)
+{
+    pm_model with;
+    try {
+        with = build_model(truth.order, {effect}, obs, run.mount, run.latitude, run.aux_names);
+    } catch (const std::exception &e) {
+        throw std::runtime_error(std::string("--inject: effect ") + effect + ": " + e.what());
+    }
+    for (int i = with.n_base; i < with.n_terms; i++)
+        if (pm_model_add_term(&truth, &with.term[i], arcsec / RAD2AS, nullptr) != PM_OK)
+            throw std::runtime_error("--inject: effect " + effect +
+                                     ": cannot add its terms to the baseline model");
+    if (pm_model_prepare(&truth) != PM_OK)
+        throw std::runtime_error("--inject: effect " + effect + ": the model with it is invalid");
+}
+
 } // namespace
 
 Injection parse_injection(const std::string &spec)
@@ -152,7 +172,10 @@ InjectReport inject(Run &run, const std::vector<Injection> &list)
             s.temp_start_c = mean_of(obs, &pm_context::temp_c);
             s.start_time_h = mean_of(obs, &pm_context::time_h);
             char err[512];
-            if (pmsim_add_effect(&s, in.effect.c_str(), arcsec, in.phase_deg, in.seed, err, sizeof err) != 0)
+            if (in.effect.rfind("aux:", 0) == 0)
+                add_column_effect(s.truth, in.effect, arcsec, run, obs);
+            else if (pmsim_add_effect(&s, in.effect.c_str(), arcsec, in.phase_deg, in.seed, err,
+                                      sizeof err) != 0)
                 throw std::runtime_error(std::string("--inject: ") + err);
             for (Obs &o : obs) {
                 double a0[2], a1[2];
