@@ -820,7 +820,12 @@ pm_status pm_model_f_prepare(pm_model_f *mf, const pm_model *m);
 **
 **  Notes:
 **  1) The correction (apparent - encoder, after the exact index shifts)
-**     agrees with the double build to 0.01" over the sky (tested at L=2).
+**     agrees with the double build to 0.01" over the sky (tested at L=2
+**     with index terms c', e' of degrees, which are applied in double, and
+**     the other terms within arcminutes).  The other isotropic rotations
+**     (a, b, d, i) are applied in float, which rounds at up to 6e-7 of
+**     their angle (check_float: a or b alone 4-5e-7, d or i 2-3e-7): of 1
+**     deg, 1e-8 rad (0.002"); of 10 deg, up to 9e-8 rad (0.018").
 **  2) The inverse is a fixed point on the float correction (the frame
 **     position is the target minus the correction there; at most
 **     PM_INVERT_F_FIXED steps of one evaluation each, usually 2, no libm
@@ -839,9 +844,13 @@ pm_status pm_model_f_prepare(pm_model_f *mf, const pm_model *m);
 **     is on the other side of the mount's pole.
 **  3) What to expect (bench/inv_stress.c "float", L = 2, harmonic terms
 **     within 10', 20,000 targets per row, docs/performance.md): the float
-**     forward's own rounding grows with the correction it carries, about
-**     1e-7 of it (isotropic terms of 1 deg: 3e-9 rad; of 10 deg: up to
-**     4e-8 rad, above PM_INVERT_F_TOL).  With isotropic terms within 1
+**     forward's own jitter (its change between neighbouring inputs) grows
+**     with the correction it carries, about 1e-7 of it (isotropic terms
+**     of 1 deg: 3e-9 rad; of 10 deg: up to 4e-8 rad, above
+**     PM_INVERT_F_TOL); its offset from the double forward is larger
+**     (Note 1), so an inverse that is PM_OK against the float forward can
+**     miss by that offset against the double one (terms of 1 deg: up to
+**     1.7e-8 rad).  With isotropic terms within 1
 **     deg every inverse 5 to 90 deg from the mount's pole returns PM_OK.
 **     With terms of several degrees some end PM_WARN_NOT_CONVERGED at
 **     that noise floor (the position returned within 5e-8 rad of the
