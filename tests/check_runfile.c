@@ -806,6 +806,52 @@ END_TEST
 START_TEST(test_pmrun_read_invalid_date) { expect_error("bad_date.dat", 3, "2023 13 1 is not a valid date"); }
 END_TEST
 
+/* A time column of clock hours that passes midnight is continued past 24 h
+** with a note naming the line (a drift was read with the wrong sign and a
+** sixth of its size: an outside probe); times that step back otherwise
+** are read as given, with a note. */
+START_TEST(test_pmrun_read_time_past_midnight)
+{
+    static const char wrapped[] = "# tau delta T D time\n"
+                                  "10 20 10.1 20.1 23.50\n"
+                                  "20 30 20.1 30.1 23.90\n"
+                                  "30 40 30.1 40.1 0.25\n"
+                                  "40 50 40.1 50.1 0.25\n"
+                                  "50 60 50.1 60.1 1.75\n";
+    static const char unordered[] = "# tau delta T D time\n"
+                                    "10 20 10.1 20.1 23.50\n"
+                                    "20 30 20.1 30.1 0.10\n"
+                                    "30 40 30.1 40.1 23.70\n";
+    static const char continued[] = "# tau delta T D time\n"
+                                    "10 20 10.1 20.1 23.50\n"
+                                    "20 30 20.1 30.1 24.10\n";
+    char path[64], err[512];
+    pmrun *run = NULL;
+    temp_file(path, sizeof path, wrapped, sizeof wrapped - 1);
+    ck_assert_msg(pmrun_read(path, NULL, &run, err, sizeof err) == PMRUN_OK, "%s", err);
+    ck_assert_double_eq(pmrun_get(run, 1)->time_h, 23.90);
+    ck_assert_double_eq(pmrun_get(run, 2)->time_h, 24.25);
+    ck_assert_double_eq(pmrun_get(run, 3)->time_h, 24.25);
+    ck_assert_double_eq(pmrun_get(run, 4)->time_h, 25.75);
+    ck_assert_int_ge(find_warning(run, ":4:", "passing midnight"), 0);
+    pmrun_free(run);
+    remove(path);
+    temp_file(path, sizeof path, unordered, sizeof unordered - 1);
+    ck_assert_msg(pmrun_read(path, NULL, &run, err, sizeof err) == PMRUN_OK, "%s", err);
+    ck_assert_double_eq(pmrun_get(run, 1)->time_h, 0.10);
+    ck_assert_double_eq(pmrun_get(run, 2)->time_h, 23.70);
+    ck_assert_int_ge(find_warning(run, ":3:", "read as given"), 0);
+    pmrun_free(run);
+    remove(path);
+    temp_file(path, sizeof path, continued, sizeof continued - 1); /* beyond 24: as given */
+    ck_assert_msg(pmrun_read(path, NULL, &run, err, sizeof err) == PMRUN_OK, "%s", err);
+    ck_assert_double_eq(pmrun_get(run, 1)->time_h, 24.10);
+    ck_assert_int_lt(find_warning(run, "time:", NULL), 0);
+    pmrun_free(run);
+    remove(path);
+}
+END_TEST
+
 /* Weather that makes refraction meaningless is an error when refraction is
 ** requested, a warning otherwise. */
 static void expect_weather_error(const char *name, const char *needle)
@@ -1203,6 +1249,7 @@ static Suite *runfile_suite(void)
     tcase_add_test(tc, test_pmrun_read_run_line_incomplete_date);
     tcase_add_test(tc, test_pmrun_read_run_line_without_latitude);
     tcase_add_test(tc, test_pmrun_read_invalid_date);
+    tcase_add_test(tc, test_pmrun_read_time_past_midnight);
     tcase_add_test(tc, test_pmrun_read_humidity_out_of_range);
     tcase_add_test(tc, test_pmrun_read_wavelength_not_positive);
     tcase_add_test(tc, test_pmrun_read_temperature_below_absolute_zero);

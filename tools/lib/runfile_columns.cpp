@@ -4,6 +4,7 @@
 #include "runfile_internal.hpp"
 #include "hostutil.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -35,6 +36,51 @@ bool known_column(const std::string &lname, Col &kind)
 }
 
 bool valid_aux_name(const std::string &s) { return pmhost::valid_column_name(s); }
+
+// A time column of clock hours that passes midnight (23.9, then 0.1): the
+// records after the step continued by 24 h where the times otherwise run
+// forward as one night does (the drift and explain's time terms read the
+// time as a number: a night from 20 h to 4 h written modulo 24 read a
+// drift of +3"/h as -0.54"/h), with a note; a note where the times step
+// back or leap half a day besides.
+void continue_past_midnight(Context &ctx, pmrun *run)
+{
+    std::vector<size_t> at;
+    double lo = 1e300, hi = -1e300;
+    for (size_t i = 0; i < run->obs.size(); i++)
+        if (std::isfinite(run->obs[i].time_h)) {
+            at.push_back(i);
+            lo = std::min(lo, run->obs[i].time_h);
+            hi = std::max(hi, run->obs[i].time_h);
+        }
+    if (at.size() < 2 || !(lo >= 0 && hi < 24)) // not hours of a clock
+        return;
+    size_t wraps = 0, back = 0, first = 0;
+    for (size_t k = 1; k < at.size(); k++) {
+        double step = run->obs[at[k]].time_h - run->obs[at[k - 1]].time_h;
+        if (step < -12) {
+            if (!wraps++) first = k;
+        } else if (step < 0 || step > 12) { // (a jump forward of half a day: not one night)
+            back++;
+        }
+    }
+    if (!wraps)
+        return;
+    const pmrun_obs &w = run->obs[at[first]], &b = run->obs[at[first - 1]];
+    if (wraps == 1 && !back) {
+        ctx.warn(w.line, "time: %.4g h after %.4g h (line %d): read as a clock passing midnight, "
+                 "this record and the %zu after it 24 h on (%.4g h); write the time continued "
+                 "(24.5 for 00:30) and there is nothing to guess",
+                 w.time_h, b.time_h, b.line, at.size() - 1 - first, w.time_h + 24);
+        for (size_t k = first; k < at.size(); k++)
+            run->obs[at[k]].time_h += 24;
+        return;
+    }
+    ctx.warn(w.line, "time: %.4g h after %.4g h (line %d), and the times step back or leap "
+             "half a day %zu times in all: not read as a clock passing midnight, read as given (write a clock "
+             "time that passes midnight continued, 24.5 for 00:30)",
+             w.time_h, b.time_h, b.line, wraps + back);
+}
 
 class ColumnParser : public FormatParser {
 public:
@@ -84,6 +130,7 @@ public:
         run->site.latitude_rad = latitude_deg_ * kDeg;
         for (const Column &c : cols_)
             if (c.kind == Col::kAux) run->aux_names.push_back(c.name);
+        continue_past_midnight(ctx_, run);
         return true;
     }
 
