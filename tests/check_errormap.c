@@ -264,6 +264,33 @@ START_TEST(test_errormap_pmfit)
 }
 END_TEST
 
+/* A German run all on one pier side, east of the meridian (the independent
+** gimbal's, tests/ref/indep_gen.py ... --coverage pier_east, its first
+** line): the map takes the west sky on the side the mount must use there,
+** beyond the pole, which the run never sampled, as pmfit plan does.  It
+** took every place on the side of its nearest star, and said 1.38" RMS,
+** "undetermined": false, where that side's own covariance gives 13"
+** (an outside probe: 1.8" against 24", the true error 53"). */
+START_TEST(test_errormap_side_never_used)
+{
+    static char out[1 << 16];
+    const char *top = getenv("PM_TOP");
+    char path[512], cmd[2048];
+    const char *em;
+    snprintf(path, sizeof path, "%s/tests/data/indep_gem_one_side.dat", top ? top : ".");
+    snprintf(cmd, sizeof cmd, "%s fit '%s' --json 2>/dev/null", tu_pmfit_path(), path);
+    ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
+    em = strstr(out, "\"error_map\"");
+    ck_assert_ptr_nonnull(em);
+    printf("check_errormap: one pier side, east: over the sky %.2f\", at the stars %.3f\"\n",
+           tu_json_num(em, "rms_arcsec"), tu_json_num(em, "at_points_arcsec"));
+    ck_assert(tu_json_num(em, "rms_arcsec") > 10 * tu_json_num(em, "at_points_arcsec"));
+    ck_assert_ptr_nonnull(strstr(em, "\"max_at_deg\": ["));
+    ck_assert(atof(strstr(em, "\"max_at_deg\": [") + 15) > 15); /* HA: in the west */
+    ck_assert_ptr_nonnull(strstr(em, "\"undetermined\": true"));
+}
+END_TEST
+
 /* pm_fit_point_gain against the refit with the star taken: the fall of the
 ** mean predicted variance over the places (each fit's variance scaled by
 ** its own sigma^2, since one more star changes sigma a little). */
@@ -327,6 +354,7 @@ static Suite *suite(void)
     tcase_add_test(t, test_errormap_matches_heldout);
     tcase_add_test(t, test_errormap_errors);
     tcase_add_test(t, test_errormap_pmfit);
+    tcase_add_test(t, test_errormap_side_never_used);
     tcase_add_test(t, test_point_gain_matches_refit);
     suite_add_tcase(s, t);
     return s;

@@ -67,6 +67,44 @@ int nearest_side(const Run &run, const FitOut &f, double ha, double dec)
     return side;
 }
 
+// How the run's German mount chooses its pier side, as pmfit plan plans it
+// (its default --meridian-limit of 15 deg): beyond the limit the side the
+// run's own points there vote for (ASCOM's, the normal side looking west,
+// without any), within it the side of the nearest star.  A run all on the
+// normal side, or without pier sides, with points beyond the limit on both
+// sides of the meridian is of a mount that does not flip (nearest star
+// everywhere).  Before, every place took the side of its nearest star: a
+// run all east of the meridian, beyond the pole, mapped the west sky on
+// the side the mount cannot use there (1.8" RMS over the sky where that
+// side's own covariance gives 24").
+struct SideRule {
+    bool flips = false;
+    int normal_west = 1; // +1: the normal side looks west (ASCOM)
+};
+
+const double MERIDIAN_LIMIT_DEG = 15;
+
+SideRule side_rule(const Run &run, const FitOut &f)
+{
+    SideRule r;
+    long vote = 0, east = 0, west = 0, flipped = 0;
+    for (int i : f.idx) {
+        const Obs &o = run.obs[i];
+        double x = std::remainder(o.ah, 2 * PI) / DEG;
+        int side = o.pier < 0 ? -1 : 1;
+        flipped += side < 0;
+        if (std::fabs(x) > MERIDIAN_LIMIT_DEG) {
+            vote += (x > 0 ? 1 : -1) * side;
+            if (side > 0)
+                (x > 0 ? west : east)++;
+        }
+    }
+    const long far = east + west;
+    r.flips = !(flipped == 0 && east >= 3 && west >= 3 && 10 * std::min(east, west) >= far);
+    r.normal_west = vote < 0 ? -1 : 1;
+    return r;
+}
+
 double elevation(const Run &run, double ha, double dec)
 {
     return std::asin(std::sin(run.latitude) * std::sin(dec) +
@@ -99,6 +137,7 @@ ErrorMap error_map(const Run &run, const FitOut &f, int side)
     e.limit_deg = e.elevation ? std::max(0.0, std::floor(lo)) : std::floor(lo);
     e.at_points_arcsec = np ? std::sqrt(ss / (double)np) * RAD2AS : NAN;
     pm_context ctx = mean_context(run, side);
+    const SideRule rule = altaz || side ? SideRule() : side_rule(run, f);
     double sum = 0, area = 0;
     const double step = 3;
     for (double y = -90 + step / 2; y < 90; y += step) {
@@ -110,9 +149,14 @@ ErrorMap error_map(const Run &run, const FitOut &f, int side)
             if (above < e.limit_deg)
                 continue;
             // the encoder position of that place on this pier side (side 0
-            // of an equatorial mount: the side of the run's nearest star)
+            // of an equatorial mount: the side the mount takes there, as
+            // side_rule says)
             double t = x * DEG, d = y * DEG;
-            int sd = altaz ? 0 : side ? side : nearest_side(run, f, t, d);
+            int sd = altaz ? 0
+                     : side ? side
+                     : rule.flips && std::fabs(x) > MERIDIAN_LIMIT_DEG
+                         ? (x > 0 ? 1 : -1) * rule.normal_west
+                         : nearest_side(run, f, t, d);
             ctx.pier = sd;
             if (sd < 0)
                 t += PI, d = PI - d;
