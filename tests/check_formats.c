@@ -243,6 +243,88 @@ START_TEST(test_pmrun_read_wrong_guess_names_the_format)
 }
 END_TEST
 
+/* nina_jnow.csv with its sides East/West written as `e` and `w` into a
+** temporary file (path out); rows of only East when `w` is NULL.  The line
+** of the first East and the first West row written: line_e, line_w. */
+static int line_e, line_w;
+static void csv_sides(char *out, const char *e, const char *w)
+{
+    char src[4096], line[1024];
+    FILE *in, *o;
+    int fd, n = 0;
+    line_e = line_w = 0;
+    data_path(src, sizeof src, "nina_jnow.csv");
+    strcpy(out, "/tmp/pm_sides_XXXXXX");
+    fd = mkstemp(out);
+    ck_assert_int_ge(fd, 0);
+    in = fopen(src, "r");
+    o = fdopen(fd, "w");
+    ck_assert_ptr_nonnull(in);
+    ck_assert_ptr_nonnull(o);
+    while (fgets(line, sizeof line, in)) {
+        char *p = strstr(line, ";East");
+        char *q = strstr(line, ";West");
+        if (p) {
+            sprintf(p, ";%s\n", e);
+            if (!line_e) line_e = n + 1;
+        } else if (q) {
+            if (!w) continue;
+            sprintf(q, ";%s\n", w);
+            if (!line_w) line_w = n + 1;
+        }
+        fputs(line, o);
+        n++;
+    }
+    fclose(in);
+    ck_assert_int_eq(fclose(o), 0);
+}
+
+/* Sides as numbers: ASCOM's SideOfPier numbers (0 pierEast, 1 pierWest) where
+** a 0 is among them, pm's (+1, -1) otherwise; the words' records either way.
+** Read as pm's, an ASCOM log's 1 (pierWest) was the normal side: d, e' and i
+** of opposite sign, nothing to show it (an outside probe). */
+START_TEST(test_pmrun_read_csv_sides_as_numbers)
+{
+    static const char *const pairs[3][2] = {{"0", "1"}, {"+1", "-1"}, {"1", "-1"}};
+    char path[64], err[1024];
+    pmrun *words = read_ok("nina_jnow.csv"), *run;
+    size_t i;
+    int k;
+    ck_assert_int_gt(count_west(words), 0);
+    for (k = 0; k < 3; k++) {
+        csv_sides(path, pairs[k][0], pairs[k][1]);
+        run = NULL;
+        ck_assert_msg(pmrun_read(path, NULL, &run, err, sizeof err) == PMRUN_OK, "%s", err);
+        ck_assert_uint_eq(pmrun_count(run), pmrun_count(words));
+        for (i = 0; i < pmrun_count(run); ++i) {
+            ck_assert_int_eq(pmrun_get(run, i)->pier, pmrun_get(words, i)->pier);
+            ck_assert(pmrun_get(run, i)->enc_dec == pmrun_get(words, i)->enc_dec);
+        }
+        if (k == 0)
+            ck_assert_ptr_nonnull(strstr(pmrun_warning(run, pmrun_n_warnings(run) - 1),
+                                         "ASCOM's SideOfPier"));
+        pmrun_free(run);
+        unlink(path);
+    }
+    /* ASCOM's -1 is pierUnknown; mixed numbers are refused */
+    csv_sides(path, "0", "-1");
+    tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, line_w, "-1 is pierUnknown");
+    unlink(path);
+    csv_sides(path, "+1", "0");
+    tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, line_e, "mixed");
+    unlink(path);
+    /* 1 alone: read as pm's +1, with a note that ASCOM's 1 is pierWest */
+    csv_sides(path, "1", NULL);
+    run = NULL;
+    ck_assert_msg(pmrun_read(path, NULL, &run, err, sizeof err) == PMRUN_OK, "%s", err);
+    ck_assert_int_eq(count_west(run), 0);
+    ck_assert_ptr_nonnull(strstr(pmrun_warning(run, pmrun_n_warnings(run) - 1), "1 is pierWest"));
+    pmrun_free(run);
+    unlink(path);
+    pmrun_free(words);
+}
+END_TEST
+
 /* ------------------------------------------------------------ samples */
 
 START_TEST(test_pmrun_read_rts2_same_as_source)
@@ -596,6 +678,7 @@ static Suite *formats_suite(void)
     tcase_add_test(tc, test_pmrun_read_rts2_j2000_reduced_with_equinox_option);
     tcase_add_test(tc, test_pmrun_read_mw4_same_as_source);
     tcase_add_test(tc, test_pmrun_read_csv_same_as_source);
+    tcase_add_test(tc, test_pmrun_read_csv_sides_as_numbers);
     tcase_add_test(tc, test_pmrun_read_csv_equinox_option_overrides);
     tcase_add_test(tc, test_pmrun_read_equinox_refused_where_it_does_not_apply);
     tcase_add_test(tc, test_pmrun_read_mmt_same_as_source);

@@ -160,6 +160,7 @@ struct Row {
     int line;
     double mra, mdec, sra, sdec;   // hours, degrees
     int pier;
+    char pier_number;              // the side as a bare number: '0', '1', '-' (-1), '+' (+1)
     bool has_time;
     UtcTime t;
     double lst_h;                  // NaN: from the time
@@ -350,6 +351,7 @@ private:
         Row r;
         r.line = n;
         r.pier = PMRUN_PIER_EAST;
+        r.pier_number = 0;
         r.has_time = false;
         r.lst_h = r.temp = nan();
         r.equinox = PMRUN_EQUINOX_FILE;
@@ -372,20 +374,23 @@ private:
             }
             case Col::kPier: {
                 std::string l = lower(v);
-                if (l == "piereast" || l == "east" || l == "e" || l == "+1" || l == "1" ||
-                    l == "normal")
+                r.pier_number = l == "0" ? '0' : l == "1" ? '1' : l == "-1" ? '-' : l == "+1" ? '+' : 0;
+                if (r.pier_number) // (numbers: resolved for the whole file, sides_by_number)
+                    r.pier = l == "-1" ? PMRUN_PIER_WEST : PMRUN_PIER_EAST;
+                else if (l == "piereast" || l == "east" || l == "e" || l == "normal")
                     r.pier = PMRUN_PIER_EAST;
-                else if (l == "pierwest" || l == "west" || l == "w" || l == "-1" ||
-                         l == "beyondpole" || l == "flipped")
+                else if (l == "pierwest" || l == "west" || l == "w" || l == "beyondpole" ||
+                         l == "flipped")
                     r.pier = PMRUN_PIER_WEST;
-                else if (l == "pierunknown" || l == "unknown" || l == "0" || l == "?" || missing)
+                else if (l == "pierunknown" || l == "unknown" || l == "?" || missing)
                     return ctx_.bad_record(n, format("field %zu (pier side) '%s': unknown side, "
                                                      "expected pierEast or pierWest (a German "
                                                      "mount's side decides its encoder angles)",
                                                      i + 1, excerpt(v).c_str()));
                 else
                     return ctx_.bad_record(n, format("field %zu (pier side) '%s': expected "
-                                                     "pierEast, pierWest, East, West, E, W, +1 or -1",
+                                                     "pierEast, pierWest, East, West, E, W, or "
+                                                     "ASCOM's numbers 0 (pierEast), 1 (pierWest)",
                                                      i + 1, excerpt(v).c_str()));
                 break;
             }
@@ -497,6 +502,7 @@ private:
             ctx_.warn(first_t->line, "date %d %d %d is outside ERFA's leap-second table: TAI-UTC "
                                      "is a guess (effect far below 0.1 arcsec)",
                       t0.year, t0.month, t0.day);
+        if (!sides_by_number()) return false;
         run->obs.reserve(rows_.size());
         for (const Row &r : rows_) {
             pmrun_obs o = blank_obs(r.line);
@@ -538,6 +544,44 @@ private:
         }
         run->format = PMRUN_FORMAT_CSV;
         run->mount = PMRUN_MOUNT_EQUATORIAL;
+        return true;
+    }
+
+    // Sides written as numbers: ASCOM's SideOfPier numbers (0 pierEast, 1
+    // pierWest, -1 pierUnknown, as Alpaca returns them) where a 0 is among
+    // them; else pm's (+1 normal, -1 beyond the pole).  Read as pm's, an
+    // ASCOM log's 1 (pierWest) was the normal side: d, e' and i with the
+    // opposite sign and nothing to show it.  A file of 1 only is read as
+    // pm's, with a note.
+    bool sides_by_number()
+    {
+        const Row *zero = nullptr, *plus = nullptr, *one = nullptr, *minus = nullptr;
+        for (const Row &r : rows_) {
+            const Row **f = r.pier_number == '0' ? &zero : r.pier_number == '+' ? &plus
+                            : r.pier_number == '1' ? &one : r.pier_number == '-' ? &minus : nullptr;
+            if (f && !*f) *f = &r;
+        }
+        if (zero) {
+            if (plus)
+                return ctx_.fail(plus->line, "pier side '+1' with '0' at line %d: ASCOM's "
+                                             "SideOfPier numbers (0 pierEast, 1 pierWest) and "
+                                             "pm's (+1 normal, -1 beyond the pole) mixed; write "
+                                             "East and West",
+                                 zero->line);
+            if (minus)
+                return ctx_.fail(minus->line, "pier side '-1' with '0' at line %d: with ASCOM's "
+                                              "SideOfPier numbers, -1 is pierUnknown (a German "
+                                              "mount's side decides its encoder angles)",
+                                 zero->line);
+            for (Row &r : rows_)
+                if (r.pier_number) r.pier = r.pier_number == '1' ? PMRUN_PIER_WEST : PMRUN_PIER_EAST;
+            ctx_.warn(zero->line, "pier sides as numbers with a 0: read as ASCOM's SideOfPier "
+                                  "(0 pierEast, the normal side; 1 pierWest, beyond the pole)");
+        } else if (one && !plus && !minus) {
+            ctx_.warn(one->line, "every pier side given as a number is 1: read as +1, the normal "
+                                 "side (pierEast); in ASCOM's SideOfPier numbers 1 is pierWest, "
+                                 "beyond the pole: if the log writes those, write East/West");
+        }
         return true;
     }
 
