@@ -852,6 +852,35 @@ START_TEST(test_pmrun_read_time_past_midnight)
 }
 END_TEST
 
+/* A pier column that names the sides the other way round from the encoder
+** (E records beyond the pole, W within) is read by the encoder, with a
+** note; E and W both beyond the pole is refused (an outside probe: --pier
+** split's "east" model was the beyond-the-pole records'). */
+START_TEST(test_pmrun_read_pier_other_way_round)
+{
+    static const char swapped[] = "# tau delta T D pier\n"
+                                  "190 110 10.1 70.1 E\n"
+                                  "20 30 20.1 30.1 W\n"
+                                  "200 120 20.1 60.1 E\n";
+    static const char both[] = "# tau delta T D pier\n"
+                               "190 110 10.1 70.1 E\n"
+                               "200 120 20.1 60.1 W\n";
+    char path[64], err[512];
+    pmrun *run = NULL;
+    temp_file(path, sizeof path, swapped, sizeof swapped - 1);
+    ck_assert_msg(pmrun_read(path, NULL, &run, err, sizeof err) == PMRUN_OK, "%s", err);
+    ck_assert_int_eq(pmrun_get(run, 0)->pier, PMRUN_PIER_WEST);
+    ck_assert_int_eq(pmrun_get(run, 1)->pier, PMRUN_PIER_EAST);
+    ck_assert_int_eq(pmrun_get(run, 2)->pier, PMRUN_PIER_WEST);
+    ck_assert_int_ge(find_warning(run, ":2:", "other way round"), 0);
+    pmrun_free(run);
+    remove(path);
+    temp_file(path, sizeof path, both, sizeof both - 1);
+    tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 3, "does not follow the encoder");
+    remove(path);
+}
+END_TEST
+
 /* Weather that makes refraction meaningless is an error when refraction is
 ** requested, a warning otherwise. */
 static void expect_weather_error(const char *name, const char *needle)
@@ -1250,6 +1279,7 @@ static Suite *runfile_suite(void)
     tcase_add_test(tc, test_pmrun_read_run_line_without_latitude);
     tcase_add_test(tc, test_pmrun_read_invalid_date);
     tcase_add_test(tc, test_pmrun_read_time_past_midnight);
+    tcase_add_test(tc, test_pmrun_read_pier_other_way_round);
     tcase_add_test(tc, test_pmrun_read_humidity_out_of_range);
     tcase_add_test(tc, test_pmrun_read_wavelength_not_positive);
     tcase_add_test(tc, test_pmrun_read_temperature_below_absolute_zero);

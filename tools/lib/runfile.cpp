@@ -709,6 +709,35 @@ bool check_conventions(Context &ctx)
                                 p, f->enc_dec / kDeg, b0 ? "beyond the pole" : "within +-90");
             }
         }
+        // E is the normal side, W beyond the pole (docs/formats.md, "Pier
+        // side"): a run whose E records are beyond the pole and whose W
+        // records (if any) are within names the sides the other way round
+        // (the side the tube is on, say).  Its labels are read by its
+        // encoders, with a note: as written, --pier split's "east" model was
+        // the beyond-the-pole records', and a term@W was fitted on the normal
+        // side (an outside probe).  E and W both beyond the pole: refused.
+        const bool e_beyond = side[0] && std::fabs(side[0]->enc_dec) > half;
+        const bool w_beyond = side[1] && std::fabs(side[1]->enc_dec) > half;
+        if (e_beyond && w_beyond)
+            return ctx.fail(side[1]->line,
+                            "pier W with encoder dec %.4g deg (beyond the pole), and line %d has "
+                            "pier E with encoder dec %.4g deg (beyond the pole too): the pier "
+                            "column does not follow the encoder (E: the normal side, W: beyond "
+                            "the pole)",
+                            side[1]->enc_dec / kDeg, side[0]->line, side[0]->enc_dec / kDeg);
+        if (e_beyond) {
+            for (pmrun_obs &o : ctx.run()->obs)
+                if (o.pier != PMRUN_PIER_UNKNOWN)
+                    o.pier = o.pier == PMRUN_PIER_WEST ? PMRUN_PIER_EAST : PMRUN_PIER_WEST;
+            ctx.warn(side[0]->line,
+                     "pier E with encoder dec %.4g deg, beyond the pole%s: the pier column names "
+                     "the sides the other way round from this reader (E: the normal side, W: "
+                     "beyond the pole); read by the encoder, E as W and W as E",
+                     side[0]->enc_dec / kDeg,
+                     side[1] ? (", and every W record within +-90 (line " +
+                                std::to_string(side[1]->line) + ")").c_str()
+                             : "");
+        }
     }
     // Axis-1 offsets of the records away from the pole / zenith, where the
     // axis-1 angle is well defined.
