@@ -806,6 +806,13 @@ END_TEST
 START_TEST(test_pmrun_read_invalid_date) { expect_error("bad_date.dat", 3, "2023 13 1 is not a valid date"); }
 END_TEST
 
+/* 23 for 2023 was read as 23 AD: 2,000 years of precession (an outside probe) */
+START_TEST(test_pmrun_read_two_digit_year)
+{
+    expect_error("bad_year_two_digits.dat", 3, "expected the year in full (2023, not 23)");
+}
+END_TEST
+
 /* A time column of clock hours that passes midnight is continued past 24 h
 ** with a note naming the line (a drift was read with the wrong sign and a
 ** sixth of its size: an outside probe); times that step back otherwise
@@ -1278,6 +1285,7 @@ static Suite *runfile_suite(void)
     tcase_add_test(tc, test_pmrun_read_run_line_incomplete_date);
     tcase_add_test(tc, test_pmrun_read_run_line_without_latitude);
     tcase_add_test(tc, test_pmrun_read_invalid_date);
+    tcase_add_test(tc, test_pmrun_read_two_digit_year);
     tcase_add_test(tc, test_pmrun_read_time_past_midnight);
     tcase_add_test(tc, test_pmrun_read_pier_other_way_round);
     tcase_add_test(tc, test_pmrun_read_humidity_out_of_range);

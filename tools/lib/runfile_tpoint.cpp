@@ -227,6 +227,17 @@ private:
                 return ctx_.fail(n, "run line date %s %s %s is not a valid date, expected year month "
                                     "day (UTC)",
                                  tok[3].c_str(), tok[4].c_str(), tok[5].c_str());
+            // (a year of two digits, 23 for 2023, was read as 23 AD: 2,000
+            // years of precession on every catalogue place, under a note that
+            // only TAI-UTC was a guess)
+            if (v[3] < 1000)
+                return ctx_.fail(n, "run line field 4 (year) '%s': expected the year in full "
+                                    "(2023, not 23): the catalogue places are reduced to the date",
+                                 tok[3].c_str());
+            if (v[3] < 1900 || v[3] > 2200)
+                ctx_.warn(n, "run line year %s: the catalogue places are reduced to that date; "
+                             "is it the year of the observations?",
+                          tok[3].c_str());
             site.year = static_cast<int>(v[3]);
             site.month = static_cast<int>(v[4]);
             site.day = static_cast<int>(v[5]);
