@@ -325,6 +325,63 @@ START_TEST(test_pmrun_read_csv_sides_as_numbers)
 }
 END_TEST
 
+/* An RA (and LST) column whose name says degrees is read in degrees (an
+** 'RA (deg)' column was read as hours, silently: sigma 20" for 0.4"); a
+** declination named in hours is refused (an outside probe). */
+START_TEST(test_pmrun_read_csv_units_in_names)
+{
+    char src[4096], path[64], line[1024], err[1024];
+    FILE *in, *o;
+    int fd, k, dec_line = 0;
+    pmrun *words = read_ok("nina_jnow.csv"), *run = NULL;
+    size_t i;
+    for (k = 0; k < 2; k++) {
+        data_path(src, sizeof src, "nina_jnow.csv");
+        strcpy(path, "/tmp/pm_units_XXXXXX");
+        fd = mkstemp(path);
+        ck_assert_int_ge(fd, 0);
+        in = fopen(src, "r");
+        o = fdopen(fd, "w");
+        ck_assert_ptr_nonnull(in);
+        ck_assert_ptr_nonnull(o);
+        for (i = 1; fgets(line, sizeof line, in); i++) {
+            double f[5];
+            char side[32];
+            if (!strncmp(line, "LST;", 4)) {
+                fputs(k ? "LST;RA;Dec (h);SolvedRA;SolvedDec;SideOfPier\n"
+                        : "LST (deg);RA (deg);Dec;SolvedRA (degrees);SolvedDec (deg);SideOfPier\n",
+                      o);
+                dec_line = (int)i;
+            } else if (line[0] != '#' &&
+                       sscanf(line, "%lf;%lf;%lf;%lf;%lf;%31s", &f[0], &f[1], &f[2], &f[3], &f[4],
+                              side) == 6) {
+                fprintf(o, "%.10f;%.10f;%.9f;%.10f;%.9f;%s\n", 15 * f[0], 15 * f[1], f[2],
+                        15 * f[3], f[4], side);
+            } else {
+                fputs(line, o);
+            }
+        }
+        fclose(in);
+        ck_assert_int_eq(fclose(o), 0);
+        if (k == 1) {
+            tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, dec_line, "a declination in hours?");
+        } else {
+            ck_assert_msg(pmrun_read(path, NULL, &run, err, sizeof err) == PMRUN_OK, "%s", err);
+            ck_assert_uint_eq(pmrun_count(run), pmrun_count(words));
+            for (i = 0; i < pmrun_count(run); ++i) {
+                const pmrun_obs *x = pmrun_get(run, i), *y = pmrun_get(words, i);
+                ck_assert(fabs(wrap(x->enc_ha - y->enc_ha)) < 1e-9);
+                ck_assert(fabs(wrap(x->app_ha - y->app_ha)) < 1e-9);
+                ck_assert(fabs(x->app_dec - y->app_dec) < 1e-9);
+            }
+            pmrun_free(run);
+        }
+        unlink(path);
+    }
+    pmrun_free(words);
+}
+END_TEST
+
 /* ------------------------------------------------------------ samples */
 
 START_TEST(test_pmrun_read_rts2_same_as_source)
@@ -679,6 +736,7 @@ static Suite *formats_suite(void)
     tcase_add_test(tc, test_pmrun_read_mw4_same_as_source);
     tcase_add_test(tc, test_pmrun_read_csv_same_as_source);
     tcase_add_test(tc, test_pmrun_read_csv_sides_as_numbers);
+    tcase_add_test(tc, test_pmrun_read_csv_units_in_names);
     tcase_add_test(tc, test_pmrun_read_csv_equinox_option_overrides);
     tcase_add_test(tc, test_pmrun_read_equinox_refused_where_it_does_not_apply);
     tcase_add_test(tc, test_pmrun_read_mmt_same_as_source);

@@ -61,8 +61,12 @@ std::string normalise(const std::string &s)
     return out;
 }
 
-Col classify(const std::string &norm)
+// The column a header name names; *unit: 'd' where a unit suffix of the
+// name says degrees (deg, degree(s), dms), 'h' hours (h, hour(s), hms), 0
+// none.
+Col classify(const std::string &norm, char *unit = nullptr)
 {
+    if (unit) *unit = 0;
     for (int pass = 0; pass < 2; ++pass)
         for (const char *suf : kSuffixes) {
             std::string n = norm;
@@ -73,7 +77,10 @@ Col classify(const std::string &norm)
             }
             for (const Known &k : kKnown)
                 for (int i = 0; k.names[i]; ++i)
-                    if (n == k.names[i]) return k.kind;
+                    if (n == k.names[i]) {
+                        if (unit && pass == 1) *unit = suf[0] == 'd' ? 'd' : 'h';
+                        return k.kind;
+                    }
             if (pass == 0) break;
         }
     return Col::kUnused;
@@ -278,7 +285,17 @@ private:
         if (!split_row(t, delim_, names, why)) return ctx_.fail(n, "header: %s", why.c_str());
         std::string unused;
         for (const std::string &name : names) {
-            Col c = classify(normalise(name));
+            char unit;
+            Col c = classify(normalise(name), &unit);
+            // a unit the column's name gives: RA and LST in degrees are read
+            // so (an 'RA (deg)' column was read as hours, silently), a
+            // declination in hours is refused
+            const bool ra = c == Col::kMountRa || c == Col::kSolvedRa || c == Col::kLst;
+            const bool dec = c == Col::kMountDec || c == Col::kSolvedDec;
+            if (dec && unit == 'h')
+                return ctx_.fail(n, "column '%s': a declination in hours? expected degrees",
+                                 excerpt(name).c_str());
+            deg_.push_back(ra && unit == 'd');
             for (size_t k = 0; k < cols_.size(); ++k)
                 if (c != Col::kUnused && cols_[k] == c)
                     return ctx_.fail(n, "column '%s' is a second %s column (the first is '%s'), "
@@ -365,7 +382,22 @@ private:
             case Col::kSolvedDec: {
                 bool hours = cols_[i] == Col::kMountRa || cols_[i] == Col::kSolvedRa;
                 double a;
-                if (!angle(v, i, hours, a, why)) return ctx_.bad_record(n, why);
+                if (hours && deg_[i]) { // (the header says degrees)
+                    std::string w;
+                    if (!parse_sexagesimal(v, a, w))
+                        return ctx_.bad_record(n, format("field %zu (%s) '%s': %s", i + 1,
+                                                         col_title(cols_[i]), excerpt(v).c_str(),
+                                                         w.c_str()));
+                    if (!(a >= 0 && a < 360))
+                        return ctx_.bad_record(n, format("field %zu (%s) '%s': out of range, "
+                                                         "expected 0 <= degrees < 360 (the header "
+                                                         "says degrees)",
+                                                         i + 1, col_title(cols_[i]),
+                                                         excerpt(v).c_str()));
+                    a /= 15;
+                } else if (!angle(v, i, hours, a, why)) {
+                    return ctx_.bad_record(n, why);
+                }
                 (cols_[i] == Col::kMountRa    ? r.mra
                  : cols_[i] == Col::kMountDec ? r.mdec
                  : cols_[i] == Col::kSolvedRa ? r.sra
@@ -409,6 +441,14 @@ private:
                 if (!parse_sexagesimal(v, r.lst_h, w))
                     return ctx_.bad_record(n, format("field %zu (LST) '%s': %s", i + 1,
                                                      excerpt(v).c_str(), w.c_str()));
+                if (deg_[i]) {
+                    if (!(r.lst_h >= 0 && r.lst_h < 360))
+                        return ctx_.bad_record(n, format("field %zu (LST) '%s': out of range, "
+                                                         "expected 0 <= degrees < 360 (the header "
+                                                         "says degrees)",
+                                                         i + 1, excerpt(v).c_str()));
+                    r.lst_h /= 15;
+                }
                 if (!(r.lst_h >= 0 && r.lst_h < 24))
                     return ctx_.bad_record(n, format("field %zu (LST) '%s': out of range, expected "
                                                      "0 <= hours < 24",
@@ -586,6 +626,7 @@ private:
     }
 
     Context &ctx_;
+    std::vector<bool> deg_;         // per column: an RA or LST in degrees (its name says so)
     int header_line_ = 0;
     char delim_ = ',';
     std::vector<Col> cols_;
