@@ -382,6 +382,45 @@ START_TEST(test_pmrun_read_csv_units_in_names)
 }
 END_TEST
 
+/* Times without their zone are UTC, said where they place the stars (a log
+** of local times read as UTC turns every hour angle by the zone, and the
+** fit blamed the plate solves: an outside probe). */
+START_TEST(test_pmrun_read_csv_time_without_zone)
+{
+    char src[4096], path[64], line[1024], err[1024];
+    FILE *in, *o;
+    int fd, k, found = -1;
+    pmrun *run = NULL;
+    data_path(src, sizeof src, "nina_j2000.csv");
+    strcpy(path, "/tmp/pm_zone_XXXXXX");
+    fd = mkstemp(path);
+    ck_assert_int_ge(fd, 0);
+    in = fopen(src, "r");
+    o = fdopen(fd, "w");
+    ck_assert_ptr_nonnull(in);
+    ck_assert_ptr_nonnull(o);
+    while (fgets(line, sizeof line, in)) {
+        char *z = strstr(line, "Z,");
+        if (z && line[0] != '#')
+            memmove(z, z + 1, strlen(z + 1) + 1);
+        fputs(line, o);
+    }
+    fclose(in);
+    ck_assert_int_eq(fclose(o), 0);
+    ck_assert_msg(pmrun_read(path, NULL, &run, err, sizeof err) == PMRUN_OK, "%s", err);
+    for (k = 0; k < pmrun_n_warnings(run); k++)
+        if (strstr(pmrun_warning(run, k), "the time has no zone"))
+            found = k;
+    ck_assert_int_ge(found, 0);
+    pmrun_free(run);
+    unlink(path);
+    run = read_ok("nina_j2000.csv"); /* with its Z: nothing said */
+    for (k = 0; k < pmrun_n_warnings(run); k++)
+        ck_assert_ptr_null(strstr(pmrun_warning(run, k), "no zone"));
+    pmrun_free(run);
+}
+END_TEST
+
 /* ------------------------------------------------------------ samples */
 
 START_TEST(test_pmrun_read_rts2_same_as_source)
@@ -737,6 +776,7 @@ static Suite *formats_suite(void)
     tcase_add_test(tc, test_pmrun_read_csv_same_as_source);
     tcase_add_test(tc, test_pmrun_read_csv_sides_as_numbers);
     tcase_add_test(tc, test_pmrun_read_csv_units_in_names);
+    tcase_add_test(tc, test_pmrun_read_csv_time_without_zone);
     tcase_add_test(tc, test_pmrun_read_csv_equinox_option_overrides);
     tcase_add_test(tc, test_pmrun_read_equinox_refused_where_it_does_not_apply);
     tcase_add_test(tc, test_pmrun_read_mmt_same_as_source);

@@ -507,6 +507,18 @@ private:
             if (!r.has_time && (need_time && equinox_of(r) == PMRUN_EQUINOX_J2000))
                 return ctx_.fail(r.line, "J2000 places need the UTC time of the row for the "
                                          "reduction, expected a time in the Time column");
+        // a time without its zone is UTC (docs/formats.md); where the
+        // times place the stars (no LST, or J2000 places) a local time would
+        // turn every hour angle by the zone, 15 deg an hour, and the fit
+        // would blame the plate solves: said
+        for (const Row &r : rows_)
+            if (r.has_time && !r.t.zoned &&
+                (std::isnan(r.lst_h) || equinox_of(r) == PMRUN_EQUINOX_J2000)) {
+                ctx_.warn(r.line, "the time has no zone (Z or +-hh:mm): read as UTC; if the log "
+                                  "writes local time, every hour angle is off by the zone (15 "
+                                  "deg an hour): give the zone, or convert the times to UTC");
+                break;
+            }
         UtcTime t0;
         if (first_t) {
             t0 = first_t->t;

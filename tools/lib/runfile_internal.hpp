@@ -189,6 +189,7 @@ bool parse_sexagesimal(const std::string &text, double &value, std::string &why)
 struct UtcTime {
     int year = 0, month = 0, day = 0;
     double hours = 0;
+    bool zoned = false; // the text gave its zone (Z or an offset)
 };
 bool parse_iso_utc(const std::string &text, UtcTime &t, std::string &why);
 // Hours from 0h UTC of `ref`'s date to `t` (whole days counted).

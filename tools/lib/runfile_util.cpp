@@ -160,10 +160,13 @@ bool parse_iso_utc(const std::string &text, UtcTime &t, std::string &why)
         }
     }
     int zsign = 0;
+    bool zoned = false;
     if (i < s.size() && (s[i] == 'Z' || s[i] == 'z')) {
         ++i;
+        zoned = true;
     } else if (i < s.size() && (s[i] == '+' || s[i] == '-')) {
         zsign = s[i++] == '-' ? -1 : 1;
+        zoned = true;
         if (!fixed_int(s, i, 2, zh)) {
             why = expect;
             return false;
@@ -188,6 +191,7 @@ bool parse_iso_utc(const std::string &text, UtcTime &t, std::string &why)
     t.month = mo;
     t.day = d;
     t.hours = h + mi / 60.0 + sec / 3600.0 - zsign * (zh + zm / 60.0);
+    t.zoned = zoned;
     return true;
 }
 
