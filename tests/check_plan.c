@@ -464,6 +464,41 @@ START_TEST(test_plan_catalogue)
 }
 END_TEST
 
+/* A star listed twice (under another name, or the same) is a candidate
+** once, and the note says so: it was proposed twice (an outside probe). */
+START_TEST(test_plan_catalogue_star_twice)
+{
+    static char text[1 << 13];
+    static cli_target t[40];
+    char args[512], line[128];
+    const char *cat;
+    int i, j, n;
+    tu_rng r;
+    tu_seed(&r, 77);
+    text[0] = 0;
+    for (i = 0; i < 30; i++) {
+        double ra = 24 * tu_uniform(&r), dec = asin(2 * tu_uniform(&r) - 1) / DEG;
+        snprintf(line, sizeof line, "%.6f %+.6f Star %02d\n", ra, dec, i);
+        strcat(text, line);
+        if (i % 6 == 0) { /* again, under another name, to 0.1" */
+            snprintf(line, sizeof line, "Again%02d %.8f %+.8f\n", i, ra + 0.1 / 15 / 3600, dec);
+            strcat(text, line);
+        }
+    }
+    cat = write_file("twice.txt", text);
+    snprintf(args, sizeof args, "--next 40 --json --catalog '%s' --lst 6", cat);
+    ck_assert_msg(plan_cli(args) == 0, "%s", out);
+    ck_assert_msg(strstr(out, "the catalogue lists 5 stars twice, taken once") != NULL, "%s", out);
+    n = parse_targets(out, t, 40);
+    ck_assert_int_gt(n, 5);
+    for (i = 0; i < n; i++)
+        for (j = 0; j < i; j++)
+            ck_assert_msg(tu_angle(t[i].x * DEG, t[i].y * DEG, t[j].x * DEG, t[j].y * DEG) >
+                              1e-3 * DEG,
+                          "%s and %s: one place", t[i].name, t[j].name);
+}
+END_TEST
+
 /* D-optimal: another plan; the I-optimal one has the lower mean predicted
 ** error (its criterion).  Physical terms: the plan determines them. */
 START_TEST(test_plan_criteria_and_terms)
@@ -957,6 +992,7 @@ static Suite *suite(void)
     tcase_add_test(t, test_plan_errors);
     tcase_add_test(t, test_plan_horizon);
     tcase_add_test(t, test_plan_catalogue);
+    tcase_add_test(t, test_plan_catalogue_star_twice);
     tcase_add_test(t, test_plan_criteria_and_terms);
     tcase_add_test(t, test_plan_slew);
     tcase_add_test(t, test_plan_sides);

@@ -1043,7 +1043,7 @@ int cmd_plan(const Options &o)
                     p.before_arcsec);
     else
         std::printf("  the model is not determined yet%s\n",
-                    p.note.empty() ? " (fewer points than half its terms)" : " (the note above)");
+                    p.note_says_undetermined ? " (the note above)" : " (fewer points than half its terms)");
     std::printf("  next targets (in this order):\n");
     for (size_t k = 0; k < p.targets.size(); k++) {
         const Target &t = p.targets[k];

@@ -596,6 +596,34 @@ Plan plan_targets(const Run &taken, const PlanOptions &opt)
     if (sky.empty())
         throw std::runtime_error("plan: no usable sky " + horizon_text(o) + " at this latitude");
     check_determinable(m, sky);
+    // a star listed twice (within 1") is a candidate once: it was proposed
+    // twice, the second time with a "predicted" gain of its own
+    {
+        std::vector<CatalogueStar> once;
+        std::string same;
+        int n_same = 0;
+        for (const CatalogueStar &s : o.stars) {
+            const CatalogueStar *first = nullptr;
+            for (const CatalogueStar &t : once)
+                if (std::fabs(s.dec_deg - t.dec_deg) * 3600 < 1 &&
+                    std::fabs(std::remainder(s.ra_h - t.ra_h, 24.0)) * 15 * 3600 *
+                            std::cos(s.dec_deg * DEG) < 1)
+                    first = &t;
+            if (!first) {
+                once.push_back(s);
+                continue;
+            }
+            if (!n_same++)
+                same = "line " + std::to_string(s.line) + " (" + s.name + ") is line " +
+                       std::to_string(first->line) + "'s place (" + first->name + ")";
+        }
+        if (n_same) {
+            plan.note += std::string(plan.note.empty() ? "" : "; ") + "the catalogue lists " +
+                         std::to_string(n_same) + (n_same == 1 ? " star" : " stars") +
+                         " twice, taken once: " + same + (n_same > 1 ? ", ..." : "");
+            o.stars = once;
+        }
+    }
     std::vector<SkyPlace> cand = o.stars.empty() ? sky_places(o, o.grid_deg, done, ctx)
                                                  : star_places(o, done, ctx);
     plan.n_catalogue = (int)o.stars.size();
@@ -618,13 +646,16 @@ Plan plan_targets(const Run &taken, const PlanOptions &opt)
     double f0 = design_criterion(m, dt, ds);
     plan.before_arcsec =
         determines(m, dt, ds) ? o.noise_arcsec * std::sqrt(std::max(0.0, f0)) : NAN;
-    if (!std::isfinite(plan.before_arcsec) && !dt.empty() && !fit_note)
+    plan.note_says_undetermined = fit_note;
+    if (!std::isfinite(plan.before_arcsec) && !dt.empty() && !fit_note) {
         // (the points fit, but some combination of the terms is fixed by no
         // point: the error over the sky is unbounded, not "too few points")
         plan.note += std::string(plan.note.empty() ? "" : "; ") + "the run's " +
                      std::to_string(dt.size()) + " points fit the " +
                     std::to_string(m.n_terms) + "-term model but do not determine it over the " +
                     "sky (a combination of its terms that no point fixes)";
+        plan.note_says_undetermined = true;
+    }
     std::vector<double> crit, secs;
     const DesignPlace *start = dt.empty() ? nullptr : &dt.back();
     std::vector<int> order =

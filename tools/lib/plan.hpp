@@ -77,6 +77,7 @@ struct Plan {
     int n_candidates = 0, n_sky = 0;
     int n_catalogue = 0;          // stars read (n_candidates of them usable)
     std::string note;             // e.g. the run does not determine the model yet
+    bool note_says_undetermined = false; // the note says why the model is not determined
 };
 
 // Plan the next targets after the observations of `taken` (may be empty:
