@@ -1143,6 +1143,9 @@ std::string compare_run(const Model *old_model, const std::shared_ptr<RunData> &
                         const std::string &old_path, const RunData &d, int order,
                         std::vector<std::string> adds)
 {
+    const bool order_given = order != -1; /* (-1: not given, the default 1) */
+    if (!order_given)
+        order = 1;
     if (order < 0 || order > PM_MAX_L)
         fail(K_ARGUMENT, "order " + std::to_string(order) + ": expected 0.." + std::to_string(PM_MAX_L));
     const int passes = 2000;
@@ -1166,6 +1169,9 @@ std::string compare_run(const Model *old_model, const std::shared_ptr<RunData> &
         fail(w.rfind("--add", 0) == 0 ? K_ARGUMENT
              : w.find("cannot open") != std::string::npos ? K_FILE : K_FORMAT, w);
     }
+    if (!os.is_run && (order_given || !adds.empty())) // (pmfit compare's rule)
+        fail(K_ARGUMENT, "old is a model: the comparison is of its own terms; order and add "
+                         "choose the model fitted to an old run");
     if (os.is_run && os.fit.status != PM_OK)
         fail_fit(os.fit, (old_path.empty() ? std::string("old run") : old_path) + " (the old run)", passes);
     Comparison c;

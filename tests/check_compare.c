@@ -226,10 +226,11 @@ START_TEST(test_compare_other_site)
              dir, tu_pmfit_path(), tu_pmfit_path(), tu_pmfit_path());
     ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
     {
-        static const char *olds[2] = {"north.dat", "north.pm"};
+        /* (a model file brings its own terms: --add is for a run) */
+        static const char *olds[2] = {"north.dat --add refraction", "north.pm"};
         int k;
         for (k = 0; k < 2; k++) {
-            snprintf(cmd, sizeof cmd, "cd %s && %s compare %s south.dat --add refraction --json",
+            snprintf(cmd, sizeof cmd, "cd %s && %s compare %s south.dat --json",
                      dir, tu_pmfit_path(), olds[k]);
             ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
             printf("check_compare: %s vs a run 17 deg further south: %d moved; %s\n", olds[k],
@@ -240,7 +241,7 @@ START_TEST(test_compare_other_site)
         }
     }
     /* the same site: no word of latitudes */
-    snprintf(cmd, sizeof cmd, "cd %s && %s compare north.pm north.dat --add refraction --json", dir,
+    snprintf(cmd, sizeof cmd, "cd %s && %s compare north.pm north.dat --json", dir,
              tu_pmfit_path());
     ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
     ck_assert_ptr_null(strstr(out, "fitted at latitude"));
@@ -292,6 +293,25 @@ START_TEST(test_compare_misuse)
             snprintf(cmd, sizeof cmd, "%s %s", tu_pmfit_path(), bad[k][0]);
         ck_assert_int_ne(tu_capture(cmd, out, sizeof out), 0);
         ck_assert_msg(strstr(out, bad[k][1]) != NULL, "%s: %s", bad[k][0], out);
+    }
+    /* a model file's own terms are compared: --order or --add with it is
+    ** refused (--order 2 compared an order-1 OLD as order 1, silently) */
+    {
+        const char *top = getenv("PM_TOP");
+        const char *args[2] = {"--order 2", "--add refraction"};
+        char model[160];
+        if (!dir[0])
+            tu_tmpdir(dir, "pm_compare_");
+        snprintf(model, sizeof model, "%s/old.pm", dir);
+        snprintf(cmd, sizeof cmd, "%s fit %s/tests/data/flip_gem_pm180.dat --save %s",
+                 tu_pmfit_path(), top ? top : ".", model);
+        ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
+        for (k = 0; k < 2; k++) {
+            snprintf(cmd, sizeof cmd, "%s compare %s %s/tests/data/flip_gem_pm180.dat %s",
+                     tu_pmfit_path(), model, top ? top : ".", args[k]);
+            ck_assert_int_ne(tu_capture(cmd, out, sizeof out), 0);
+            ck_assert_msg(strstr(out, "the comparison is of its own terms") != NULL, "%s", out);
+        }
     }
 }
 END_TEST

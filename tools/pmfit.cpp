@@ -101,6 +101,7 @@ struct Options {
     int format = PMRUN_FORMAT_AUTO;  // --format NAME (docs/formats.md)
     int equinox = PMRUN_EQUINOX_FILE; // --equinox J2000|JNow
     std::string tpoint_terms;        // fit --tpoint-terms FILE
+    bool order_given = false;        // --order on the command line
 };
 
 void usage(FILE *f)
@@ -409,6 +410,7 @@ bool fit_option(Options &o, const Cmd &c, Args &g)
         if (!parse_int(v, &o.order) || o.order < 0 || o.order > PM_MAX_L)
             die(std::string("--order: expected an integer 0..") + std::to_string(PM_MAX_L) +
                 ", got '" + v + "'");
+        o.order_given = true;
     } else if (!c.sim && !c.eval && !c.expl && a == "--pier") {
         std::string v = g.need("joint or split");
         if (v == "split")
@@ -656,6 +658,31 @@ void check_combinations(const Options &o, const Cmd &c, int argc, char **argv)
     }
 }
 
+/* pmfit CMD --help: the usage of CMD (its "usage: pmfit CMD" sections),
+** or all of it. */
+void usage_of(const std::string &cmd)
+{
+    char *buf = nullptr;
+    size_t len = 0;
+    FILE *m = open_memstream(&buf, &len);
+    if (!m) {
+        usage(stdout);
+        return;
+    }
+    usage(m);
+    std::fclose(m);
+    std::string all(buf, len), out;
+    std::free(buf);
+    const std::string head = "usage: pmfit " + cmd + " ";
+    for (size_t at = all.find(head); at != std::string::npos; at = all.find(head, at + 1)) {
+        size_t end = all.find("\nusage: ", at);
+        out += all.substr(at, end == std::string::npos ? std::string::npos : end + 1 - at);
+        if (end != std::string::npos && all.compare(end + 1, head.size(), head) != 0)
+            out += "\n";
+    }
+    std::fputs(out.empty() ? all.c_str() : out.c_str(), stdout);
+}
+
 Options parse_args(int argc, char **argv)
 {
     Options o;
@@ -668,6 +695,11 @@ Options parse_args(int argc, char **argv)
         usage(stdout);
         std::exit(0);
     }
+    for (int i = 2; i < argc; i++)
+        if (!std::strcmp(argv[i], "--help") || !std::strcmp(argv[i], "-h")) {
+            usage_of(o.cmd);
+            std::exit(0);
+        }
     if (o.cmd == "report")
         return parse_report(o, argc, argv);
     if (o.cmd != "fit" && o.cmd != "simulate" && o.cmd != "eval" && o.cmd != "explain" &&
@@ -1076,6 +1108,14 @@ int cmd_plan(const Options &o)
 int cmd_compare(const Options &o, const Run &run)
 {
     // (an unreadable OLD throws its file:line message: main prints it, exit 1)
+    {
+        char err[1024];
+        // the terms of a model file are its own: --order 2 with an order-1
+        // OLD compared order 1 without a word
+        if ((o.order_given || !o.adds.empty()) && is_model_file(o.model, err, sizeof err) == 1)
+            die(o.model + " is a model file: the comparison is of its own terms; --order and "
+                          "--add choose the model fitted to an OLD run");
+    }
     OldSide os = load_old(o.model, o.order, o.adds, o.refraction, o.skip_bad, o.format,
                           o.equinox, 100);
     if (os.is_run && os.fit.status != PM_OK)

@@ -839,19 +839,23 @@ def plan(run=None, *, latitude=None, mount=None, order=1, add=(), next=5, min_el
     return _json.loads(text)
 
 
-def compare(old, run, *, order=1, add=()):
+def compare(old, run, *, order=None, add=()):
     """What changed since last night?  ``pmfit compare OLD RUN --json`` as a
     dict (keys in docs/formats.md, "pmfit compare --json"; docs/model.md,
-    "What changed"): ``old`` is a Model, a Run (fitted at ``order`` with
-    ``add``, so that its errors count), or a path to a model file or a run
-    file; ``run`` (a Run or a path) is the new night."""
+    "What changed"): ``old`` is a Model, a Run (fitted at ``order``, default
+    1, with ``add``, so that its errors count), or a path to a model file or
+    a run file; ``run`` (a Run or a path) is the new night.  ``order`` and
+    ``add`` with a model (its own terms are compared) raise ArgumentError."""
     r = _run(run)
+    o = -1 if order is None else _order(order)
+    if order is not None and not 0 <= o <= MAX_L:
+        raise ArgumentError("order: expected an integer 0..%d, got %r" % (MAX_L, order))
     if isinstance(old, Model):
-        text = _pm.compare_run(old, None, "", r._data, _order(order), _adds(add))
+        text = _pm.compare_run(old, None, "", r._data, o, _adds(add))
     elif isinstance(old, Run):
-        text = _pm.compare_run(None, old._data, "", r._data, _order(order), _adds(add))
+        text = _pm.compare_run(None, old._data, "", r._data, o, _adds(add))
     else:
-        text = _pm.compare_run(None, None, _path(old, "old"), r._data, _order(order), _adds(add))
+        text = _pm.compare_run(None, None, _path(old, "old"), r._data, o, _adds(add))
     return _json.loads(text)
 
 

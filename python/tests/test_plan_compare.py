@@ -99,6 +99,15 @@ def test_compare_equals_pmfit(tmp_path):
     assert pm.compare(model, SIM) == want                     # OLD a model file
     assert pm.compare(pm.load_model(str(model)), SIM) == want  # OLD a Model
     assert pm.compare(SIM, SIM, order=2)["n_terms"] == pm.fit_run(SIM, order=2).n_params
+    # a model's own terms are compared: order or add with it is refused (an
+    # order-1 model compared as order 1 under order=2, without a word)
+    for old in (model, pm.load_model(str(model))):
+        with pytest.raises(pm.ArgumentError, match="its own terms"):
+            pm.compare(old, SIM, order=2)
+        with pytest.raises(pm.ArgumentError, match="its own terms"):
+            pm.compare(old, SIM, add="refraction")
+    with pytest.raises(pm.ArgumentError, match="order"):
+        pm.compare(SIM, SIM, order=-1)
     with pytest.raises(pm.Error, match="mount|equatorial|alt"):
         pm.compare(real_run("mmt/k_and_e.dat"), gem)
     with pytest.raises(pm.FileError, match="nothing.dat"):
