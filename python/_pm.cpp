@@ -1050,7 +1050,8 @@ std::string plan_run(const std::shared_ptr<RunData> &d, const std::string &mount
                      double grid, bool fork, double noise, const std::string &criterion,
                      const std::string &sides, double meridian_limit, double slew, double settle,
                      double point_time, double flip_time, const std::string &horizon,
-                     const std::string &catalogue, double lst, const std::string &utc, double lon)
+                     const std::string &catalogue, double lst, const std::string &utc, double lon,
+                     double max_el)
 {
     Run none;
     const Run &run = d ? d->run : none;
@@ -1096,6 +1097,8 @@ std::string plan_run(const std::shared_ptr<RunData> &d, const std::string &mount
     po.adds = adds;
     po.next = next;
     po.min_el_deg = in_range("min_el", min_el, -10, 80, "degrees");
+    if (!std::isnan(max_el))
+        po.max_el_deg = in_range("max_el", max_el, 10, 90, "degrees");
     po.grid_deg = in_range("grid", grid, 1, 30, "degrees");
     po.gem = !fork;
     po.d_optimal = criterion == "D" || criterion == "d";

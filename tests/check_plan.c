@@ -499,6 +499,39 @@ START_TEST(test_plan_catalogue_star_twice)
 }
 END_TEST
 
+/* The highest elevation of the targets in plan_cli's JSON output. */
+static double highest_target(void)
+{
+    const char *p = strstr(out, "\"targets\": [");
+    double hi = -90;
+    ck_assert_ptr_nonnull(p);
+    while ((p = strstr(p, "\"elevation_deg\": ")) != NULL) {
+        double el = atof(p + strlen("\"elevation_deg\": "));
+        if (el > hi)
+            hi = el;
+        p++;
+    }
+    return hi;
+}
+
+/* An alt-az mount is planned below 85 deg by default (the zenith keyhole:
+** targets at 87-89 deg were proposed, an outside probe), --max-el sets it
+** for any mount; above --min-el and at most 90, else an error. */
+START_TEST(test_plan_max_el)
+{
+    ck_assert_msg(plan_cli("--lat 47 --mount altaz --next 30 --grid 2 --json") == 0, "%s", out);
+    printf("check_plan: alt-az, 30 targets on a 2 deg grid: highest %.2f deg\n", highest_target());
+    ck_assert(highest_target() <= 85 + 1e-9);
+    ck_assert_msg(plan_cli("--lat 47 --mount altaz --next 30 --grid 2 --max-el 90 --json") == 0,
+                  "%s", out);
+    ck_assert(highest_target() > 85); /* the keyhole's places are the plan's best there */
+    ck_assert_msg(plan_cli("--lat 47 --next 20 --max-el 60 --json") == 0, "%s", out);
+    ck_assert(highest_target() <= 60 + 1e-9);
+    ck_assert_int_ne(plan_cli("--lat 47 --next 5 --min-el 30 --max-el 20"), 0);
+    ck_assert_msg(strstr(out, "--max-el must be above --min-el") != NULL, "%s", out);
+}
+END_TEST
+
 /* D-optimal: another plan; the I-optimal one has the lower mean predicted
 ** error (its criterion).  Physical terms: the plan determines them. */
 START_TEST(test_plan_criteria_and_terms)
@@ -993,6 +1026,7 @@ static Suite *suite(void)
     tcase_add_test(t, test_plan_horizon);
     tcase_add_test(t, test_plan_catalogue);
     tcase_add_test(t, test_plan_catalogue_star_twice);
+    tcase_add_test(t, test_plan_max_el);
     tcase_add_test(t, test_plan_criteria_and_terms);
     tcase_add_test(t, test_plan_slew);
     tcase_add_test(t, test_plan_sides);

@@ -84,6 +84,7 @@ struct Options {
     std::string error_map;           // fit --error-map FILE.svg
     int next = 5;                    // plan --next K
     double min_el = 15, grid = 6;    // plan --min-el, --grid
+    double max_el = NAN;             // plan --max-el (NaN: the mount's)
     std::string horizon, catalogue;  // plan --horizon FILE, --catalog FILE
     double lst = -1, lon = NAN;      // plan --lst HOURS, --lon DEG (with --utc)
     std::string utc;                 // plan --utc YYYY-MM-DDTHH:MM[:SS]
@@ -182,7 +183,8 @@ void usage(FILE *f)
         "  does last night's model point tonight?\n"
         "\n"
         "usage: pmfit plan [RUN] [--next K] [--order L] [--add EFFECT ...] [--lat DEG]\n"
-        "                  [--mount equatorial|altaz] [--fork] [--min-el DEG] [--grid DEG]\n"
+        "                  [--mount equatorial|altaz] [--fork] [--min-el DEG] [--max-el DEG]\n"
+        "                  [--grid DEG]\n"
         "                  [--noise ARCSEC] [--json] [--horizon FILE] [--criterion I|D]\n"
         "                  [--catalog FILE (--lst HOURS | --utc YYYY-MM-DDTHH:MM --lon DEG)]\n"
         "                  [--sides run|meridian|both] [--meridian-limit DEG]\n"
@@ -191,7 +193,8 @@ void usage(FILE *f)
         "  which star next: the K targets (default 5) that most reduce the model's predicted\n"
         "  pointing error averaged over the sky above --min-el (default 15 deg), given the\n"
         "  points of RUN taken so far (none: the first points of a run); candidates on a grid\n"
-        "  of --grid deg (6); a German mount takes each on the side the run used nearby\n"
+        "  of --grid deg (6); a German mount takes each on the side the run used nearby;\n"
+        "  --max-el: the highest place (default: alt-az 85 deg, the zenith keyhole; 90)\n"
         "  --horizon F      azimuth-dependent horizon: 'azimuth elevation' lines (N.I.N.A.,\n"
         "                   APCC .hrz, Cartes du Ciel) or MountWizzard4 .hpts (docs/formats.md)\n"
         "  --catalog F      candidates are the stars of F ('RA Dec [name]' lines), placed on\n"
@@ -489,6 +492,8 @@ bool plan_option(Options &o, const Cmd &c, Args &g)
     } else if (a == "--min-el") {
         o.min_el = number(a, g.need("degrees"), -10, 80);
         o.min_el_given = true;
+    } else if (a == "--max-el") {
+        o.max_el = number(a, g.need("degrees"), 10, 90);
     } else if (a == "--grid") {
         o.grid = number(a, g.need("degrees"), 1, 30);
     } else if (a == "--horizon") {
@@ -1028,6 +1033,7 @@ int cmd_plan(const Options &o)
     po.adds = o.adds;
     po.next = o.next;
     po.min_el_deg = o.min_el;
+    po.max_el_deg = o.max_el;
     po.grid_deg = o.grid;
     po.gem = !o.fork;
     po.noise_arcsec = o.noise;
@@ -1062,10 +1068,13 @@ int cmd_plan(const Options &o)
         return 0;
     }
     bool az = po.mount == PM_MOUNT_ALTAZ;
+    char below[48] = "";
+    if (max_el_of(po) < 90)
+        std::snprintf(below, sizeof below, " and below %g", max_el_of(po));
     std::printf("pmfit plan: %zu points taken, order %d%s, noise %.3g\" per axis; %d candidates "
-                "above %.0f deg elevation%s%s%s\n", run.obs.size(), o.order,
+                "above %.0f%s deg elevation%s%s%s\n", run.obs.size(), o.order,
                 o.adds.empty() ? "" : " + terms", po.noise_arcsec, p.n_candidates, po.min_el_deg,
-                o.horizon.empty() ? "" : (" and the horizon of " + o.horizon).c_str(),
+                below, o.horizon.empty() ? "" : (" and the horizon of " + o.horizon).c_str(),
                 o.catalogue.empty() ? "" : (" (stars of " + o.catalogue + ": " +
                                             std::to_string(p.n_catalogue) + ")").c_str(),
                 po.d_optimal ? "; D-optimal" : "");

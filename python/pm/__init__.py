@@ -798,12 +798,13 @@ def _opt_path(name, v):
 def plan(run=None, *, latitude=None, mount=None, order=1, add=(), next=5, min_el=15.0,
          grid=6.0, fork=False, noise=None, criterion="I", sides="run", meridian_limit=15.0,
          slew=None, settle=5.0, point_time=30.0, flip_time=60.0, horizon=None, catalogue=None,
-         lst=None, utc=None, lon=None):
+         lst=None, utc=None, lon=None, max_el=None):
     """Which star next? ``pmfit plan [RUN] --json`` as a dict (keys in
     docs/formats.md, "pmfit plan --json"; the method in docs/model.md,
     "Which star next"): the ``next`` targets that most reduce the model's
     predicted pointing error averaged over the sky above ``min_el``
-    (degrees) and the ``horizon`` file, given the points of ``run`` taken so
+    (degrees) and the ``horizon`` file and below ``max_el`` (default: alt-az
+    85, the zenith keyhole; equatorial 90), given the points of ``run`` taken so
     far (a Run or a path; None: the first points of a run).
 
     ``latitude`` (degrees; default the run's), ``mount`` ("equatorial" or
@@ -835,7 +836,8 @@ def plan(run=None, *, latitude=None, mount=None, order=1, add=(), next=5, min_el
                         _opt_float("settle", settle), _opt_float("point_time", point_time),
                         _opt_float("flip_time", flip_time), _opt_path("horizon", horizon),
                         _opt_path("catalogue", catalogue), _opt_float("lst", lst),
-                        "" if utc is None else utc, _opt_float("lon", lon))
+                        "" if utc is None else utc, _opt_float("lon", lon),
+                        _opt_float("max_el", max_el))
     return _json.loads(text)
 
 

@@ -294,6 +294,13 @@ std::vector<int> greedy_design(const pm_model &m, const std::vector<DesignPlace>
     return order;
 }
 
+double max_el_of(const PlanOptions &o)
+{
+    if (std::isfinite(o.max_el_deg))
+        return o.max_el_deg;
+    return o.mount == PM_MOUNT_ALTAZ ? 85.0 : 90.0;
+}
+
 namespace {
 
 // A place of the sky in the plan: sky position (degrees), elevation,
@@ -321,7 +328,7 @@ void el_az(const PlanOptions &o, double x, double y, double &el, double &az)
 
 bool usable(const PlanOptions &o, double el, double az)
 {
-    return el >= o.min_el_deg && (o.horizon.empty() || el >= o.horizon.at(az));
+    return el >= o.min_el_deg && el <= max_el_of(o) && (o.horizon.empty() || el >= o.horizon.at(az));
 }
 
 // The encoder position of sky place (x, y) on `side`.
@@ -485,6 +492,8 @@ void check_options(const PlanOptions &o)
         throw std::runtime_error("plan: --next must be 1..1000");
     if (!(o.grid_deg >= 1 && o.grid_deg <= 30))
         throw std::runtime_error("plan: the candidate grid must be 1..30 deg");
+    if (std::isfinite(o.max_el_deg) && !(o.max_el_deg > o.min_el_deg && o.max_el_deg <= 90))
+        throw std::runtime_error("plan: --max-el must be above --min-el and at most 90 deg");
     if (!(o.meridian_limit_deg >= 0 && o.meridian_limit_deg <= 90))
         throw std::runtime_error("plan: --meridian-limit must be 0..90 deg");
     if (o.slew.on() && !(o.slew.settle_s >= 0 && o.slew.point_s >= 0 && o.slew.flip_s >= 0 &&
@@ -538,6 +547,8 @@ void check_determinable(const pm_model &m, const std::vector<SkyPlace> &sky)
 std::string horizon_text(const PlanOptions &o)
 {
     std::string s = "above " + std::to_string((int)std::lround(o.min_el_deg)) + " deg elevation";
+    if (max_el_of(o) < 90)
+        s += " and below " + fmt("%g", max_el_of(o));
     if (!o.horizon.empty())
         s += " and the horizon of " + o.horizon.path;
     return s;
@@ -786,6 +797,8 @@ pmhost::PlanOptions from_c(const pmplan_options *c)
     o.gem = c->gem != 0;
     o.latitude = c->latitude_deg * pmhost::PI / 180;
     o.min_el_deg = c->min_el_deg;
+    if (c->max_el_deg > 0)
+        o.max_el_deg = c->max_el_deg;
     o.grid_deg = c->grid_deg;
     o.noise_arcsec = c->noise_arcsec;
     if (c->adds) {

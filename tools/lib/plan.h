@@ -46,6 +46,9 @@ typedef struct pmplan_options {
     double meridian_limit_deg;
     double slew_rate_deg_s; /* > 0: weigh the slew time (per axis rate) */
     double settle_s, point_s, flip_s;
+    /* since the zenith keyhole: */
+    double max_el_deg;    /* the highest place planned; 0: the mount's (alt-az 85 deg, the
+                             zenith keyhole; equatorial 90) */
 } pmplan_options;
 
 /* order 1, equatorial German mount, latitude 47, horizon 15 deg, grid 6

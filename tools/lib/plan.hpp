@@ -40,6 +40,7 @@ struct PlanOptions {
     int mount = PM_MOUNT_EQUATORIAL;
     double latitude = NAN;         // radians (equatorial: required)
     double min_el_deg = 15;        // the horizon (with `horizon`: the higher of the two)
+    double max_el_deg = NAN;       // the highest place (NaN: the mount's, max_el_of)
     Horizon horizon;               // azimuth-dependent horizon (empty: none)
     int next = 5;                  // how many targets
     double noise_arcsec = 1;       // per axis, to scale the predicted error (a run's sigma)
@@ -79,6 +80,11 @@ struct Plan {
     std::string note;             // e.g. the run does not determine the model yet
     bool note_says_undetermined = false; // the note says why the model is not determined
 };
+
+// The highest elevation planned: o.max_el_deg, else the mount's: an
+// alt-az mount 85 deg (the zenith keyhole, where azimuth turns faster than
+// it can follow: most cannot slew or track there), an equatorial one 90.
+double max_el_of(const PlanOptions &o);
 
 // Plan the next targets after the observations of `taken` (may be empty:
 // the first points of a run).  The model's rows are evaluated at the run's
