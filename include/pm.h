@@ -630,7 +630,13 @@ pm_status pm_model_invert(const pm_model *m, const pm_context *ctx,
 */
 /* Largest start angle pm_model_invert_near(_f) accepts (radians; about
 ** 160,000 turns): the result is returned within pi of the start, and
-** beyond this a double no longer holds an angle to 1e-10 rad. */
+** beyond this a double no longer holds an angle to 1e-10 rad.  PM_OK needs
+** the result held to PM_INVERT_TOL, which a double near the start cannot
+** beyond about 1e3 rad (its spacing there is 1.1e-13): with larger starts
+** most calls end PM_WARN_NOT_CONVERGED with the answer within the
+** spacing (an outside probe: 87% at 1e4 rad, misses up to 9e-13 rad).  A
+** controller that keeps its axis angles within a few turns of zero gets
+** PM_OK. */
 #define PM_START_MAX 1e6
 pm_status pm_model_invert_near(const pm_model *m, const pm_context *ctx,
                                double app_ha, double app_dec,
