@@ -143,6 +143,12 @@ struct Explanation {
                                          // left out of every cross-validated RMS (sorted)
     std::vector<Unmodelled> unmodelled;  // where the search ended: the most significant
                                          // family that does not predict better (0 or 1)
+    struct Blurred {                     // significant, but not separable from the model's
+        std::string effect;              // harmonics (explain.cpp, separable)
+        int step = 0, order = 0;
+        double error_arcsec = 0, error_order1_arcsec = 0;
+    };
+    std::vector<Blurred> blurred;
 };
 
 // The pipeline: baseline -> locate -> candidates -> select (singles, then
@@ -163,6 +169,8 @@ std::string explain_json(const Run &run, const Explanation &ex, int order);
 std::vector<std::string> not_tried(const Run &run);
 // "significant, not modelled" in words: its sizes and what would fit it.
 std::string unmodelled_text(const Unmodelled &u);
+// A family significant at a step but not separable from its harmonics, in words.
+std::string blurred_text(const Explanation::Blurred &b);
 void print_explain_text(const Run &run, const Explanation &ex, int order, bool added,
                         double alpha, bool gears_ha, bool gears_dec);
 

@@ -76,6 +76,9 @@ struct Candidate {
     bool fitted = false;               // fit made already (the chosen period's, prefer_integer)
     double log_fap = 0;                // natural log of the false-alarm probability
     double cv = 0;                     // cross-validated RMS once checked
+    double blur = 0;                   // > 0: its terms' error beside the harmonics over their
+                                       // error at order 1, where that passed kMaxBlur
+    double err_arcsec = 0, err1_arcsec = 0; // (that largest error, here and at order 1)
 };
 
 double elevation_of(const Run &run, const Obs &o);

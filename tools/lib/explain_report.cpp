@@ -144,6 +144,14 @@ std::string explain_json(const Run &run, const Explanation &ex, int order)
              num(u.sigma_before_arcsec) + ", \"cv_before_arcsec\": " +
              num(u.cv_before_arcsec) + "}";
     }
+    j += "], \"not_separable\": [";
+    for (size_t i = 0; i < ex.blurred.size(); i++) {
+        const Explanation::Blurred &b = ex.blurred[i];
+        j += std::string(i ? ", " : "") + "{\"effect\": " + str(b.effect) + ", \"step\": " +
+             std::to_string(b.step) + ", \"order\": " + std::to_string(b.order) +
+             ", \"error_arcsec\": " + num(b.error_arcsec) + ", \"error_order1_arcsec\": " +
+             num(b.error_order1_arcsec) + "}";
+    }
     j += "], \"not_tried\": [";
     const std::vector<std::string> nt = not_tried(run);
     for (size_t i = 0; i < nt.size(); i++)
@@ -251,9 +259,19 @@ void print_findings(const Explanation &ex, double alpha)
                     ex.withdrawn_why[i].c_str());
     for (const Unmodelled &u : ex.unmodelled)
         std::printf("  significant, not modelled: %s\n", unmodelled_text(u).c_str());
+    for (const Explanation::Blurred &b : ex.blurred)
+        std::printf("  significant, not named: %s\n", blurred_text(b).c_str());
 }
 
 } // namespace
+
+std::string blurred_text(const Explanation::Blurred &b)
+{
+    return fmt("%s at step %d: its value is not determined beside the order-%d terms (1 sigma "
+               "%.4g\" there, %.4g\" beside order 1's): on this sky those terms hold nearly its "
+               "shape, so its fitted size is a balance between them, not a measurement",
+               b.effect.c_str(), b.step, b.order, b.error_arcsec, b.error_order1_arcsec);
+}
 
 std::string unmodelled_text(const Unmodelled &u)
 {

@@ -650,6 +650,8 @@ void explain_findings(Page &p, const Data &d)
         para(p, "Withdrawn: " + h(w) + "; the findings above are those of the search without it.");
     for (const Unmodelled &u : ex.unmodelled)
         para(p, "<b>Significant, not modelled:</b> " + h(unmodelled_text(u)) + ".");
+    for (const Explanation::Blurred &b : ex.blurred)
+        para(p, "<b>Significant, not named:</b> " + h(blurred_text(b)) + ".");
 }
 
 void section_explain(Page &p, const Data &d)
