@@ -107,8 +107,6 @@ static void prove(const effect_case *c)
             snprintf(spec, sizeof spec, "i@W");
         else if (!strcmp(c->name, "outlier"))
             snprintf(spec, sizeof spec, "outlier:1");
-        else if (!strcmp(c->name, "temperature_collimation"))
-            snprintf(spec, sizeof spec, "temperature:i");
         else
             snprintf(spec, sizeof spec, "%s", c->name);
         run_once(NULL, 0, 0, seed, c->order, &r0);
@@ -151,7 +149,7 @@ static void prove(const effect_case *c)
                    r.n_findings ? r.findings[0].amplitude_arcsec : 0,
                    r.n_findings ? r.findings[0].cycles_per_rev : 0);
     }
-    printf("check_explain: %-23s baseline L=%d: named first %2d/%d, parameters %2d/%d, "
+    printf("check_explain: %-13s baseline L=%d: named first %2d/%d, parameters %2d/%d, "
            "inflation %.2f-%.2f (%d seeds)\n",
            c->name, c->order, right, qualified, params, qualified, infl_lo, infl_hi, seeds);
     ck_assert_msg(qualified == RUNS, "%s: only %d concealed runs in %d seeds", c->name,
@@ -166,7 +164,7 @@ static const effect_case CASES[] = {
     {"ha_periodic", 1, 3.0, 1},  {"dec_periodic", 1, 3.0, 1}, {"pier_side", 1, 3.0, 0},
     {"refraction", 1, 3.0, 0},   {"tube_flexure", 0, 3.0, 0}, {"temperature", 1, 3.0, 0},
     {"time_drift", 1, 3.0, 0},   {"hysteresis", 1, 3.0, 0},   {"higher_order", 1, 3.0, 0},
-    {"outlier", 1, 20.0, 0},     {"temperature_collimation", 1, 3.0, 0}};
+    {"outlier", 1, 20.0, 0}};
 
 START_TEST(test_pmx_explain_concealed)
 {

@@ -221,31 +221,6 @@ START_TEST(test_two_periods_one_axis)
 }
 END_TEST
 
-/* A collimation that follows temperature, 1.0"/C (the independent gimbal's
-** collimation angle, a night cooling by 3-8 C), on a southern German mount
-** and an alt-az mount: found first, as the collimation's, with its size
-** (25%).  explain tried temperature on the two indices only, which take a
-** part of it: a run of our simulator, 3"/C on i, 10 of its sigmas, gave no
-** finding.  tests/ref/indep_gen.py tests/data/indep_M_temp_collimation.dat
-** --mount M --n 200 --seed 41001 --lat -33 --noise 1 --aniso 3 --effect
-** temperature_collimation=1.0 (the files' first line). */
-START_TEST(test_temperature_collimation)
-{
-    static const char *const file[2] = {"indep_gem_temp_collimation.dat",
-                                        "indep_altaz_temp_collimation.dat"};
-    pmx_result r;
-    const pmx_finding *f;
-    explain_file(file[_i], &r);
-    ck_assert_int_ge(r.n_findings, 1);
-    f = &r.findings[0];
-    printf("check_explain_outside: %s: first %s, %.2f\" +- %.2f\" per deg C\n", file[_i],
-           f->effect, f->amplitude_arcsec, f->amplitude_err_arcsec);
-    ck_assert_str_eq(f->effect, "temperature_collimation");
-    ck_assert(fabs(f->amplitude_arcsec - 1.0) <= 0.25);
-    ck_assert_int_lt(find(&r, "temperature"), 0);
-}
-END_TEST
-
 /* Nothing hidden, the generator's own gimbal parameters varying by 10'
 ** over the sky (tpoint_gen's anisotropy, its TPOINT-convention gimbal;
 ** /usr/bin/python3 tests/ref/tpoint_gen.py tests/data/outside_M_aniso600.dat
@@ -305,7 +280,6 @@ static Suite *suite(void)
     tcase_add_test(t, test_unresolved_pair_invents_nothing);
     tcase_add_loop_test(t, test_composed_outside, 0, 2);
     tcase_add_test(t, test_composed_undetermined);
-    tcase_add_loop_test(t, test_temperature_collimation, 0, 2);
     suite_add_tcase(s, t);
     return s;
 }

@@ -162,10 +162,9 @@ void usage(FILE *f)
         "\n"
         "  fits the baseline model (order L, default 1, plus --add terms), locates where the\n"
         "  residuals are too large, names the physics left out (ha_periodic, dec_periodic,\n"
-        "  pier_side, refraction, tube_flexure, temperature, temperature_collimation,\n"
-        "  time_drift, hysteresis, higher_order, outlier), adds it and repeats while the\n"
-        "  false-alarm probability is below P (default 0.01) and the leave-one-out RMS\n"
-        "  improves (docs/explain.md);\n"
+        "  pier_side, refraction, tube_flexure, temperature, time_drift, hysteresis,\n"
+        "  higher_order, outlier), adds it and repeats while the false-alarm probability is\n"
+        "  below P (default 0.01) and the leave-one-out RMS improves (docs/explain.md);\n"
         "  --plots DIR writes SVG pictures: residuals on the sky before/after, residual vs the\n"
         "  located variable, periodograms, sigma per step; --robust: explain the points a\n"
         "  robust fit of the baseline keeps (the rejected ones are listed); --gear G: a known\n"
@@ -1163,7 +1162,7 @@ double finding_variable(const Run &run, const Finding &f, const Obs &o, size_t j
         *xlab = "elevation (deg)";
         return el * 180 / PI;
     }
-    if (f.effect == "temperature" || f.effect == "temperature_collimation") {
+    if (f.effect == "temperature") {
         *xlab = "temperature (deg C)";
         return o.ctx.temp_c;
     }

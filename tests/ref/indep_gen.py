@@ -46,8 +46,6 @@ reports as amplitude_arcsec):
   temperature                th1 += s1*K*(T - mean T), th2 += s2*K*(T - mean T), K arcsec/degC,
                              s1, s2 = +-1 drawn per run (truth gives them)
   time_drift                 the same with (t - mean t), K arcsec per hour
-  temperature_collimation    the collimation (the optical axis' angle to the perpendicular
-                             of the Dec/elevation axis) += K*(T - mean T), K arcsec/degC
   hysteresis                 th1 += B*dir, dir = sign of the last slew on axis 1 (column dir)
   pier_side                  (gem only) extra collimation C on pier side 'W' only
   outlier                    a fraction (--outliers, default 1%) of the points moved by
@@ -94,8 +92,7 @@ AS = DEG / 3600.0
 MOUNTS = ("gem", "fork", "altaz")
 COVERAGES = ("full", "half", "band", "pier_east")
 EFFECTS = ("ha_periodic", "dec_periodic", "refraction", "tube_flexure", "temperature",
-           "time_drift", "hysteresis", "pier_side", "outlier", "higher_order",
-           "temperature_collimation")
+           "time_drift", "hysteresis", "pier_side", "outlier", "higher_order")
 ANISO_PARAMS = ("axis1", "axis2", "np", "coll", "tilt_x", "tilt_y")  # order of dq columns
 ALIASES = {"az_periodic": "ha_periodic", "el_periodic": "dec_periodic", "outliers": "outlier",
            "pier": "pier_side", "flexure": "tube_flexure"}
@@ -409,9 +406,6 @@ def gen(params):
                      unit="arcsec per degC" if name == "temperature" else "arcsec per hour")
         elif name == "hysteresis":
             x.update(explain_c_prime=A, explain_amplitude_arcsec=abs(A))
-        elif name == "temperature_collimation":
-            x.update(collimation_per_unit=A, explain_amplitude_arcsec=abs(A),
-                     unit="arcsec per degC")
         elif name == "pier_side":
             x.update(extra_collimation_west_arcsec=A, explain_amplitude_arcsec=abs(A))
         elif name == "higher_order":
@@ -466,8 +460,6 @@ def gen(params):
                 x1 += eff["hysteresis"]["size"] * AS * sdir
             if "pier_side" in eff:
                 coll += np.where(flip, eff["pier_side"]["size"] * AS, 0.0)
-            if "temperature_collimation" in eff:
-                coll += eff["temperature_collimation"]["size"] * AS * (temp - temp.mean())
         th1 = enc1 - I1 * DEG + x1 + dq[:, 0]
         th2 = enc2 - I2 * DEG + x2 + dq[:, 1]
         ch = CH * AS + coll + dq[:, 3]

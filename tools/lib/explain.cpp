@@ -820,13 +820,8 @@ void physical_candidates(const Run &run, const State &st, std::vector<Candidate>
     }
     if (run.mount == PM_MOUNT_EQUATORIAL && both_sides(run, st.use))
         add_candidate(cands, st, "pier_side", {"e'@W", "i@W"});
-    if (input_usable(run, st.use, 0)) {
+    if (input_usable(run, st.use, 0))
         add_candidate(cands, st, "temperature", {"temperature"});
-        // the collimation on its own: thermal movement of the optics, which
-        // the indices' terms take a part of only (a GEM of 3"/C on i alone
-        // was found nowhere, 10 of its sigmas)
-        add_candidate(cands, st, "temperature_collimation", {"temperature:i"});
-    }
     if (input_usable(run, st.use, 1))
         add_candidate(cands, st, "time_drift", {"time_drift"});
     // backlash: the last slew direction on axis 1 (HA index) and, when
@@ -1195,14 +1190,10 @@ std::string separating(const std::string &a, const std::string &b)
         return "points below 20 deg elevation (cot el grows there while cos el levels off)";
     if (elev && one_is("higher_order"))
         return "low points spread over every azimuth (an elevation effect is the same at all of them)";
-    bool temp = one_is("temperature") || one_is("temperature_collimation");
-    if (elev && temp)
+    if (elev && one_is("temperature"))
         return "one star followed at fixed elevation while the temperature changes";
-    if (pair_is("temperature", "time_drift") || pair_is("temperature_collimation", "time_drift"))
+    if (pair_is("temperature", "time_drift"))
         return "a night whose temperature does not follow the clock, or a second night";
-    if (pair_is("temperature", "temperature_collimation"))
-        return "stars at high and low declination (altitude) on both sides while the temperature "
-               "changes (the collimation's share grows away from the equator)";
     if (one_is("hysteresis"))
         return "the same places approached from both directions";
     if (one_is("ha_periodic") || one_is("dec_periodic"))

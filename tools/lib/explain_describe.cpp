@@ -351,9 +351,6 @@ const char *family_words(const Run &run, const std::string &e, double sign)
                     "azimuth index, as thermal expansion of the tube or the structure moves them"
                   : "the pointing drifts with temperature (arcsec per deg C): thermal expansion "
                     "of the tube or mount";
-    if (e == "temperature_collimation")
-        return "the collimation follows temperature (arcsec per deg C): the optics move in the "
-               "tube as it warms or cools (mirror cell, secondary, focuser)";
     if (e == "time_drift")
         return "the pointing drifts through the night (arcsec per hour): settling, slipping "
                "encoders or a clock error";

@@ -311,11 +311,11 @@ void print_explain_text(const Run &run, const Explanation &ex, int order, bool a
     }
     print_located(ex, alpha, gears_ha, gears_dec, run.mount == PM_MOUNT_ALTAZ);
     print_findings(ex, alpha);
-    std::printf("\n  %-26s %5s %10s %10s\n", "step", "P", "sigma(\")", "CV RMS(\")");
-    std::printf("  %-26s %5d %10.3f %s\n", "baseline", ex.base_n_params, ex.base_sigma_arcsec,
+    std::printf("\n  %-22s %5s %10s %10s\n", "step", "P", "sigma(\")", "CV RMS(\")");
+    std::printf("  %-22s %5d %10.3f %s\n", "baseline", ex.base_n_params, ex.base_sigma_arcsec,
                 cv_cell(ex.base_cv_rms_arcsec).c_str());
     for (const Finding &f : ex.findings)
-        std::printf("  %-26s %5d %10.3f %s\n", ("+ " + f.effect).c_str(), f.n_params_after,
+        std::printf("  %-22s %5d %10.3f %s\n", ("+ " + f.effect).c_str(), f.n_params_after,
                     f.sigma_after_arcsec, cv_cell(f.cv_rms_after_arcsec).c_str());
     const std::vector<std::string> nt = not_tried(run);
     if (!nt.empty())

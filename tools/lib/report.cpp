@@ -511,7 +511,7 @@ double finding_x(const Data &d, const Finding &f, const Obs &o, size_t j, std::s
         *label = "elevation (deg)";
         return where_of(d.run, o).el;
     }
-    if (f.effect == "temperature" || f.effect == "temperature_collimation") {
+    if (f.effect == "temperature") {
         *label = "temperature (\xc2\xb0" "C)";
         return o.ctx.temp_c;
     }
