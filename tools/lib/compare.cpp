@@ -104,9 +104,161 @@ void cross_validate(const pm_model &old_model, const Run &run, double cv[3])
         cv[w] = n[w] ? std::sqrt(ss[w] / (double)n[w]) : NAN;
 }
 
+// d^T C^-1 d over the terms `s` (C row-major, n x n), by Cholesky; NaN
+// where C restricted to them is not positive definite.
+double quad_form(const std::vector<double> &d, const std::vector<double> &C, int n,
+                 const std::vector<int> &s)
+{
+    const size_t m = s.size();
+    std::vector<double> L(m * m, 0.0), y(m, 0.0);
+    for (size_t i = 0; i < m; i++)
+        for (size_t j = 0; j <= i; j++) {
+            double v = C[(size_t)s[i] * (size_t)n + (size_t)s[j]];
+            for (size_t k = 0; k < j; k++)
+                v -= L[i * m + k] * L[j * m + k];
+            if (i == j) {
+                if (!(v > 0))
+                    return NAN;
+                L[i * m + i] = std::sqrt(v);
+            } else {
+                L[i * m + j] = v / L[j * m + j];
+            }
+        }
+    double q = 0;
+    for (size_t i = 0; i < m; i++) {
+        double v = d[(size_t)s[i]];
+        for (size_t k = 0; k < i; k++)
+            v -= L[i * m + k] * y[k];
+        y[i] = v / L[i * m + i];
+        q += y[i] * y[i];
+    }
+    return q;
+}
+
+// The changes of all terms together, and of all but c' and e' (what a
+// re-zero leaves): T = d^T (C_old + C_new)^-1 d, with C from the fits'
+// estimated sigma, so T / k against F(k, nu) (Hotelling's T^2 read as F),
+// nu the residual degrees of freedom of the refit (and of the old fit,
+// the fewer).  (Against chi^2(k), as if sigma were known, unchanged alt-az
+// mounts of 30 stars, nu = 38, got "refit" in 3 of 30 pairs.)  One term at a time, 22 terms at 3 sigma flag one on
+// 6% of unchanged nights, while terms this sky confounds (an alt-az run's
+// c', d and i, correlated -0.9998) can move together by many sigma with
+// none beyond 3 alone (an outside probe: the old model left 14" where a
+// refit leaves 0.89", and the report said "everything else stable").
+// C_old: the old fit's covariance (OLD a run); for a model file, which
+// keeps each coefficient's error but not their correlations, its errors
+// with the refit's correlations shrunk by a tenth toward none (the same
+// terms on a sky like it are correlated alike, but not exactly: with the
+// refit's own, an unchanged alt-az mount's pair of nights of 40 stars read
+// p = 10^-4.8, the old night's nearly degenerate combination of c', d and
+// i lying a little elsewhere; each term's own error says how well the old
+// sky held it); none without errors.
+void joint_tests(const pm_model &old_model, const std::vector<double> &old_err,
+                 const FitOut &f, const FitOut *old_fit, Comparison &c)
+{
+    const int P = old_model.n_terms;
+    if (f.cov.size() != (size_t)(P * P) || P < 6)
+        return;
+    std::vector<double> C = f.cov, d((size_t)P);
+    for (int i = 0; i < P; i++)
+        d[(size_t)i] = f.model.coef[i] - old_model.coef[i];
+    if (old_fit && old_fit->cov.size() == (size_t)(P * P)) {
+        for (size_t k = 0; k < C.size(); k++)
+            C[k] += old_fit->cov[k];
+        c.old_cov = "the old fit's";
+    } else if (old_err.size() >= (size_t)P) {
+        for (int i = 0; i < P; i++)
+            if (!(f.cov[(size_t)(i * P + i)] > 0))
+                return;
+        const double shrink = 0.1; // (toward independent errors: another sky's correlations)
+        for (int i = 0; i < P; i++)
+            for (int j = 0; j < P; j++)
+                C[(size_t)(i * P + j)] +=
+                    old_err[(size_t)i] * old_err[(size_t)j] *
+                    (i == j ? 1.0
+                            : (1 - shrink) * f.cov[(size_t)(i * P + j)] /
+                                  std::sqrt(f.cov[(size_t)(i * P + i)] * f.cov[(size_t)(j * P + j)]));
+        c.old_cov = "the model file's errors, correlated as the refit's terms";
+        c.old_cov_borrowed = true;
+    } else {
+        c.old_cov = "none (the model file keeps no errors)";
+    }
+    std::vector<int> all, rest;
+    for (int i = 0; i < P; i++) {
+        all.push_back(i);
+        if (i != 2 && i != 4) // (c', e')
+            rest.push_back(i);
+    }
+    double nu = (double)(2 * f.res.n_obs - P);
+    if (old_fit && old_fit->cov.size() == (size_t)(P * P))
+        nu = std::min(nu, (double)(2 * old_fit->res.n_obs - P));
+    if (!(nu > 0))
+        return;
+    const double qa = quad_form(d, C, P, all), qr = quad_form(d, C, P, rest), ln10 = std::log(10.0);
+    if (std::isfinite(qa))
+        c.joint_log10p = log_f_tail(qa / P, P, nu) / ln10;
+    if (std::isfinite(qr))
+        c.rest_log10p = log_f_tail(qr / (P - 2), P - 2, nu) / ln10;
+}
+
+std::string p_text(double log10p)
+{
+    return log10p > -3 ? fmt("p = %.2g", std::pow(10.0, log10p)) : fmt("p = 10^%.1f", log10p);
+}
+
 std::string advice_of(const Comparison &c)
 {
-    char b[400];
+    char b[600];
+    const double alpha_log10 = -2; // 1%
+    // (the old model predicting this night far worse than a refit is not
+    // "still holds", whatever the terms' errors say: a model file's
+    // borrowed correlations cannot show terms this sky confounds moving as
+    // one, the old run's covariance can)
+    const bool far_worse = c.cv_as_is > 2 * c.cv_refit;
+    if (std::isfinite(c.joint_log10p) && std::isfinite(c.rest_log10p) &&
+        !(c.joint_log10p >= alpha_log10 && far_worse)) {
+        if (c.joint_log10p >= alpha_log10) {
+            std::string single;
+            if (!c.moved.empty())
+                single = fmt("; %s alone moved %.1f sigma, within what testing %d terms gives by "
+                             "chance",
+                             c.moved[0].name.c_str(), std::fabs(c.moved[0].z), c.n_terms);
+            std::snprintf(b, sizeof b, "the model still holds: its %d terms together have not "
+                                       "moved beyond both fits' errors (joint test, %s)%s; "
+                                       "cross-validated %.3g\" as is, %.3g\" refitted",
+                          c.n_terms, p_text(c.joint_log10p).c_str(), single.c_str(), c.cv_as_is,
+                          c.cv_refit);
+        } else if (c.rest_log10p >= alpha_log10) {
+            std::snprintf(b, sizeof b, "re-zero the index terms (c' %+.2f\", e' %+.2f\"): the "
+                                       "terms moved together (joint test, %s), but beyond the "
+                                       "indices not (%s); cross-validated %.3g\" re-zeroed, "
+                                       "%.3g\" refitted, %.3g\" as is",
+                          c.rezero_c, c.rezero_e, p_text(c.joint_log10p).c_str(),
+                          p_text(c.rest_log10p).c_str(), c.cv_rezero, c.cv_refit, c.cv_as_is);
+        } else {
+            std::snprintf(b, sizeof b, "refit: terms beyond the indices moved (joint test, %s); "
+                                       "a re-zero of the index terms leaves %.3g\" where a full "
+                                       "refit predicts %.3g\" (cross-validated; as is %.3g\")",
+                          p_text(c.rest_log10p).c_str(), c.cv_rezero, c.cv_refit, c.cv_as_is);
+        }
+        std::string a = b;
+        if (c.old_cov_borrowed && c.joint_log10p < alpha_log10)
+            a += "; the model file keeps its terms' errors but not their correlations, taken "
+                 "here from the refit: where the two nights saw different parts of the sky, "
+                 "compare with the old run itself (pmfit compare OLD_RUN RUN), whose "
+                 "covariance is known";
+        return a;
+    }
+    std::string pre;
+    if (std::isfinite(c.joint_log10p) && far_worse)
+        pre = fmt("the terms are within their errors (joint test, %s), yet the old model predicts "
+                  "this night far worse than a refit (cross-validated %.3g\" against %.3g\")%s: ",
+                  p_text(c.joint_log10p).c_str(), c.cv_as_is, c.cv_refit,
+                  c.old_cov_borrowed ? "; terms this sky confounds can move as one, which a "
+                                       "model file's errors without their correlations cannot "
+                                       "show (compare with the old run itself, whose covariance "
+                                       "is known)"
+                                     : "");
     if (c.moved.empty() && c.cv_as_is <= 1.05 * c.cv_refit) {
         std::snprintf(b, sizeof b, "the model still holds: no term moved beyond 3 sigma and it "
                                    "predicts this night as well as a refit would (%.3g\" vs %.3g\")",
@@ -121,7 +273,7 @@ std::string advice_of(const Comparison &c)
                                    "refit predicts %.3g\" (cross-validated; as is %.3g\")",
                       c.cv_rezero, c.cv_refit, c.cv_as_is);
     }
-    return b;
+    return pre + b;
 }
 
 } // namespace
@@ -234,6 +386,7 @@ Comparison compare_models(const pm_model &old_in, const std::vector<double> &old
         c.old_pred_new = predicted_over(*old_fit, run);
         c.old_pred_old = predicted_over(*old_fit, *old_run);
     }
+    joint_tests(old_model, old_err, f, old_fit, c);
     c.advice = advice_of(c);
     if (std::isfinite(c.old_pred_new) && c.old_pred_new > 2 * c.old_pred_old &&
         c.old_pred_new > c.sigma_refit) {
@@ -272,7 +425,8 @@ std::string comparison_json(const Comparison &c)
          num(c.rezero_e) + ", \"e_error_arcsec\": " + num(c.rezero_e_err) +
          "}, \"cv_rms_arcsec\": {\"as_is\": " + num(c.cv_as_is) + ", \"rezero\": " +
          num(c.cv_rezero) + ", \"refit\": " + num(c.cv_refit) +
-         "}, \"old_predicted_sigma_arcsec\": {\"at_new_points\": " + num(c.old_pred_new) +
+         "}, \"joint_log10_p\": " + num(c.joint_log10p) + ", \"rest_log10_p\": " +
+         num(c.rest_log10p) + ", \"old_predicted_sigma_arcsec\": {\"at_new_points\": " + num(c.old_pred_new) +
          ", \"at_old_points\": " + num(c.old_pred_old) + "}, \"advice\": \"" +
          json_escape(c.advice) + "\", \"notes\": [";
     for (size_t k = 0; k < c.notes.size(); k++)
@@ -297,7 +451,20 @@ void print_comparison(const Comparison &c, const std::string &old_name, const st
         std::printf("    %-14s %-36s %+10.2f\" -> %+10.2f\": moved %+8.2f\" +- %.2f\" (%.1f sigma)\n",
                     t.name.c_str(), t.meaning.c_str(), t.old_arcsec, t.new_arcsec,
                     t.new_arcsec - t.old_arcsec, t.err_arcsec, std::fabs(t.z));
-    std::printf("    everything else stable (%d terms)\n", c.n_stable);
+    const bool together = std::isfinite(c.joint_log10p) && c.joint_log10p < -2;
+    if (together)
+        std::printf("    the other %d terms each within 3 sigma\n", c.n_stable);
+    else
+        std::printf("    everything else stable (%d terms)\n", c.n_stable);
+    if (std::isfinite(c.joint_log10p))
+        std::printf("  all terms together: %s (joint test of their changes, %s; the old "
+                    "covariance: %s)%s\n",
+                    together ? "moved" : "not moved", p_text(c.joint_log10p).c_str(),
+                    c.old_cov.c_str(),
+                    c.joint_log10p < -2 && c.moved.empty()
+                        ? ": no one term beyond 3 sigma, but together they are; terms this "
+                          "sky confounds moved as one"
+                        : "");
     std::printf("\n  re-zero (only c' and e' refitted): c' %+.2f\" +- %.2f\", e' %+.2f\" +- %.2f\"\n",
                 c.rezero_c, c.rezero_c_err, c.rezero_e, c.rezero_e_err);
     std::printf("  cross-validated RMS per axis (5-fold): as is %.3f\", re-zero %.3f\", full refit "

@@ -33,6 +33,13 @@ struct Comparison {
     // OLD a run: the old fit's predicted error (pm_fit_pointing_sigma) at
     // the new run's points and at its own; NaN for a model file
     double old_pred_new = NAN, old_pred_old = NAN;
+    // The joint test of the changes (NaN where not made): log10 of the
+    // chance of so large a change of all terms together, and of all but
+    // c' and e' (what a re-zero leaves), with both fits' errors
+    // (compare.cpp, joint_tests); old_cov: how the old covariance was had
+    double joint_log10p = NAN, rest_log10p = NAN;
+    std::string old_cov;
+    bool old_cov_borrowed = false; // a model file's errors with the refit's correlations
     std::string advice;
     std::vector<std::string> notes; // how the run was read for the old model (run_for_model)
     pm_model refit, rezeroed;
