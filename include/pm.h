@@ -573,8 +573,13 @@ pm_status pm_model_apply(const pm_model *m, const pm_context *ctx,
 **     1,200,000 cold calls within 0.5 deg of the mount's pole, down to its
 **     very edge, did not (both where d and i nearly cancel at that pole;
 **     bench/inv_stress.c; tests/check_bounded.c asserts 48,000 calls, all
-**     PM_OK).  For tracking use pm_model_invert_near, which never needs the
-**     rescue (at most 13).
+**     PM_OK).  An outside probe's 2,400,000 such calls (its own random
+**     models, isotropic terms within 1 deg) found 4 more, 0.017-0.028 deg
+**     from the pole where d and i do not cancel: PM_WARN_UNREACHABLE with
+**     the position returned 1.8-7" off, for targets pm_model_invert_near
+**     reaches from a start 1e-3 rad away (the rescue's 12 samples missed
+**     the pair of close roots; not fixed).  For tracking use
+**     pm_model_invert_near, which never needs the rescue (at most 13).
 **  3) PM_WARN_NOT_CONVERGED: a bound was reached; the best position found
 **     is returned.  PM_WARN_UNREACHABLE: no position on the requested side
 **     points at the target: it lies in the cap around the mount's pole
