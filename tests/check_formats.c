@@ -313,6 +313,15 @@ START_TEST(test_pmrun_read_csv_sides_as_numbers)
     csv_sides(path, "+1", "0");
     tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, line_e, "mixed");
     unlink(path);
+    /* -1 alone: pm's beyond the pole, with a note that ASCOM's -1 is pierUnknown
+    ** (it was read so silently) */
+    csv_sides(path, "-1", NULL);
+    run = NULL;
+    ck_assert_msg(pmrun_read(path, NULL, &run, err, sizeof err) == PMRUN_OK, "%s", err);
+    ck_assert_int_eq(count_west(run), (int)pmrun_count(run));
+    ck_assert_ptr_nonnull(strstr(pmrun_warning(run, pmrun_n_warnings(run) - 1), "-1 pierUnknown"));
+    pmrun_free(run);
+    unlink(path);
     /* 1 alone: read as pm's +1, with a note that ASCOM's 1 is pierWest */
     csv_sides(path, "1", NULL);
     run = NULL;
@@ -379,6 +388,20 @@ START_TEST(test_pmrun_read_csv_units_in_names)
         unlink(path);
     }
     pmrun_free(words);
+    /* hours written with their letters under a header in degrees: refused
+    ** (read as degrees: sigma 14" for 0.5", an outside probe) */
+    {
+        static const char text[] = "# equinox: JNow\n# refraction: no\n"
+                                   "LST;RA (deg);Dec;SolvedRA (deg);SolvedDec;SideOfPier\n"
+                                   "8.86;2h45m30.357s;63.97;2h45m19.878s;63.98;West\n";
+        strcpy(path, "/tmp/pm_units_XXXXXX");
+        fd = mkstemp(path);
+        ck_assert_int_ge(fd, 0);
+        ck_assert_int_eq(write(fd, text, sizeof text - 1), (long)(sizeof text - 1));
+        close(fd);
+        tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 4, "written in hours, but the header names");
+        unlink(path);
+    }
 }
 END_TEST
 

@@ -806,10 +806,34 @@ END_TEST
 START_TEST(test_pmrun_read_invalid_date) { expect_error("bad_date.dat", 3, "2023 13 1 is not a valid date"); }
 END_TEST
 
-/* 23 for 2023 was read as 23 AD: 2,000 years of precession (an outside probe) */
+/* 23 for 2023 was read as 23 AD: 2,000 years of precession (an outside probe);
+** an alt-az file's records are not reduced: its year is not checked */
 START_TEST(test_pmrun_read_two_digit_year)
 {
+    char src[4096], path[64], line[1024], err[512];
+    FILE *in, *o;
+    int fd;
+    pmrun *run = NULL;
     expect_error("bad_year_two_digits.dat", 3, "expected the year in full (2023, not 23)");
+    data_path(src, sizeof src, "tpoint_altaz.dat");
+    strcpy(path, "/tmp/check_runfile_XXXXXX");
+    fd = mkstemp(path);
+    ck_assert_int_ge(fd, 0);
+    in = fopen(src, "r");
+    o = fdopen(fd, "w");
+    ck_assert_ptr_nonnull(in);
+    ck_assert_ptr_nonnull(o);
+    while (fgets(line, sizeof line, in)) {
+        char *y = strstr(line, " 2021 8 21 "); /* the run line's date */
+        if (y)
+            memmove(y + 1, y + 3, strlen(y + 3) + 1); /* 2021 -> 21 */
+        fputs(line, o);
+    }
+    fclose(in);
+    ck_assert_int_eq(fclose(o), 0);
+    ck_assert_msg(pmrun_read(path, NULL, &run, err, sizeof err) == PMRUN_OK, "%s", err);
+    pmrun_free(run);
+    remove(path);
 }
 END_TEST
 
@@ -850,6 +874,34 @@ START_TEST(test_pmrun_read_time_past_midnight)
     ck_assert_int_ge(find_warning(run, ":3:", "read as given"), 0);
     pmrun_free(run);
     remove(path);
+    /* a time of 23:59:53 written 24.00; a clock set back a minute; newest first */
+    {
+        static const char edge[] = "# tau delta T D time\n"
+                                   "10 20 10.1 20.1 23.50\n"
+                                   "20 30 20.1 30.1 24.00\n"
+                                   "30 40 30.1 40.1 23.98\n"
+                                   "40 50 40.1 50.1 0.25\n";
+        static const char newest[] = "# tau delta T D time\n"
+                                     "10 20 10.1 20.1 1.50\n"
+                                     "20 30 20.1 30.1 0.25\n"
+                                     "30 40 30.1 40.1 23.75\n"
+                                     "40 50 40.1 50.1 22.00\n";
+        temp_file(path, sizeof path, edge, sizeof edge - 1);
+        ck_assert_msg(pmrun_read(path, NULL, &run, err, sizeof err) == PMRUN_OK, "%s", err);
+        ck_assert_double_eq(pmrun_get(run, 1)->time_h, 24.00);
+        ck_assert_double_eq(pmrun_get(run, 3)->time_h, 24.25);
+        ck_assert_int_ge(find_warning(run, ":5:", "passing midnight"), 0);
+        pmrun_free(run);
+        remove(path);
+        temp_file(path, sizeof path, newest, sizeof newest - 1);
+        ck_assert_msg(pmrun_read(path, NULL, &run, err, sizeof err) == PMRUN_OK, "%s", err);
+        ck_assert_double_eq(pmrun_get(run, 0)->time_h, 25.50);
+        ck_assert_double_eq(pmrun_get(run, 1)->time_h, 24.25);
+        ck_assert_double_eq(pmrun_get(run, 2)->time_h, 23.75);
+        ck_assert_int_ge(find_warning(run, ":4:", "newest first"), 0);
+        pmrun_free(run);
+        remove(path);
+    }
     temp_file(path, sizeof path, continued, sizeof continued - 1); /* beyond 24: as given */
     ck_assert_msg(pmrun_read(path, NULL, &run, err, sizeof err) == PMRUN_OK, "%s", err);
     ck_assert_double_eq(pmrun_get(run, 1)->time_h, 24.10);

@@ -975,13 +975,16 @@ void score(const Run &run, const State &st, std::vector<Candidate> &cands, doubl
 // Is a family's value determined beside the model's harmonics of order >= 2?
 // Its terms' 1-sigma errors in the candidate's fit against their errors in
 // the same family at order 1: where the ratio passes kMaxBlur (a variance
-// inflation of 900), the harmonics nearly hold the family's shape on this
+// inflation of 25), the harmonics largely hold the family's shape on this
 // sky, and its fitted value is a balance between them, not a measurement
 // (a real German run with an HA worm injected, at order 4: refraction named
 // at 97,779" +- 31,973", 27 deg, at false-alarm 0.0065, its coefficient 340
-// times its error at order 1).  Such a candidate is not taken; the step
-// says so (Explanation::blurred).
-const double kMaxBlur = 30;
+// times its error at order 1; with 30 as the bound, gem-28 at order 3
+// still named refraction at 5206" +- 1838" and, with a worm injected,
+// 10,199" +- 848", 9 and 20 times their errors at order 1: a family whose
+// error grows 5 times is significant only at sizes no mount has).  Such a
+// candidate is not taken; the step says so (Explanation::blurred).
+const double kMaxBlur = 5;
 
 bool separable(const Run &run, const State &st, Candidate &c)
 {
@@ -1533,6 +1536,21 @@ bool step(const Run &run, State &st, const ExplainOptions &opt, Explanation &ex)
     const double K = step_tests(cands, opt);
     score(run, st, cands, K);
     int k = choose(run, st, cands, opt);
+    // a candidate whose fit did not converge is not judged: said, so that a
+    // reading that depends on it is seen to (a real German run's order 3
+    // predicted better than the step's choice, but its fit crept along a
+    // valley: the explanation then differed with a perfectly modelled
+    // effect injected, which let it converge; an outside probe)
+    for (const Candidate &c : cands)
+        if (!c.fit.ok && c.fit.f.status == PM_ERR_DIVERGED && c.effect != "outlier" &&
+            std::none_of(ex.unfitted.begin(), ex.unfitted.end(),
+                         [&](const Explanation::Unfitted &u) { return u.effect == c.effect; })) {
+            Explanation::Unfitted u;
+            u.effect = c.effect;
+            u.step = ex.findings.empty() ? 1 : ex.findings.back().step + 1;
+            u.order = c.order;
+            ex.unfitted.push_back(u);
+        }
     for (const Candidate &c : cands)
         if (c.blur > 0 && std::none_of(ex.blurred.begin(), ex.blurred.end(),
                                        [&](const Explanation::Blurred &b) { return b.effect == c.effect; })) {

@@ -149,6 +149,11 @@ struct Explanation {
         double error_arcsec = 0, error_order1_arcsec = 0;
     };
     std::vector<Blurred> blurred;
+    struct Unfitted {                    // a candidate whose fit did not converge: not
+        std::string effect;              // judged at that step (its first)
+        int step = 0, order = 0;
+    };
+    std::vector<Unfitted> unfitted;
 };
 
 // The pipeline: baseline -> locate -> candidates -> select (singles, then
@@ -169,6 +174,8 @@ std::string explain_json(const Run &run, const Explanation &ex, int order);
 std::vector<std::string> not_tried(const Run &run);
 // "significant, not modelled" in words: its sizes and what would fit it.
 std::string unmodelled_text(const Unmodelled &u);
+// A candidate whose fit did not converge, in words.
+std::string unfitted_text(const Explanation::Unfitted &u);
 // A family significant at a step but not separable from its harmonics, in words.
 std::string blurred_text(const Explanation::Blurred &b);
 void print_explain_text(const Run &run, const Explanation &ex, int order, bool added,

@@ -144,6 +144,11 @@ std::string explain_json(const Run &run, const Explanation &ex, int order)
              num(u.sigma_before_arcsec) + ", \"cv_before_arcsec\": " +
              num(u.cv_before_arcsec) + "}";
     }
+    j += "], \"not_converged\": [";
+    for (size_t i = 0; i < ex.unfitted.size(); i++)
+        j += std::string(i ? ", " : "") + "{\"effect\": " + str(ex.unfitted[i].effect) +
+             ", \"step\": " + std::to_string(ex.unfitted[i].step) + ", \"order\": " +
+             std::to_string(ex.unfitted[i].order) + "}";
     j += "], \"not_separable\": [";
     for (size_t i = 0; i < ex.blurred.size(); i++) {
         const Explanation::Blurred &b = ex.blurred[i];
@@ -207,12 +212,12 @@ std::string cv_cell(double x)
 void print_findings(const Explanation &ex, double alpha)
 {
     std::printf("\nfindings:\n");
-    if (ex.findings.empty() && ex.unmodelled.empty())
+    if (ex.findings.empty() && ex.unmodelled.empty() && ex.blurred.empty() && ex.unfitted.empty())
         std::printf("  none: nothing significant is left out (false-alarm probability below %g "
                     "and a better cross-validated RMS were required)\n",
                     alpha);
     else if (ex.findings.empty())
-        std::printf("  none that this run can model (false-alarm probability below %g and a "
+        std::printf("  none named (false-alarm probability below %g and a "
                     "better cross-validated RMS were required); but see below\n",
                     alpha);
     for (size_t i = 0; i < ex.findings.size(); i++) {
@@ -261,9 +266,19 @@ void print_findings(const Explanation &ex, double alpha)
         std::printf("  significant, not modelled: %s\n", unmodelled_text(u).c_str());
     for (const Explanation::Blurred &b : ex.blurred)
         std::printf("  significant, not named: %s\n", blurred_text(b).c_str());
+    for (const Explanation::Unfitted &u : ex.unfitted)
+        std::printf("  not judged: %s\n", unfitted_text(u).c_str());
 }
 
 } // namespace
+
+std::string unfitted_text(const Explanation::Unfitted &u)
+{
+    return fmt("%s%s at step %d: its fit did not converge, so the step chose without it (a "
+               "reading of this run may change where it does)",
+               u.effect.c_str(),
+               u.effect == "higher_order" ? fmt(" (order %d)", u.order).c_str() : "", u.step);
+}
 
 std::string blurred_text(const Explanation::Blurred &b)
 {

@@ -672,6 +672,8 @@ void explain_findings(Page &p, const Data &d)
         para(p, "<b>Significant, not modelled:</b> " + h(unmodelled_text(u)) + ".");
     for (const Explanation::Blurred &b : ex.blurred)
         para(p, "<b>Significant, not named:</b> " + h(blurred_text(b)) + ".");
+    for (const Explanation::Unfitted &u : ex.unfitted)
+        para(p, "<b>Not judged:</b> " + h(unfitted_text(u)) + ".");
 }
 
 void section_explain(Page &p, const Data &d)

@@ -41,8 +41,11 @@ bool valid_aux_name(const std::string &s) { return pmhost::valid_column_name(s);
 // records after the step continued by 24 h where the times otherwise run
 // forward as one night does (the drift and explain's time terms read the
 // time as a number: a night from 20 h to 4 h written modulo 24 read a
-// drift of +3"/h as -0.54"/h), with a note; a note where the times step
-// back or leap half a day besides.
+// drift of +3"/h as -0.54"/h), with a note; likewise a run written newest
+// first (the records before the leap forward).  Steps back of minutes (a
+// clock set) are allowed; a note where the times step back by more, or
+// leap half a day more than once.  Clock hours are 0..24 (a time of 23:59:53
+// written to two decimals is 24.00).
 void continue_past_midnight(Context &ctx, pmrun *run)
 {
     std::vector<size_t> at;
@@ -53,33 +56,46 @@ void continue_past_midnight(Context &ctx, pmrun *run)
             lo = std::min(lo, run->obs[i].time_h);
             hi = std::max(hi, run->obs[i].time_h);
         }
-    if (at.size() < 2 || !(lo >= 0 && hi < 24)) // not hours of a clock
+    if (at.size() < 2 || !(lo >= 0 && hi <= 24)) // not hours of a clock
         return;
-    size_t wraps = 0, back = 0, first = 0;
+    const double kClockSet = 0.5; // h: a step back this small is the clock, not the order
+    size_t down = 0, up = 0, first_down = 0, first_up = 0, back = 0, fwd = 0, first_odd = 0;
     for (size_t k = 1; k < at.size(); k++) {
         double step = run->obs[at[k]].time_h - run->obs[at[k - 1]].time_h;
         if (step < -12) {
-            if (!wraps++) first = k;
-        } else if (step < 0 || step > 12) { // (a jump forward of half a day: not one night)
-            back++;
+            if (!down++) first_down = k;
+        } else if (step > 12) {
+            if (!up++) first_up = k;
+        } else if (step < -kClockSet) {
+            if (!back++ && !fwd) first_odd = k;
+        } else if (step > kClockSet) {
+            if (!fwd++ && !back) first_odd = k;
         }
     }
-    if (!wraps)
+    if (!down && !up)
         return;
-    const pmrun_obs &w = run->obs[at[first]], &b = run->obs[at[first - 1]];
-    if (wraps == 1 && !back) {
-        ctx.warn(w.line, "time: %.4g h after %.4g h (line %d): read as a clock passing midnight, "
-                 "this record and the %zu after it 24 h on (%.4g h); write the time continued "
-                 "(24.5 for 00:30) and there is nothing to guess",
-                 w.time_h, b.time_h, b.line, at.size() - 1 - first, w.time_h + 24);
-        for (size_t k = first; k < at.size(); k++)
-            run->obs[at[k]].time_h += 24;
+    // one night in order: one leap, and the other steps all the other way
+    const bool forward = down == 1 && !up && !back, reverse = up == 1 && !down && !fwd;
+    const size_t k = forward ? first_down : first_up;
+    const pmrun_obs &w = run->obs[at[k]], &b = run->obs[at[k - 1]];
+    if (forward || reverse) {
+        const size_t from = forward ? k : 0, to = forward ? at.size() : k;
+        ctx.warn(w.line, "time: %.4g h after %.4g h (line %d): read as a clock passing midnight%s, "
+                 "the %zu records %s it 24 h on; write the time continued (24.5 for 00:30) and "
+                 "there is nothing to guess",
+                 w.time_h, b.time_h, b.line, forward ? "" : " (the run written newest first)",
+                 to - from, forward ? "from" : "before");
+        for (size_t q = from; q < to; q++)
+            run->obs[at[q]].time_h += 24;
         return;
     }
-    ctx.warn(w.line, "time: %.4g h after %.4g h (line %d), and the times step back or leap "
-             "half a day %zu times in all: not read as a clock passing midnight, read as given (write a clock "
-             "time that passes midnight continued, 24.5 for 00:30)",
-             w.time_h, b.time_h, b.line, wraps + back);
+    const size_t odd = first_odd ? first_odd : (down ? first_down : first_up);
+    const pmrun_obs &o = run->obs[at[odd]], &p = run->obs[at[odd - 1]];
+    ctx.warn(o.line, "time: %.4g h after %.4g h (line %d): the times are not one night in order "
+             "(%zu leaps of half a day, %zu steps of more than %g h against the rest): not read "
+             "as a clock passing midnight, read as given (write a clock time that passes "
+             "midnight continued, 24.5 for 00:30)",
+             o.time_h, p.time_h, p.line, down + up, down ? back : fwd, kClockSet);
 }
 
 class ColumnParser : public FormatParser {

@@ -384,6 +384,12 @@ private:
                 double a;
                 if (hours && deg_[i]) { // (the header says degrees)
                     std::string w;
+                    if (v.find_first_of("hH") != std::string::npos)
+                        return ctx_.bad_record(n, format("field %zu (%s) '%s': written in hours, "
+                                                         "but the header names the column in "
+                                                         "degrees",
+                                                         i + 1, col_title(cols_[i]),
+                                                         excerpt(v).c_str()));
                     if (!parse_sexagesimal(v, a, w))
                         return ctx_.bad_record(n, format("field %zu (%s) '%s': %s", i + 1,
                                                          col_title(cols_[i]), excerpt(v).c_str(),
@@ -441,6 +447,10 @@ private:
                 if (!parse_sexagesimal(v, r.lst_h, w))
                     return ctx_.bad_record(n, format("field %zu (LST) '%s': %s", i + 1,
                                                      excerpt(v).c_str(), w.c_str()));
+                if (deg_[i] && v.find_first_of("hH") != std::string::npos)
+                    return ctx_.bad_record(n, format("field %zu (LST) '%s': written in hours, but "
+                                                     "the header names the column in degrees",
+                                                     i + 1, excerpt(v).c_str()));
                 if (deg_[i]) {
                     if (!(r.lst_h >= 0 && r.lst_h < 360))
                         return ctx_.bad_record(n, format("field %zu (LST) '%s': out of range, "
@@ -629,10 +639,14 @@ private:
                 if (r.pier_number) r.pier = r.pier_number == '1' ? PMRUN_PIER_WEST : PMRUN_PIER_EAST;
             ctx_.warn(zero->line, "pier sides as numbers with a 0: read as ASCOM's SideOfPier "
                                   "(0 pierEast, the normal side; 1 pierWest, beyond the pole)");
-        } else if (one && !plus && !minus) {
-            ctx_.warn(one->line, "every pier side given as a number is 1: read as +1, the normal "
-                                 "side (pierEast); in ASCOM's SideOfPier numbers 1 is pierWest, "
-                                 "beyond the pole: if the log writes those, write East/West");
+        } else if (one || minus) {
+            // (pm's numbers, which ASCOM's read otherwise: 1 is pierWest, -1
+            // pierUnknown; a log of -1 alone was read beyond the pole silently)
+            const Row *first = one && (!minus || one->line < minus->line) ? one : minus;
+            ctx_.warn(first->line, "pier sides as the numbers 1 and -1 without a 0: read as pm's "
+                                   "(+1 the normal side, -1 beyond the pole); in ASCOM's "
+                                   "SideOfPier numbers 1 is pierWest and -1 pierUnknown: if the "
+                                   "log writes those, write East/West");
         }
         return true;
     }

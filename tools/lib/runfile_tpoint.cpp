@@ -230,11 +230,12 @@ private:
             // (a year of two digits, 23 for 2023, was read as 23 AD: 2,000
             // years of precession on every catalogue place, under a note that
             // only TAI-UTC was a guess)
-            if (v[3] < 1000)
+            // (alt-az records are not reduced: the date is not used there)
+            if (v[3] < 1000 && mount_ == PMRUN_MOUNT_EQUATORIAL)
                 return ctx_.fail(n, "run line field 4 (year) '%s': expected the year in full "
                                     "(2023, not 23): the catalogue places are reduced to the date",
                                  tok[3].c_str());
-            if (v[3] < 1900 || v[3] > 2200)
+            if ((v[3] < 1900 || v[3] > 2200) && mount_ == PMRUN_MOUNT_EQUATORIAL)
                 ctx_.warn(n, "run line year %s: the catalogue places are reduced to that date; "
                              "is it the year of the observations?",
                           tok[3].c_str());
