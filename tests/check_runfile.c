@@ -937,6 +937,17 @@ START_TEST(test_pmrun_read_pier_other_way_round)
     temp_file(path, sizeof path, both, sizeof both - 1);
     tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 3, "does not follow the encoder");
     remove(path);
+    {   /* W only, within +-90: the run cannot say which is right; said */
+        static const char w_only[] = "# tau delta T D pier\n"
+                                     "20 30 20.1 30.1 W\n"
+                                     "40 10 40.1 10.1 W\n";
+        temp_file(path, sizeof path, w_only, sizeof w_only - 1);
+        ck_assert_msg(pmrun_read(path, NULL, &run, err, sizeof err) == PMRUN_OK, "%s", err);
+        ck_assert_int_eq(pmrun_get(run, 0)->pier, PMRUN_PIER_WEST);
+        ck_assert_int_ge(find_warning(run, ":2:", "every record is pier W"), 0);
+        pmrun_free(run);
+        remove(path);
+    }
 }
 END_TEST
 

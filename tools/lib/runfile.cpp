@@ -725,6 +725,16 @@ bool check_conventions(Context &ctx)
                             "column does not follow the encoder (E: the normal side, W: beyond "
                             "the pole)",
                             side[1]->enc_dec / kDeg, side[0]->line, side[0]->enc_dec / kDeg);
+        // W only, every encoder dec within +-90: the label and the encoder
+        // disagree, and the run cannot say which is right (a sky position
+        // folded back, or the sides named the other way round): said
+        if (!side[0] && side[1] && !w_beyond)
+            ctx.warn(side[1]->line,
+                     "every record is pier W (beyond the pole) with its encoder declination "
+                     "within +-90 deg: the sky position folded back (ASCOM's pierWest: give the "
+                     "mount's axes, dec beyond +-90), or the pier column names the sides the "
+                     "other way round; read as written, which the fit cannot check (the signs "
+                     "of d, e' and i follow the side)");
         if (e_beyond) {
             for (pmrun_obs &o : ctx.run()->obs)
                 if (o.pier != PMRUN_PIER_UNKNOWN)
