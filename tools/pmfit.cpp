@@ -696,10 +696,20 @@ Options parse_args(int argc, char **argv)
         std::exit(2);
     }
     o.cmd = argv[1];
+    auto known = [](const std::string &c) {
+        return c == "fit" || c == "simulate" || c == "eval" || c == "explain" || c == "compare" ||
+               c == "plan" || c == "report";
+    };
     if (o.cmd == "-h" || o.cmd == "--help" || o.cmd == "help") {
-        usage(stdout);
+        if (argc > 2 && known(argv[2])) // pmfit help CMD
+            usage_of(argv[2]);
+        else
+            usage(stdout);
         std::exit(0);
     }
+    if (!known(o.cmd))
+        die("unknown command '" + o.cmd +
+            "' (expected: fit, explain, eval, compare, plan, report or simulate); see pmfit --help");
     for (int i = 2; i < argc; i++)
         if (!std::strcmp(argv[i], "--help") || !std::strcmp(argv[i], "-h")) {
             usage_of(o.cmd);
@@ -707,10 +717,6 @@ Options parse_args(int argc, char **argv)
         }
     if (o.cmd == "report")
         return parse_report(o, argc, argv);
-    if (o.cmd != "fit" && o.cmd != "simulate" && o.cmd != "eval" && o.cmd != "explain" &&
-        o.cmd != "compare" && o.cmd != "plan")
-        die("unknown command '" + o.cmd +
-            "' (expected: fit, explain, eval, compare, plan, report or simulate); see pmfit --help");
     const Cmd c = {o.cmd == "simulate", o.cmd == "eval", o.cmd == "explain", o.cmd == "compare",
                    o.cmd == "plan"};
     Args g = {argc, argv, 2, std::string()};

@@ -71,9 +71,10 @@ int nearest_side(const Run &run, const FitOut &f, double ha, double dec)
 // (its default --meridian-limit of 15 deg): beyond the limit the side the
 // run's own points there vote for (ASCOM's, the normal side looking west,
 // without any), within it the side of the nearest star.  A run all on the
-// normal side, or without pier sides, with points beyond the limit on both
-// sides of the meridian is of a mount that does not flip (nearest star
-// everywhere).  Before, every place took the side of its nearest star: a
+// normal side, or without pier sides, is taken as a mount that does not
+// flip (nearest star everywhere: a fork, or a German mount whose run never
+// flipped, for which the map may then be too kind where it would).
+// Before, every place took the side of its nearest star: a
 // run all east of the meridian, beyond the pole, mapped the west sky on
 // the side the mount cannot use there (1.8" RMS over the sky where that
 // side's own covariance gives 24").
@@ -87,20 +88,21 @@ const double MERIDIAN_LIMIT_DEG = 15;
 SideRule side_rule(const Run &run, const FitOut &f)
 {
     SideRule r;
-    long vote = 0, east = 0, west = 0, flipped = 0;
+    long vote = 0, flipped = 0;
     for (int i : f.idx) {
         const Obs &o = run.obs[i];
         double x = std::remainder(o.ah, 2 * PI) / DEG;
         int side = o.pier < 0 ? -1 : 1;
         flipped += side < 0;
-        if (std::fabs(x) > MERIDIAN_LIMIT_DEG) {
+        if (std::fabs(x) > MERIDIAN_LIMIT_DEG)
             vote += (x > 0 ? 1 : -1) * side;
-            if (side > 0)
-                (x > 0 ? west : east)++;
-        }
     }
-    const long far = east + west;
-    r.flips = !(flipped == 0 && east >= 3 && west >= 3 && 10 * std::min(east, west) >= far);
+    // A run with no point beyond the pole may be of a fork (or a German
+    // mount that never flipped): each place then takes its nearest star's
+    // side, as before (the side rule put a fork's unsampled west on the
+    // side it never uses: 32" predicted where the fit errs by 4.2", an
+    // outside probe); a point beyond the pole says the mount flips.
+    r.flips = flipped > 0;
     r.normal_west = vote < 0 ? -1 : 1;
     return r;
 }

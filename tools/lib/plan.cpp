@@ -609,6 +609,7 @@ Plan plan_targets(const Run &taken, const PlanOptions &opt)
     check_determinable(m, sky);
     // a star listed twice (within 1") is a candidate once: it was proposed
     // twice, the second time with a "predicted" gain of its own
+    plan.n_catalogue = (int)o.stars.size(); // (the stars read)
     {
         std::vector<CatalogueStar> once;
         std::string same;
@@ -637,7 +638,6 @@ Plan plan_targets(const Run &taken, const PlanOptions &opt)
     }
     std::vector<SkyPlace> cand = o.stars.empty() ? sky_places(o, o.grid_deg, done, ctx)
                                                  : star_places(o, done, ctx);
-    plan.n_catalogue = (int)o.stars.size();
     if (cand.empty())
         throw std::runtime_error(
             o.stars.empty() ? "plan: no candidate on the " + std::to_string(o.grid_deg) +
