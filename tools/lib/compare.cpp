@@ -140,8 +140,9 @@ double quad_form(const std::vector<double> &d, const std::vector<double> &C, int
 // estimated sigma, so T / k against F(k, nu) (Hotelling's T^2 read as F),
 // nu the residual degrees of freedom of the refit (and of the old fit,
 // the fewer).  (Against chi^2(k), as if sigma were known, unchanged alt-az
-// mounts of 30 stars, nu = 38, got "refit" in 3 of 30 pairs.)  One term at a time, 22 terms at 3 sigma flag one on
-// 6% of unchanged nights, while terms this sky confounds (an alt-az run's
+// mounts of 30 stars, nu = 38, got "refit" in 3 of 30 pairs.)  One term at
+// a time, 22 terms at 3 sigma flag one on 6% of unchanged nights, while
+// terms this sky confounds (an alt-az run's
 // c', d and i, correlated -0.9998) can move together by many sigma with
 // none beyond 3 alone (an outside probe: the old model left 14" where a
 // refit leaves 0.89", and the report said "everything else stable").
@@ -477,11 +478,13 @@ void print_comparison(const Comparison &c, const std::string &old_name, const st
     if (std::isfinite(c.joint_log10p))
         std::printf("  all terms together: %s (joint test of their changes, %s; the old "
                     "covariance: %s)%s\n",
-                    together ? "moved" : "not moved", p_text(c.joint_log10p).c_str(),
-                    c.old_cov.c_str(),
-                    c.joint_log10p < -2 && c.moved.empty()
+                    !together               ? "not moved"
+                    : c.old_cov_borrowed ? "differ from the model file's beyond its errors"
+                                         : "moved",
+                    p_text(c.joint_log10p).c_str(), c.old_cov.c_str(),
+                    together && c.moved.empty()
                         ? ": no one term beyond 3 sigma, but together they are; terms this "
-                          "sky confounds moved as one"
+                          "sky confounds changed as one"
                         : "");
     std::printf("\n  re-zero (only c' and e' refitted): c' %+.2f\" +- %.2f\", e' %+.2f\" +- %.2f\"\n",
                 c.rezero_c, c.rezero_c_err, c.rezero_e, c.rezero_e_err);
