@@ -951,6 +951,35 @@ START_TEST(test_pmrun_read_pier_other_way_round)
 }
 END_TEST
 
+/* Four numbers under a line of words are read as TPOINT (the words its
+** caption): the error says so and how to mark a column header (it spoke of
+** a latitude's whole degrees only: an outside probe). */
+START_TEST(test_pmrun_read_header_without_hash)
+{
+    static const char text[] = "tau delta T D\n"
+                               "-147.540642059 -162.103582003 32.487047222 -17.894317317\n";
+    char path[64];
+    temp_file(path, sizeof path, text, sizeof text - 1);
+    tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 2, "start its header with '#' ('# tau delta T D'");
+    remove(path);
+}
+END_TEST
+
+/* The notes made before an error come with it (the run and its notes are
+** not returned on error; a TPOINT year of 9999 was noted, then the file
+** refused for "mixed encoder conventions" without the note: an outside
+** probe). */
+START_TEST(test_pmrun_read_error_keeps_notes)
+{
+    static const char text[] = "# flavour: sweet\n# tau delta T D\n10 20 x 30\n";
+    char path[64];
+    temp_file(path, sizeof path, text, sizeof text - 1);
+    tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 3, "(noted before it: ");
+    tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 3, "'flavour' accepted, not used");
+    remove(path);
+}
+END_TEST
+
 /* Weather that makes refraction meaningless is an error when refraction is
 ** requested, a warning otherwise. */
 static void expect_weather_error(const char *name, const char *needle)
@@ -1351,6 +1380,8 @@ static Suite *runfile_suite(void)
     tcase_add_test(tc, test_pmrun_read_two_digit_year);
     tcase_add_test(tc, test_pmrun_read_time_past_midnight);
     tcase_add_test(tc, test_pmrun_read_pier_other_way_round);
+    tcase_add_test(tc, test_pmrun_read_header_without_hash);
+    tcase_add_test(tc, test_pmrun_read_error_keeps_notes);
     tcase_add_test(tc, test_pmrun_read_humidity_out_of_range);
     tcase_add_test(tc, test_pmrun_read_wavelength_not_positive);
     tcase_add_test(tc, test_pmrun_read_temperature_below_absolute_zero);

@@ -72,13 +72,26 @@ std::string Context::where(int line) const
     return path_ + ": ";
 }
 
+// The notes made before an error, appended to it: the run and its notes
+// are not returned on error, and a note can be the cause (a year of 9999
+// noted, then refused for "mixed encoder conventions" without it).
+static std::string with_notes(const std::vector<std::string> &notes)
+{
+    if (notes.empty())
+        return "";
+    std::string s = " (noted before it: " + notes[0];
+    if (notes.size() > 1)
+        s += "; and " + std::to_string(notes.size() - 1) + " more";
+    return s + ")";
+}
+
 bool Context::fail(int line, const char *fmt, ...)
 {
     if (!failed()) {
         va_list ap;
         va_start(ap, fmt);
         error_ = where(line) + (reading_as_.empty() ? "" : "read as " + reading_as_ + ": ") +
-                 vformat(fmt, ap);
+                 vformat(fmt, ap) + with_notes(run_->warnings);
         va_end(ap);
         status_ = PMRUN_ERR_FORMAT;
     }

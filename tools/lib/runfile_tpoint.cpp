@@ -78,7 +78,10 @@ public:
         std::vector<std::string> tok = tokens(t);
         if (stage_ == kHead) {
             if (is_number(tok[0]) || tok[0][0] == '+' || tok[0][0] == '-') return run_line(n, tok);
-            if (caption_line_ == 0) caption_line_ = n;
+            if (caption_line_ == 0) {
+                caption_line_ = n;
+                caption_ = t;
+            }
             return true;   // caption
         }
         if (tok.size() == 1 && lower(tok[0]) == "end") {
@@ -198,23 +201,34 @@ private:
                              kRunExpected);
         double v[12];
         for (size_t i = 0; i < 12; ++i) v[i] = nan();
+        // four numbers under a line of words: a four-column or named-column
+        // file whose header lost its '#' (read as TPOINT, the words its
+        // caption: the message was about a latitude's whole degrees)
+        std::string hint;
+        if (tok.size() == 4 && caption_line_ > 0)
+            hint = format("; read as a TPOINT file, line %d ('%s') its caption and this line its "
+                          "run line: if the file holds four-column or named-column records, "
+                          "start its header with '#' ('# %s', docs/formats.md, sections 1 and 2)",
+                          caption_line_, excerpt(caption_).c_str(), excerpt(caption_).c_str());
         for (size_t i = 0; i < tok.size(); ++i) {
             std::string why;
             if (!parse_number(tok[i], v[i], why))
-                return ctx_.fail(n, "run line field %zu (%s) '%s': %s; the run line is %s", i + 1,
-                                 kRunFields[i], excerpt(tok[i]).c_str(), why.c_str(), kRunExpected);
+                return ctx_.fail(n, "run line field %zu (%s) '%s': %s; the run line is %s%s", i + 1,
+                                 kRunFields[i], excerpt(tok[i]).c_str(), why.c_str(), kRunExpected,
+                                 hint.c_str());
         }
         std::string why;
         double lat;
         if (!sexa(tok, 0, 3, true, kRunFields, lat, why))
-            return ctx_.fail(n, "run line %s", why.c_str());
+            return ctx_.fail(n, "run line %s%s", why.c_str(), hint.c_str());
         if (std::fabs(lat) > 90)
             return ctx_.fail(n, "run line latitude %s %s %s is beyond +-90 deg, expected -90..+90",
                              tok[0].c_str(), tok[1].c_str(), tok[2].c_str());
         site.latitude_rad = lat * kDeg;
         if (tok.size() >= 4 && tok.size() < 6)
             return ctx_.fail(n, "run line has an incomplete date, expected year month day after the "
-                                "latitude");
+                                "latitude%s",
+                             hint.c_str());
         if (tok.size() >= 6) {
             for (size_t i = 3; i < 6; ++i)
                 if (!whole(v[i]))
@@ -568,6 +582,7 @@ private:
     Context &ctx_;
     Stage stage_ = kHead;
     int caption_line_ = 0;
+    std::string caption_;   // its text (a hint where a column header lost its '#')
     int run_line_ = 0;
     int mount_ = PMRUN_MOUNT_EQUATORIAL;
     int mount_line_ = 0;
