@@ -1054,6 +1054,8 @@ int simpler_reading(const Run &run, const State &st, std::vector<Candidate> &can
             c.fit.P <= st.cur.P || !(c.log_fap < std::log(opt.alpha)))
             continue;
         double bic = c.fit.chi2 / s2 + c.fit.P * ln2n;
+        if (bic < best && !separable(run, st, c)) // (not a measurement: not the simpler reading)
+            continue;
         if (!(bic < best))
             continue;
         c.cv = cv_of(run, st.use, c.order, c.adds, opt, c.fit, st.cv_skip);
