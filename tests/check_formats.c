@@ -247,36 +247,35 @@ END_TEST
 ** temporary file (path out); rows of only East when `w` is NULL.  The line
 ** of the first East and the first West row written: line_e, line_w. */
 static int line_e, line_w;
+typedef struct sides_edit {
+    const char *e, *w;
+    int n; /* lines written */
+} sides_edit;
+
+static int edit_sides(char *line, size_t size, void *arg)
+{
+    sides_edit *a = (sides_edit *)arg;
+    char *p = strstr(line, ";East"), *q = strstr(line, ";West");
+    if (p) {
+        snprintf(p, size - (size_t)(p - line), ";%s\n", a->e);
+        if (!line_e) line_e = a->n + 1;
+    } else if (q) {
+        if (!a->w) return 0;
+        snprintf(q, size - (size_t)(q - line), ";%s\n", a->w);
+        if (!line_w) line_w = a->n + 1;
+    }
+    a->n++;
+    return 1;
+}
+
 static void csv_sides(char *out, const char *e, const char *w)
 {
-    char src[4096], line[1024];
-    FILE *in, *o;
-    int fd, n = 0;
+    char src[4096];
+    sides_edit a = {e, w, 0};
     line_e = line_w = 0;
     data_path(src, sizeof src, "nina_jnow.csv");
     strcpy(out, "/tmp/pm_sides_XXXXXX");
-    fd = mkstemp(out);
-    ck_assert_int_ge(fd, 0);
-    in = fopen(src, "r");
-    o = fdopen(fd, "w");
-    ck_assert_ptr_nonnull(in);
-    ck_assert_ptr_nonnull(o);
-    while (fgets(line, sizeof line, in)) {
-        char *p = strstr(line, ";East");
-        char *q = strstr(line, ";West");
-        if (p) {
-            sprintf(p, ";%s\n", e);
-            if (!line_e) line_e = n + 1;
-        } else if (q) {
-            if (!w) continue;
-            sprintf(q, ";%s\n", w);
-            if (!line_w) line_w = n + 1;
-        }
-        fputs(line, o);
-        n++;
-    }
-    fclose(in);
-    ck_assert_int_eq(fclose(o), 0);
+    tu_edited_copy(src, out, edit_sides, &a);
 }
 
 /* Sides as numbers: ASCOM's SideOfPier numbers (0 pierEast, 1 pierWest) where
@@ -334,46 +333,47 @@ START_TEST(test_pmrun_read_csv_sides_as_numbers)
 }
 END_TEST
 
+/* nina_jnow.csv's RA and LST in degrees, the header saying so (k = 0), or
+** its declination named in hours (k = 1; the header's line: header). */
+typedef struct units_edit {
+    int k, n, header;
+} units_edit;
+
+static int edit_units(char *line, size_t size, void *arg)
+{
+    units_edit *a = (units_edit *)arg;
+    double f[5];
+    char side[32];
+    a->n++;
+    if (!strncmp(line, "LST;", 4)) {
+        snprintf(line, size, "%s",
+                 a->k ? "LST;RA;Dec (h);SolvedRA;SolvedDec;SideOfPier\n"
+                      : "LST (deg);RA (deg);Dec;SolvedRA (degrees);SolvedDec (deg);SideOfPier\n");
+        a->header = a->n;
+    } else if (line[0] != '#' && sscanf(line, "%lf;%lf;%lf;%lf;%lf;%31s", &f[0], &f[1], &f[2],
+                                        &f[3], &f[4], side) == 6) {
+        snprintf(line, size, "%.10f;%.10f;%.9f;%.10f;%.9f;%s\n", 15 * f[0], 15 * f[1], f[2],
+                 15 * f[3], f[4], side);
+    }
+    return 1;
+}
+
 /* An RA (and LST) column whose name says degrees is read in degrees (an
 ** 'RA (deg)' column was read as hours, silently: sigma 20" for 0.4"); a
 ** declination named in hours is refused (an outside probe). */
 START_TEST(test_pmrun_read_csv_units_in_names)
 {
-    char src[4096], path[64], line[1024], err[1024];
-    FILE *in, *o;
-    int fd, k, dec_line = 0;
+    char src[4096], path[64], err[1024];
+    int fd, k;
     pmrun *words = read_ok("nina_jnow.csv"), *run = NULL;
     size_t i;
     for (k = 0; k < 2; k++) {
+        units_edit a = {k, 0, 0};
         data_path(src, sizeof src, "nina_jnow.csv");
         strcpy(path, "/tmp/pm_units_XXXXXX");
-        fd = mkstemp(path);
-        ck_assert_int_ge(fd, 0);
-        in = fopen(src, "r");
-        o = fdopen(fd, "w");
-        ck_assert_ptr_nonnull(in);
-        ck_assert_ptr_nonnull(o);
-        for (i = 1; fgets(line, sizeof line, in); i++) {
-            double f[5];
-            char side[32];
-            if (!strncmp(line, "LST;", 4)) {
-                fputs(k ? "LST;RA;Dec (h);SolvedRA;SolvedDec;SideOfPier\n"
-                        : "LST (deg);RA (deg);Dec;SolvedRA (degrees);SolvedDec (deg);SideOfPier\n",
-                      o);
-                dec_line = (int)i;
-            } else if (line[0] != '#' &&
-                       sscanf(line, "%lf;%lf;%lf;%lf;%lf;%31s", &f[0], &f[1], &f[2], &f[3], &f[4],
-                              side) == 6) {
-                fprintf(o, "%.10f;%.10f;%.9f;%.10f;%.9f;%s\n", 15 * f[0], 15 * f[1], f[2],
-                        15 * f[3], f[4], side);
-            } else {
-                fputs(line, o);
-            }
-        }
-        fclose(in);
-        ck_assert_int_eq(fclose(o), 0);
+        tu_edited_copy(src, path, edit_units, &a);
         if (k == 1) {
-            tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, dec_line, "a declination in hours?");
+            tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, a.header, "a declination in hours?");
         } else {
             ck_assert_msg(pmrun_read(path, NULL, &run, err, sizeof err) == PMRUN_OK, "%s", err);
             ck_assert_uint_eq(pmrun_count(run), pmrun_count(words));
@@ -405,31 +405,28 @@ START_TEST(test_pmrun_read_csv_units_in_names)
 }
 END_TEST
 
+/* a row's time without its zone (its Z taken out) */
+static int edit_no_zone(char *line, size_t size, void *arg)
+{
+    char *z = strstr(line, "Z,");
+    (void)size;
+    (void)arg;
+    if (z && line[0] != '#')
+        memmove(z, z + 1, strlen(z + 1) + 1);
+    return 1;
+}
+
 /* Times without their zone are UTC, said where they place the stars (a log
 ** of local times read as UTC turns every hour angle by the zone, and the
 ** fit blamed the plate solves: an outside probe). */
 START_TEST(test_pmrun_read_csv_time_without_zone)
 {
-    char src[4096], path[64], line[1024], err[1024];
-    FILE *in, *o;
-    int fd, k, found = -1;
+    char src[4096], path[64], err[1024];
+    int k, found = -1;
     pmrun *run = NULL;
     data_path(src, sizeof src, "nina_j2000.csv");
     strcpy(path, "/tmp/pm_zone_XXXXXX");
-    fd = mkstemp(path);
-    ck_assert_int_ge(fd, 0);
-    in = fopen(src, "r");
-    o = fdopen(fd, "w");
-    ck_assert_ptr_nonnull(in);
-    ck_assert_ptr_nonnull(o);
-    while (fgets(line, sizeof line, in)) {
-        char *z = strstr(line, "Z,");
-        if (z && line[0] != '#')
-            memmove(z, z + 1, strlen(z + 1) + 1);
-        fputs(line, o);
-    }
-    fclose(in);
-    ck_assert_int_eq(fclose(o), 0);
+    tu_edited_copy(src, path, edit_no_zone, NULL);
     ck_assert_msg(pmrun_read(path, NULL, &run, err, sizeof err) == PMRUN_OK, "%s", err);
     for (k = 0; k < pmrun_n_warnings(run); k++)
         if (strstr(pmrun_warning(run, k), "the time has no zone"))

@@ -251,26 +251,26 @@ START_TEST(test_inject_misuse)
 }
 END_TEST
 
-/* flip_gem with an auxiliary column 'hum' (deterministic values 10..70) */
-static void with_column(const char *src, const char *dst)
+/* flip_gem with an auxiliary column 'hum' (deterministic values 10..70;
+** arg: the records so far) */
+static int edit_with_column(char *line, size_t size, void *arg)
 {
-    FILE *in = fopen(src, "r"), *o = fopen(dst, "w");
-    char line[1024];
+    int *i = (int *)arg;
+    size_t n = strcspn(line, "\r\n");
+    line[n] = 0;
+    if (!strncmp(line, "# tau", 5))
+        snprintf(line + n, size - n, " hum\n");
+    else if (line[0] == '#' || !line[0])
+        snprintf(line + n, size - n, "\n");
+    else
+        snprintf(line + n, size - n, " %.3f\n", 40 + 30 * sin(1.7 * (*i)++));
+    return 1;
+}
+
+static void with_column(const char *src, char *dst)
+{
     int i = 0;
-    ck_assert_ptr_nonnull(in);
-    ck_assert_ptr_nonnull(o);
-    while (fgets(line, sizeof line, in)) {
-        size_t n = strcspn(line, "\r\n");
-        line[n] = 0;
-        if (!strncmp(line, "# tau", 5))
-            fprintf(o, "%s hum\n", line);
-        else if (line[0] == '#' || !line[0])
-            fprintf(o, "%s\n", line);
-        else
-            fprintf(o, "%s %.3f\n", line, 40 + 30 * sin(1.7 * i++));
-    }
-    fclose(in);
-    ck_assert_int_eq(fclose(o), 0);
+    tu_edited_copy(src, dst, edit_with_column, &i);
 }
 
 /* An effect on the run's own column (aux:NAME) is injected as pmfit fit

@@ -19,6 +19,7 @@
 
 #include "runfile.h"
 #include "tu_runfile.h"
+#include "tu_tool.h"
 #include "ref/runfile_reduction_ref.h"
 
 #define PI 3.14159265358979323846
@@ -806,31 +807,27 @@ END_TEST
 START_TEST(test_pmrun_read_invalid_date) { expect_error("bad_date.dat", 3, "2023 13 1 is not a valid date"); }
 END_TEST
 
+/* the run line's date 2021 8 21 written 21 8 21 */
+static int edit_two_digit_year(char *line, size_t size, void *arg)
+{
+    char *y = strstr(line, " 2021 8 21 ");
+    (void)size;
+    (void)arg;
+    if (y)
+        memmove(y + 1, y + 3, strlen(y + 3) + 1); /* 2021 -> 21 */
+    return 1;
+}
+
 /* 23 for 2023 was read as 23 AD: 2,000 years of precession (an outside probe);
 ** an alt-az file's records are not reduced: its year is not checked */
 START_TEST(test_pmrun_read_two_digit_year)
 {
-    char src[4096], path[64], line[1024], err[512];
-    FILE *in, *o;
-    int fd;
+    char src[4096], path[64], err[512];
     pmrun *run = NULL;
     expect_error("bad_year_two_digits.dat", 3, "expected the year in full (2023, not 23)");
     data_path(src, sizeof src, "tpoint_altaz.dat");
     strcpy(path, "/tmp/check_runfile_XXXXXX");
-    fd = mkstemp(path);
-    ck_assert_int_ge(fd, 0);
-    in = fopen(src, "r");
-    o = fdopen(fd, "w");
-    ck_assert_ptr_nonnull(in);
-    ck_assert_ptr_nonnull(o);
-    while (fgets(line, sizeof line, in)) {
-        char *y = strstr(line, " 2021 8 21 "); /* the run line's date */
-        if (y)
-            memmove(y + 1, y + 3, strlen(y + 3) + 1); /* 2021 -> 21 */
-        fputs(line, o);
-    }
-    fclose(in);
-    ck_assert_int_eq(fclose(o), 0);
+    tu_edited_copy(src, path, edit_two_digit_year, NULL);
     ck_assert_msg(pmrun_read(path, NULL, &run, err, sizeof err) == PMRUN_OK, "%s", err);
     pmrun_free(run);
     remove(path);

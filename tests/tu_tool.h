@@ -25,6 +25,32 @@ static inline const char *tu_pmfit_path(void)
     return path;
 }
 
+/* A copy of the file src written to dst, each line passed through
+** edit(line, size, arg) first: it may change the line in place (line holds
+** size bytes) and returns 0 to leave the line out.  dst ending in "XXXXXX"
+** is a mkstemp template (the file's name written into it). */
+typedef int (*tu_line_edit)(char *line, size_t size, void *arg);
+static inline void tu_edited_copy(const char *src, char *dst, tu_line_edit edit, void *arg)
+{
+    char line[4096];
+    size_t n = strlen(dst);
+    FILE *in = fopen(src, "r"), *o;
+    ck_assert_msg(in != NULL, "%s: cannot open", src);
+    if (n >= 6 && !strcmp(dst + n - 6, "XXXXXX")) {
+        int fd = mkstemp(dst);
+        ck_assert_int_ge(fd, 0);
+        o = fdopen(fd, "w");
+    } else {
+        o = fopen(dst, "w");
+    }
+    ck_assert_msg(o != NULL, "%s: cannot write", dst);
+    while (fgets(line, sizeof line, in))
+        if (edit(line, sizeof line, arg))
+            fputs(line, o);
+    fclose(in);
+    ck_assert_int_eq(fclose(o), 0);
+}
+
 /* The whole of a file, NUL-terminated (the caller frees it); NULL if it
 ** cannot be opened.  A file that opens but cannot be read fails the test. */
 static inline char *tu_slurp(const char *path)
