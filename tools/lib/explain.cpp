@@ -1543,27 +1543,17 @@ bool step(const Run &run, State &st, const ExplainOptions &opt, Explanation &ex)
     // predicted better than the step's choice, but its fit crept along a
     // valley: the explanation then differed with a perfectly modelled
     // effect injected, which let it converge; an outside probe)
-    for (const Candidate &c : cands)
+    // (and a family the harmonics mostly hold, first_passing's separable)
+    const int step_no = ex.findings.empty() ? 1 : ex.findings.back().step + 1;
+    for (const Candidate &c : cands) {
         if (!c.fit.ok && c.fit.f.status == PM_ERR_DIVERGED && c.effect != "outlier" &&
             std::none_of(ex.unfitted.begin(), ex.unfitted.end(),
-                         [&](const Explanation::Unfitted &u) { return u.effect == c.effect; })) {
-            Explanation::Unfitted u;
-            u.effect = c.effect;
-            u.step = ex.findings.empty() ? 1 : ex.findings.back().step + 1;
-            u.order = c.order;
-            ex.unfitted.push_back(u);
-        }
-    for (const Candidate &c : cands)
+                         [&](const Explanation::Unfitted &u) { return u.effect == c.effect; }))
+            ex.unfitted.push_back({c.effect, step_no, c.order});
         if (c.blur > 0 && std::none_of(ex.blurred.begin(), ex.blurred.end(),
-                                       [&](const Explanation::Blurred &b) { return b.effect == c.effect; })) {
-            Explanation::Blurred b;
-            b.effect = c.effect;
-            b.step = ex.findings.empty() ? 1 : ex.findings.back().step + 1;
-            b.order = st.order;
-            b.error_arcsec = c.err_arcsec;
-            b.error_order1_arcsec = c.err1_arcsec;
-            ex.blurred.push_back(b);
-        }
+                                       [&](const Explanation::Blurred &b) { return b.effect == c.effect; }))
+            ex.blurred.push_back({c.effect, step_no, st.order, c.err_arcsec, c.err1_arcsec});
+    }
     if (k >= 0) {
         record(run, st, cands[(size_t)k], cands, opt, ex);
         return true;
