@@ -243,6 +243,62 @@ START_TEST(test_pmrun_read_wrong_guess_names_the_format)
 }
 END_TEST
 
+/* Excel's first line 'sep=;' (or 'sep=,') names the delimiter; it was read as
+** a TPOINT caption and the file refused for another cause (an outside probe).
+** A delimiter other than ',' or ';' is refused on that line. */
+typedef struct sep_edit {
+    int first; /* the next line is the file's first */
+    char sep;
+} sep_edit;
+
+static int edit_sep(char *line, size_t size, void *arg)
+{
+    sep_edit *a = (sep_edit *)arg;
+    size_t n = strlen(line);
+    if (a->first && n + 7 < size) {
+        memmove(line + 6, line, n + 1);
+        memcpy(line, "sep=", 4);
+        line[4] = a->sep;
+        line[5] = '\n';
+    }
+    a->first = 0;
+    return 1;
+}
+
+START_TEST(test_pmrun_read_csv_excel_sep)
+{
+    static const char seps[2] = {';', '\t'};
+    char src[4096], path[64], err[1024];
+    pmrun *words = read_ok("nina_jnow.csv"), *run;
+    size_t i;
+    int k;
+    data_path(src, sizeof src, "nina_jnow.csv");
+    for (k = 0; k < 2; ++k) {
+        sep_edit a;
+        a.first = 1;
+        a.sep = seps[k];
+        strcpy(path, "/tmp/pm_sep_XXXXXX");
+        tu_edited_copy(src, path, edit_sep, &a);
+        if (k == 0) {
+            run = NULL;
+            ck_assert_msg(pmrun_read(path, NULL, &run, err, sizeof err) == PMRUN_OK, "%s", err);
+            ck_assert_int_eq(pmrun_format(run), PMRUN_FORMAT_CSV);
+            ck_assert_uint_eq(pmrun_count(run), pmrun_count(words));
+            for (i = 0; i < pmrun_count(run); ++i) {
+                ck_assert(pmrun_get(run, i)->enc_ha == pmrun_get(words, i)->enc_ha);
+                ck_assert(pmrun_get(run, i)->app_dec == pmrun_get(words, i)->app_dec);
+                ck_assert_int_eq(pmrun_get(run, i)->line, pmrun_get(words, i)->line + 1);
+            }
+            pmrun_free(run);
+        } else {
+            tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 1, "expected 'sep=,' or 'sep=;'");
+        }
+        unlink(path);
+    }
+    pmrun_free(words);
+}
+END_TEST
+
 /* nina_jnow.csv with its sides East/West written as `e` and `w` into a
 ** temporary file (path out); rows of only East when `w` is NULL.  The line
 ** of the first East and the first West row written: line_e, line_w. */
@@ -795,6 +851,7 @@ static Suite *formats_suite(void)
     tcase_add_test(tc, test_pmrun_read_mw4_same_as_source);
     tcase_add_test(tc, test_pmrun_read_csv_same_as_source);
     tcase_add_test(tc, test_pmrun_read_csv_sides_as_numbers);
+    tcase_add_test(tc, test_pmrun_read_csv_excel_sep);
     tcase_add_test(tc, test_pmrun_read_csv_units_in_names);
     tcase_add_test(tc, test_pmrun_read_csv_time_without_zone);
     tcase_add_test(tc, test_pmrun_read_csv_equinox_option_overrides);

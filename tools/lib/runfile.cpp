@@ -452,6 +452,12 @@ bool csv_header(const std::string &line)
     return ra >= 2 && dec >= 2;   // the mount's and the solved position
 }
 
+// Excel's optional first line of a CSV file, 'sep=;', naming its delimiter.
+bool excel_sep_line(const std::string &t)
+{
+    return t.size() >= 4 && lower(t.substr(0, 4)) == "sep=";
+}
+
 // The first '#' line of an RTS2 gpoint file names its columns
 // ("#  Observation  MJD  LST-MNT  RA-MNT ..."), or a '#observatory',
 // '#gem' or '#altaz' line gives the site.
@@ -497,6 +503,16 @@ public:
             if (held_.size() > 1000 || held_bytes_ > (1u << 20)) return choose(n, nullptr);
             return true;
         }
+        // Excel's first line 'sep=;' names the delimiter of the CSV that follows
+        if (!sep_line_ && excel_sep_line(t)) {
+            if (t.size() != 5 || (t[4] != ',' && t[4] != ';'))
+                return ctx_.fail(n, "Excel's delimiter line '%s': expected 'sep=,' or 'sep=;' (a "
+                                    "CSV log's fields are separated by ',' or ';')",
+                                 excerpt(t).c_str());
+            sep_line_ = n;
+            held_.emplace_back(n, text);
+            return true;
+        }
         return choose(n, &t) && parser_->line(n, text);
     }
 
@@ -526,6 +542,12 @@ private:
         if (rts2_) {
             format = PMRUN_FORMAT_RTS2;
             why = format_str("its '#' line %d is an RTS2 gpoint header", first_hash_);
+        } else if (sep_line_) {
+            if (t && !csv_header(*t))
+                return ctx_.fail(n, "line %d follows Excel's delimiter line (line %d) but is not a "
+                                    "CSV header naming the mount's and the solved RA and Dec; %s",
+                                 n, sep_line_, kExpectedAny);
+            format = PMRUN_FORMAT_CSV;
         } else if (!held_.empty() || !t) {
             if (t && t->compare(0, 4, "CAT:") == 0) {
                 format = PMRUN_FORMAT_MMT;
@@ -597,6 +619,7 @@ private:
     std::vector<std::pair<int, std::string>> held_;
     size_t held_bytes_ = 0;
     int first_hash_ = 0;
+    int sep_line_ = 0;   // Excel's 'sep=' line, 0: none
     bool rts2_ = false;
 };
 

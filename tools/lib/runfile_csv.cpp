@@ -184,6 +184,11 @@ public:
         std::string t = trim(text);
         if (t.empty()) return true;
         if (t[0] == '#') return header_line_ ? true : metadata(n, t.substr(1));
+        if (!header_line_ && !sep_ && t.size() == 5 && lower(t.substr(0, 4)) == "sep=" &&
+            (t[4] == ',' || t[4] == ';')) {
+            sep_ = t[4];   // Excel's delimiter line (the detector checked it)
+            return true;
+        }
         if (!header_line_) return header(n, t);
         return row(n, t);
     }
@@ -279,7 +284,7 @@ private:
     bool header(int n, const std::string &t)
     {
         header_line_ = n;
-        delim_ = t.find(',') != std::string::npos ? ',' : ';';
+        delim_ = sep_ ? sep_ : t.find(',') != std::string::npos ? ',' : ';';
         std::vector<std::string> names;
         std::string why;
         if (!split_row(t, delim_, names, why)) return ctx_.fail(n, "header: %s", why.c_str());
@@ -655,6 +660,7 @@ private:
     std::vector<bool> deg_;         // per column: an RA or LST in degrees (its name says so)
     int header_line_ = 0;
     char delim_ = ',';
+    char sep_ = 0;   // from Excel's 'sep=' line, 0: none
     std::vector<Col> cols_;
     bool has_[10] = {};
     std::vector<Row> rows_;
