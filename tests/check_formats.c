@@ -243,6 +243,27 @@ START_TEST(test_pmrun_read_wrong_guess_names_the_format)
 }
 END_TEST
 
+/* A TPOINT alt-az file without its ': ALTAZ' line: the four-field records are
+** refused with a hint at the option (the error spoke only of 14 fields). */
+static int edit_no_altaz(char *line, size_t size, void *arg)
+{
+    (void)size;
+    (void)arg;
+    return strncmp(line, ": ALTAZ", 7) != 0;
+}
+
+START_TEST(test_pmrun_read_tpoint_altaz_without_option)
+{
+    char src[4096], path[64];
+    data_path(src, sizeof src, "tpoint_altaz.dat");
+    strcpy(path, "/tmp/pm_noaltaz_XXXXXX");
+    tu_edited_copy(src, path, edit_no_altaz, NULL);
+    tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 6, "4 fields, expected 14");
+    tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 6, "after the option line ': ALTAZ'");
+    unlink(path);
+}
+END_TEST
+
 /* Excel's first line 'sep=;' (or 'sep=,') names the delimiter; it was read as
 ** a TPOINT caption and the file refused for another cause (an outside probe).
 ** A delimiter other than ',' or ';' is refused on that line. */
@@ -852,6 +873,7 @@ static Suite *formats_suite(void)
     tcase_add_test(tc, test_pmrun_read_csv_same_as_source);
     tcase_add_test(tc, test_pmrun_read_csv_sides_as_numbers);
     tcase_add_test(tc, test_pmrun_read_csv_excel_sep);
+    tcase_add_test(tc, test_pmrun_read_tpoint_altaz_without_option);
     tcase_add_test(tc, test_pmrun_read_csv_units_in_names);
     tcase_add_test(tc, test_pmrun_read_csv_time_without_zone);
     tcase_add_test(tc, test_pmrun_read_csv_equinox_option_overrides);

@@ -422,13 +422,20 @@ private:
                              PMRUN_MAX_RECORDS);
         bool altaz = mount_ == PMRUN_MOUNT_ALTAZ;
         size_t need = altaz ? 4 : 14;
-        if (tok.size() < need || tok.size() > need + PMRUN_MAX_AUX)
-            return ctx_.bad_record(n, format("%zu fields, expected %zu%s: %s", tok.size(), need,
+        if (tok.size() < need || tok.size() > need + PMRUN_MAX_AUX) {
+            // four to eight fields and no mount option: an alt-az run without its ': ALTAZ'?
+            const bool az_hint = !altaz && !mount_line_ && tok.size() >= 4 && tok.size() <= 8;
+            return ctx_.bad_record(n, format("%zu fields, expected %zu%s: %s%s", tok.size(), need,
                                              tok.size() > need ? format(" (+ at most %d auxiliary)",
                                                                         PMRUN_MAX_AUX)
                                                                      .c_str()
                                                                : "",
-                                             altaz ? kAzExpected : kEqExpected));
+                                             altaz ? kAzExpected : kEqExpected,
+                                             az_hint ? " (an alt-az run? TPOINT reads its records "
+                                                       "as alt-az only after the option line "
+                                                       "': ALTAZ' before the run line)"
+                                                     : ""));
+        }
         double aux[PMRUN_MAX_AUX];
         for (double &a : aux) a = nan();
         std::string why;
