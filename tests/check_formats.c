@@ -527,6 +527,42 @@ START_TEST(test_pmrun_read_rts2_same_as_source)
 }
 END_TEST
 
+/* A gpoint file with Julian dates in field 2 (where gpoint writes MJD) is
+** read as JD - 2400000.5, with a note; it was refused. */
+static int edit_jd(char *line, size_t size, void *arg)
+{
+    char name[64], rest[1024];
+    double mjd;
+    (void)arg;
+    if (line[0] != '#' && sscanf(line, "%63s %lf %1023[^\n]", name, &mjd, rest) == 3)
+        snprintf(line, size, "%s %.8f %s\n", name, mjd + 2400000.5, rest);
+    return 1;
+}
+
+START_TEST(test_pmrun_read_rts2_julian_dates)
+{
+    char src[4096], path[64], err[1024];
+    pmrun *mjd = read_ok("rts2_gpoint.dat"), *run = NULL;
+    size_t i;
+    data_path(src, sizeof src, "rts2_gpoint.dat");
+    strcpy(path, "/tmp/pm_jd_XXXXXX");
+    tu_edited_copy(src, path, edit_jd, NULL);
+    ck_assert_msg(pmrun_read(path, NULL, &run, err, sizeof err) == PMRUN_OK, "%s", err);
+    ck_assert_uint_eq(pmrun_count(run), pmrun_count(mjd));
+    for (i = 0; i < pmrun_count(run); ++i) {
+        const pmrun_obs *x = pmrun_get(run, i), *y = pmrun_get(mjd, i);
+        ck_assert(fabs(wrap(x->app_ha - y->app_ha)) < TOL_SAME_RAD);
+        ck_assert(fabs(x->app_dec - y->app_dec) < TOL_SAME_RAD);
+        ck_assert(x->enc_ha == y->enc_ha && x->enc_dec == y->enc_dec);
+        ck_assert(fabs(x->time_h - y->time_h) < 1e-6);
+    }
+    ck_assert_ptr_nonnull(strstr(pmrun_warning(run, 0), "is a Julian date"));
+    pmrun_free(run);
+    unlink(path);
+    pmrun_free(mjd);
+}
+END_TEST
+
 START_TEST(test_pmrun_read_rts2_j2000_reduced_with_equinox_option)
 {
     pmrun_options o;
@@ -873,6 +909,7 @@ static Suite *formats_suite(void)
     tcase_add_test(tc, test_pmrun_read_csv_same_as_source);
     tcase_add_test(tc, test_pmrun_read_csv_sides_as_numbers);
     tcase_add_test(tc, test_pmrun_read_csv_excel_sep);
+    tcase_add_test(tc, test_pmrun_read_rts2_julian_dates);
     tcase_add_test(tc, test_pmrun_read_tpoint_altaz_without_option);
     tcase_add_test(tc, test_pmrun_read_csv_units_in_names);
     tcase_add_test(tc, test_pmrun_read_csv_time_without_zone);

@@ -64,9 +64,21 @@ public:
                 return ctx_.bad_record(n, format("field %zu (%s) '%s': %s (degrees)", i + 1,
                                                  names[i], excerpt(tok[i]).c_str(), why.c_str()));
         }
+        if (v[1] > 2415000.5 && v[1] < 2500000.5) {
+            // a Julian date where gpoint writes the modified one (the ranges
+            // are disjoint: JD 2415000.5 is MJD 15000)
+            v[1] -= 2400000.5;
+            if (!jd_warned_) {
+                jd_warned_ = true;
+                ctx_.warn(n, "field 2 (MJD) '%s' is a Julian date: read as MJD = JD - 2400000.5 "
+                             "(noted once)",
+                          excerpt(tok[1]).c_str());
+            }
+        }
         if (!(v[1] > 15000 && v[1] < 100000))
             return ctx_.bad_record(n, format("field 2 (MJD) '%s': out of range, expected a modified "
-                                             "Julian date 15000..100000 (years 1900..2132)",
+                                             "Julian date 15000..100000 (years 1900..2132) or a "
+                                             "Julian date",
                                              excerpt(tok[1]).c_str()));
         if (std::fabs(v[8]) > 90)
             return ctx_.bad_record(n, format("field 9 (%s) '%s': beyond +-90 deg, expected the "
@@ -212,6 +224,7 @@ private:
     int directive_line_ = 0;
     int first_data_ = 0;
     bool extra_warned_ = false;
+    bool jd_warned_ = false;
 };
 
 }  // namespace
