@@ -243,6 +243,35 @@ START_TEST(test_pmrun_read_wrong_guess_names_the_format)
 }
 END_TEST
 
+/* An equatorial TPOINT file with its LST as h m s: the seconds are read as
+** aux1 (TPOINT's LST is h and decimal minutes), and the note says so. */
+static int edit_lst_hms(char *line, size_t size, void *arg)
+{
+    int *n = (int *)arg;
+    char *last = strrchr(line, ' ');
+    double m;
+    if (++*n >= 9 && line[0] >= '0' && line[0] <= '9' && last && sscanf(last, "%lf", &m) == 1)
+        snprintf(last, size - (size_t)(last - line), " %02d %05.2f\n", (int)m,
+                 (m - (int)m) * 60.0);
+    return 1;
+}
+
+START_TEST(test_pmrun_read_tpoint_lst_seconds_noted)
+{
+    char src[4096], path[64], err[1024];
+    pmrun *run = NULL;
+    int n = 0;
+    data_path(src, sizeof src, "tpoint_equat.dat");
+    strcpy(path, "/tmp/pm_lsthms_XXXXXX");
+    tu_edited_copy(src, path, edit_lst_hms, &n);
+    ck_assert_msg(pmrun_read(path, NULL, &run, err, sizeof err) == PMRUN_OK, "%s", err);
+    ck_assert_ptr_nonnull(strstr(pmrun_warning(run, 0), "if field 15 is the LST's seconds"));
+    ck_assert(pmrun_get(run, 1)->aux[0] == 22.2);
+    pmrun_free(run);
+    unlink(path);
+}
+END_TEST
+
 /* A TPOINT alt-az file without its ': ALTAZ' line: the four-field records are
 ** refused with a hint at the option (the error spoke only of 14 fields). */
 static int edit_no_altaz(char *line, size_t size, void *arg)
@@ -909,6 +938,7 @@ static Suite *formats_suite(void)
     tcase_add_test(tc, test_pmrun_read_csv_same_as_source);
     tcase_add_test(tc, test_pmrun_read_csv_sides_as_numbers);
     tcase_add_test(tc, test_pmrun_read_csv_excel_sep);
+    tcase_add_test(tc, test_pmrun_read_tpoint_lst_seconds_noted);
     tcase_add_test(tc, test_pmrun_read_rts2_julian_dates);
     tcase_add_test(tc, test_pmrun_read_tpoint_altaz_without_option);
     tcase_add_test(tc, test_pmrun_read_csv_units_in_names);

@@ -405,13 +405,23 @@ private:
     }
 
     // Notes once that records carry fields beyond the standard ones.
-    void note_extra(int n, size_t extra, size_t need)
+    void note_extra(int n, const std::vector<std::string> &tok, size_t need)
     {
+        size_t extra = tok.size() - need;
         if (extra == 0 || extra_warned_) return;
         extra_warned_ = true;
+        // whole LST minutes and a first extra field below 60: the LST's
+        // seconds, written where TPOINT has decimal minutes?
+        double m = 0, x = -1;
+        std::string w;
+        const bool lst_seconds = need == 14 && parse_number(tok[13], m, w) && whole(m) &&
+                                 parse_number(tok[14], x, w) && x >= 0 && x < 60;
         ctx_.warn(n, "record has %zu field(s) beyond the standard %zu: kept as auxiliary columns "
-                     "aux1..aux%zu (noted once)",
-                  extra, need, extra);
+                     "aux1..aux%zu (noted once)%s",
+                  extra, need, extra,
+                  lst_seconds ? "; if field 15 is the LST's seconds, write the LST as hours and "
+                                "decimal minutes (TPOINT's h m): its seconds are not read"
+                              : "");
     }
 
     bool record(int n, const std::vector<std::string> &tok)
@@ -440,7 +450,7 @@ private:
         for (double &a : aux) a = nan();
         std::string why;
         if (!aux_fields(tok, need, aux, why)) return ctx_.bad_record(n, why);
-        note_extra(n, tok.size() - need, need);
+        note_extra(n, tok, need);
         return altaz ? altaz_record(n, tok, aux) : eq_record(n, tok, aux);
     }
 
