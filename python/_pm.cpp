@@ -273,6 +273,7 @@ std::pair<long, pm_status> apply_lanes_on(const pm_model &m, int path, long n, i
 struct Model {
     pm_model m;
     pmmodel_info info; // a model file's column names and pier side (modelfile.h)
+    std::vector<double> cov; // the fit's covariance (P x P) where info.has_err; else empty
 
     Model()
     {
@@ -337,6 +338,7 @@ struct Model {
             fail_status(s, "coefficients");
         m = t;
         info.has_err = 0; /* a fit's errors are not these coefficients' */
+        cov.clear();
     }
 
     void set_latitude(double lat)
@@ -411,6 +413,7 @@ struct Model {
             fail_status(s, "add_term");
         m = c;
         info.has_err = 0; /* a fit's errors are not this model's */
+        cov.clear();
         return index;
     }
 
@@ -565,8 +568,9 @@ struct Model {
     {
         no_nul("comment", comment);
         char err[1024];
-        if (pmmodel_save_info(path.c_str(), &m, &info, comment ? comment->c_str() : nullptr, err,
-                              sizeof err) != 0)
+        const bool c = info.has_err && cov.size() == (size_t)m.n_terms * (size_t)m.n_terms;
+        if (pmmodel_save_cov(path.c_str(), &m, &info, c ? cov.data() : nullptr,
+                             comment ? comment->c_str() : nullptr, err, sizeof err) != 0)
             fail(K_FILE, err);
     }
 
@@ -585,7 +589,10 @@ struct Model {
     {
         Model r;
         char err[1024];
-        if (pmmodel_load_info(path.c_str(), &r.m, &r.info, err, sizeof err) != 0) {
+        int has_cov = 0;
+        r.cov.assign((size_t)PM_MAX_TERMS * PM_MAX_TERMS, 0.0);
+        if (pmmodel_load_cov(path.c_str(), &r.m, &r.info, r.cov.data(), r.cov.size(), &has_cov, err,
+                             sizeof err) != 0) {
             // a file that cannot be opened is an OSError, its content a ValueError
             FILE *f = std::fopen(path.c_str(), "rb");
             if (!f)
@@ -593,6 +600,7 @@ struct Model {
             std::fclose(f);
             fail(K_FORMAT, err);
         }
+        r.cov.resize(has_cov ? (size_t)r.m.n_terms * (size_t)r.m.n_terms : 0);
         return r;
     }
 };
@@ -800,6 +808,8 @@ struct Fit {
         Model r;
         r.m = out.model;
         r.info = info;
+        if (info.has_err && out.cov.size() == (size_t)out.model.n_terms * (size_t)out.model.n_terms)
+            r.cov = out.cov; /* (saved with the model: a later compare's joint test) */
         return r;
     }
     py::array_t<double> coefficients() const
@@ -1158,7 +1168,7 @@ std::string compare_run(const Model *old_model, const std::shared_ptr<RunData> &
             pm_model m = old_model->m;
             if (pm_model_prepare(&m) != PM_OK)
                 fail(K_ARGUMENT, "old: the model cannot be prepared (non-finite coefficients?)");
-            os = old_from_model(m, old_model->info);
+            os = old_from_model(m, old_model->info, old_model->cov);
         } else if (old_run) {
             os = old_from_run(old_run->run, order, adds, passes);
         } else {

@@ -257,6 +257,41 @@ START_TEST(test_compare_other_site)
 }
 END_TEST
 
+/* A version-5 model file's line as version 4 writes it (errors, no
+** correlations). */
+static int edit_to_v4(char *line, size_t size, void *arg)
+{
+    (void)size;
+    (void)arg;
+    if (!strcmp(line, "correlations\n") || !strncmp(line, "corr ", 5))
+        return 0;
+    if (!strncmp(line, "pm-model 5", 10))
+        strcpy(line, "pm-model 4\n");
+    return 1;
+}
+
+/* ... and as version 3 writes it (no errors). */
+static int edit_to_v3(char *line, size_t size, void *arg)
+{
+    char *e;
+    if (!edit_to_v4(line, size, arg) || !strcmp(line, "errors\n"))
+        return 0;
+    if (!strncmp(line, "pm-model 4", 10))
+        strcpy(line, "pm-model 3\n");
+    if (!strncmp(line, "term ", 5) && (e = strrchr(line, ' ')) != NULL)
+        strcpy(e, "\n"); /* the last field, the error */
+    return 1;
+}
+
+/* OLD's model file as version 4 (NAME.pm to NAMEv4.pm in dir). */
+static void to_v4(const char *name)
+{
+    char v5[160], v4[160];
+    snprintf(v5, sizeof v5, "%s/%s.pm", dir, name);
+    snprintf(v4, sizeof v4, "%s/%sv4.pm", dir, name);
+    tu_edited_copy(v5, v4, edit_to_v4, NULL);
+}
+
 /* Terms this sky confounds: an alt-az mount's collimation moved by 20"
 ** between two nights (c', d and i nearly one term at order 1).  No single
 ** term moves beyond 3 sigma, the old model leaves 14" where a refit leaves
@@ -283,13 +318,67 @@ START_TEST(test_compare_confounded_terms_moved)
     ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
     ck_assert_ptr_null(strstr(out, "everything else stable"));
     ck_assert_ptr_nonnull(strstr(out, "all terms together: moved"));
-    /* OLD the model file (errors without correlations): never "still holds"
-    ** where it predicts the night far worse than a refit, and it says why */
+    /* OLD the model file: it keeps the fit's covariance (version 5), and
+    ** the joint test reads the same */
     compare("az1.pm", "az2.dat");
-    printf("check_compare: the same, OLD the model file: %s\n", strstr(out, "\"advice\""));
+    printf("check_compare: the same, OLD the model file: joint test 10^%.1f; %s\n",
+           tu_json_num(out, "joint_log10_p"), strstr(out, "\"advice\""));
+    ck_assert(tu_json_num(out, "joint_log10_p") < -10);
+    ck_assert_ptr_nonnull(strstr(out, "\"advice\": \"refit"));
+    /* a version-4 file (errors without correlations): never "still holds"
+    ** where it predicts the night far worse than a refit, and it says why */
+    to_v4("az1");
+    compare("az1v4.pm", "az2.dat");
+    printf("check_compare: the same, OLD the version-4 model file: %s\n",
+           strstr(out, "\"advice\""));
     ck_assert_ptr_null(strstr(out, "still holds"));
     ck_assert_ptr_nonnull(strstr(out, "refit"));
     ck_assert_ptr_nonnull(strstr(out, "compare with the old run itself"));
+}
+END_TEST
+
+/* An unchanged mount's two nights, each on its own half of the sky (the
+** independent gimbal's --coverage half), OLD the first night's model file:
+** it keeps the fit's covariance (version 5), so the joint test and the
+** advice are the old run's.  A version-4 file (errors, the refit's
+** correlations borrowed) read such pairs as "differ from the model
+** file's" and advised a refit (p = 10^-6.7 where the run gives 0.28). */
+START_TEST(test_compare_model_file_other_half_of_sky)
+{
+    static const char *mounts[2] = {"gem", "altaz"};
+    const char *top = getenv("PM_TOP");
+    char cmd[4096], run_advice[200];
+    int m, k, same = 0, pairs = 0;
+    if (!dir[0])
+        tu_tmpdir(dir, "pm_compare_");
+    for (m = 0; m < 2; m++)
+        for (k = 0; k < 4; k++) {
+            double p_run, p_file;
+            const char *a;
+            snprintf(cmd, sizeof cmd,
+                     "cd %s && for s in %d %d; do /usr/bin/python3 %s/tests/ref/indep_gen.py h$s.dat "
+                     "--mount %s --n 40 --seed $s --noise 1 --geom 0 --aniso 0 --index 1.5,-0.7 "
+                     "--coverage half 2>&1 || exit 1; done > /dev/null && mv h%d.dat h1.dat && "
+                     "mv h%d.dat h2.dat && %s fit h1.dat --save h1.pm > /dev/null",
+                     dir, 800 + 2 * k, 801 + 2 * k, top ? top : ".", mounts[m], 800 + 2 * k,
+                     801 + 2 * k, tu_pmfit_path());
+            ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
+            compare("h1.dat", "h2.dat");
+            p_run = tu_json_num(out, "joint_log10_p");
+            a = strstr(out, "\"advice\"");
+            ck_assert_ptr_nonnull(a);
+            snprintf(run_advice, sizeof run_advice, "%.60s", a);
+            compare("h1.pm", "h2.dat");
+            p_file = tu_json_num(out, "joint_log10_p");
+            printf("check_compare: unchanged %s mount, halves of the sky, seeds %d/%d: joint test "
+                   "10^%.2f (run) 10^%.2f (model file); %.60s\n",
+                   mounts[m], 800 + 2 * k, 801 + 2 * k, p_run, p_file, strstr(out, "\"advice\""));
+            ck_assert_ptr_nonnull(strstr(out, "\"old_covariance\": \"model_file\""));
+            ck_assert(fabs(p_run - p_file) < 0.01);
+            pairs++;
+            same += strstr(out, run_advice) != NULL;
+        }
+    ck_assert_int_eq(same, pairs);
 }
 END_TEST
 
@@ -332,21 +421,6 @@ START_TEST(test_compare_unchanged_mount_holds)
     ck_assert_int_ge(held, pairs - 1);
 }
 END_TEST
-
-/* A version-4 model file's line as version 3 writes it (no errors). */
-static int edit_to_v3(char *line, size_t size, void *arg)
-{
-    char *e;
-    (void)size;
-    (void)arg;
-    if (!strcmp(line, "errors\n"))
-        return 0;
-    if (!strncmp(line, "pm-model 4", 10))
-        strcpy(line, "pm-model 3\n");
-    if (!strncmp(line, "term ", 5) && (e = strrchr(line, ' ')) != NULL)
-        strcpy(e, "\n"); /* the last field, the error */
-    return 1;
-}
 
 /* Where the joint test has little power the cross-validation guards the
 ** advice: an alt-az azimuth index moved 10" between a night of 300 stars
@@ -457,6 +531,7 @@ static Suite *suite(void)
     tcase_add_test(t, test_compare_confounded_terms_moved);
     tcase_add_test(t, test_compare_unchanged_mount_holds);
     tcase_add_test(t, test_compare_guards);
+    tcase_add_test(t, test_compare_model_file_other_half_of_sky);
     suite_add_tcase(s, t);
     return s;
 }

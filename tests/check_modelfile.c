@@ -101,7 +101,7 @@ START_TEST(test_pmmodel_load_errors_name_line)
     make_tmpdir();
     expect_load_error("", "1", "empty");
     expect_load_error("hello\n", "1", "pm-model");
-    expect_load_error("pm-model 5\n", "1", "version");
+    expect_load_error("pm-model 6\n", "1", "version");
     expect_load_error("pm-model 1\nmount dobsonian\n", "2", "mount");
     expect_load_error("pm-model 1\nmount altaz\norder x\n", "3", "order");
     snprintf(big, sizeof big, "pm-model 1\nmount altaz\norder %d\n", PM_MAX_L + 1);
@@ -447,6 +447,123 @@ START_TEST(test_pmmodel_info)
 }
 END_TEST
 
+/* Version 5: the fit's covariance, kept as correlations beside the term
+** lines' errors (pmfit compare then tests a model file's changes with it,
+** as with the old run). */
+START_TEST(test_pmmodel_covariance)
+{
+    static const char head5[] = "pm-model 5\nmount equatorial\norder 0\nerrors\ncorrelations\n"
+                                "terms 6\nterm a 1 0 0 0 1e-6\nterm b 2 0 0 0 1e-6\n"
+                                "term c 3 0 0 0 1e-6\nterm d 4 0 0 0 1e-6\n"
+                                "term e 5 0 0 0 1e-6\nterm i 6 0 0 0 1e-6\n";
+    static const struct { const char *lines, *line, *word; } bad[] = {
+        {"corr 2 1 0\ncorr 3 1 0 0\nend\n", "15", "'end' before the correlations of term 4"},
+        {"corr 2 1 0\ncorr 3 2 0\n", "14", "out of order"},
+        {"corr 2 1 0\ncorr 3 1 0 0 0\n", "14", "has 2 left"},
+        {"corr 2 1 1.5\n", "13", "bad correlation"},
+        {"corr 2 1 nan\n", "13", "bad correlation"},
+        {"corr 2\n", "13", "expected 'corr 2 1 r...'"},
+        /* r21 = r31 = 0.9, r32 = -0.9: no covariance has these */
+        {"corr 2 1 0.9\ncorr 3 1 0.9 -0.9\ncorr 4 1 0 0 0\ncorr 5 1 0 0 0 0\n"
+         "corr 6 1 0 0 0 0 0\nend\n",
+         "14", "not those of a covariance"},
+        {"corr 2 1 0\ncorr 3 1 0 0\ncorr 4 1 0 0 0\ncorr 5 1 0 0 0 0\ncorr 6 1 0 0 0 0 0\n"
+         "corr 7 1 0\n",
+         "18", "more correlations"},
+    };
+    pm_model a, b;
+    pmmodel_info in, got;
+    double *A, *cov, *back;
+    char path[300], err[512], text[2048];
+    tu_rng r;
+    int P, i, j, k, has = 7;
+    FILE *f;
+    make_tmpdir();
+    path_in(path, sizeof path, "c.pm");
+    random_model(&a, 2, 21);
+    P = a.n_terms;
+    A = malloc(sizeof(double) * (size_t)(P * P));
+    cov = malloc(sizeof(double) * (size_t)(P * P));
+    back = malloc(sizeof(double) * (size_t)(PM_MAX_TERMS * PM_MAX_TERMS));
+    ck_assert(A && cov && back);
+    tu_seed(&r, 5);
+    for (i = 0; i < P * P; i++)
+        A[i] = tu_uniform(&r) - 0.5;
+    memset(&in, 0, sizeof in);
+    in.has_err = 1;
+    for (i = 0; i < P; i++)
+        for (j = 0; j < P; j++) {
+            double c = 0;
+            for (k = 0; k < P; k++)
+                c += A[i * P + k] * A[j * P + k];
+            cov[i * P + j] = 1e-12 * c; /* (A A^T: a covariance, radians^2) */
+        }
+    for (i = 0; i < P; i++)
+        in.err[i] = sqrt(cov[i * P + i]);
+    ck_assert_msg(pmmodel_save_cov(path, &a, &in, cov, "c", err, sizeof err) == 0, "%s", err);
+    f = fopen(path, "r");
+    ck_assert_ptr_nonnull(f);
+    ck_assert_ptr_nonnull(fgets(text, sizeof text, f)); /* the comment */
+    ck_assert_ptr_nonnull(fgets(text, sizeof text, f));
+    fclose(f);
+    ck_assert_str_eq(text, "pm-model 5\n");
+    for (i = 0; i < P * P; i++)
+        back[i] = -7;
+    ck_assert_msg(pmmodel_load_cov(path, &b, &got, back, (size_t)(PM_MAX_TERMS * PM_MAX_TERMS),
+                                   &has, err, sizeof err) == 0, "%s", err);
+    ck_assert_int_eq(has, 1);
+    ck_assert(memcmp(b.coef, a.coef, sizeof(double) * (size_t)P) == 0);
+    ck_assert(memcmp(got.err, in.err, sizeof(double) * (size_t)P) == 0);
+    for (i = 0; i < P; i++)
+        for (j = 0; j < P; j++)
+            ck_assert_msg(fabs(back[i * P + j] - cov[i * P + j]) <=
+                              1e-9 * sqrt(cov[i * P + i] * cov[j * P + j]),
+                          "cov[%d][%d] %.17g read back %.17g", i, j, cov[i * P + j], back[i * P + j]);
+    /* the older calls read it, without the covariance */
+    ck_assert_msg(pmmodel_load_info(path, &b, &got, err, sizeof err) == 0, "%s", err);
+    ck_assert_int_eq(got.has_err, 1);
+    ck_assert_msg(pmmodel_load(path, &b, err, sizeof err) == 0, "%s", err);
+    /* too little room: an error, nothing changed */
+    ck_assert_int_eq(pmmodel_load_cov(path, &b, &got, back, (size_t)(P * P - 1), &has, err,
+                                      sizeof err), -1);
+    ck_assert_msg(strstr(err, "needs") != NULL, "%s", err);
+    ck_assert_int_eq(has, 0);
+    /* a version-4 file: no covariance, the buffer untouched */
+    ck_assert_int_eq(pmmodel_save_info(path, &a, &in, NULL, err, sizeof err), 0);
+    back[0] = -7;
+    ck_assert_int_eq(pmmodel_load_cov(path, &b, &got, back, (size_t)(P * P), &has, err, sizeof err),
+                     0);
+    ck_assert_int_eq(has, 0);
+    ck_assert(back[0] == -7);
+    /* what cannot be written */
+    cov[1] += 1e-15; /* (not symmetric) */
+    ck_assert_int_eq(pmmodel_save_cov(path, &a, &in, cov, NULL, err, sizeof err), -1);
+    ck_assert_msg(strstr(err, "not symmetric") != NULL, "%s", err);
+    cov[1] -= 1e-15;
+    in.has_err = 0;
+    ck_assert_int_eq(pmmodel_save_cov(path, &a, &in, cov, NULL, err, sizeof err), -1);
+    ck_assert_msg(strstr(err, "needs the errors") != NULL, "%s", err);
+    /* the file's faults, at their line */
+    for (k = 0; k < (int)(sizeof bad / sizeof bad[0]); k++) {
+        snprintf(text, sizeof text, "%s%s", head5, bad[k].lines);
+        expect_load_error(text, bad[k].line, bad[k].word);
+    }
+    expect_load_error("pm-model 5\nmount equatorial\norder 0\ncorrelations\n", "4",
+                      "without the 'errors' line");
+    expect_load_error("pm-model 4\nmount equatorial\norder 0\nerrors\ncorrelations\n", "5",
+                      "version 5 has it");
+    expect_load_error("pm-model 5\nmount equatorial\norder 0\nerrors\nterms 6\n"
+                      "term a 1 0 0 0 1e-6\ncorr 2 1 0\n",
+                      "7", "without the 'correlations' line");
+    expect_load_error("pm-model 5\nmount equatorial\norder 0\nerrors\ncorrelations\nterms 6\n"
+                      "term a 1 0 0 0 1e-6\ncorr 2 1 0\n",
+                      "8", "before the last term line");
+    free(A);
+    free(cov);
+    free(back);
+}
+END_TEST
+
 static Suite *suite(void)
 {
     Suite *s = suite_create("modelfile");
@@ -463,6 +580,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_pmmodel_load_binary_and_missing);
     tcase_add_test(tc, test_pmmodel_save_unwritable);
     tcase_add_test(tc, test_pmmodel_info);
+    tcase_add_test(tc, test_pmmodel_covariance);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -1750,8 +1750,12 @@ int run_main(int argc, char **argv)
                                     : "");
         // a write that fails now still lets the report below be printed
         if (!o.save.empty() &&
-            pmmodel_save_info((o.save + suffix).c_str(), &fits[k].model, &info, note.c_str(), e,
-                              sizeof e) != 0)
+            pmmodel_save_cov((o.save + suffix).c_str(), &fits[k].model, &info,
+                             fits[k].cov.size() == (size_t)fits[k].model.n_terms *
+                                                       (size_t)fits[k].model.n_terms
+                                 ? fits[k].cov.data()
+                                 : nullptr,
+                             note.c_str(), e, sizeof e) != 0)
             write_errors.push_back(e);
         if (!o.tpoint_terms.empty()) {
             if (pmtp_write((o.tpoint_terms + suffix).c_str(), &fits[k].model, fits[k].res.err,

@@ -98,6 +98,18 @@ def test_compare_equals_pmfit(tmp_path):
     want = cli("compare", model, SIM, "--json")
     assert pm.compare(model, SIM) == want                     # OLD a model file
     assert pm.compare(pm.load_model(str(model)), SIM) == want  # OLD a Model
+    # the model file keeps the fit's covariance (version 5), and so does a
+    # fit's Model: the joint test uses it as the old run's; a Model whose
+    # coefficients were set keeps no errors
+    assert open(model).read().count("pm-model 5") == 1
+    assert want["old_covariance"] == "model_file"
+    fitted = pm.fit_run(SIM).model
+    assert pm.compare(fitted, SIM)["old_covariance"] == "model_file"
+    fitted.save(str(tmp_path / "f.pm"))
+    assert "correlations" in open(tmp_path / "f.pm").read()
+    fitted.coefficients = fitted.coefficients
+    assert pm.compare(fitted, SIM)["old_covariance"] == "none"
+    assert pm.compare(SIM, SIM)["old_covariance"] == "run"
     assert pm.compare(SIM, SIM, order=2)["n_terms"] == pm.fit_run(SIM, order=2).n_params
     # a model's own terms are compared: order or add with it is refused (an
     # order-1 model compared as order 1 under order=2, without a word)

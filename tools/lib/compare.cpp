@@ -146,8 +146,9 @@ double quad_form(const std::vector<double> &d, const std::vector<double> &C, int
 // c', d and i, correlated -0.9998) can move together by many sigma with
 // none beyond 3 alone (an outside probe: the old model left 14" where a
 // refit leaves 0.89", and the report said "everything else stable").
-// C_old: the old fit's covariance (OLD a run); for a model file, which
-// keeps each coefficient's error but not their correlations, its errors
+// C_old: the old fit's covariance (OLD a run, or a version-5 model file,
+// which keeps it); for a model file that keeps each coefficient's error
+// but not their correlations (version 4), its errors
 // with the refit's correlations shrunk by a tenth toward none (the same
 // terms on a sky like it are correlated alike, but not exactly: with the
 // refit's own, an unchanged alt-az mount's pair of nights of 40 stars read
@@ -155,7 +156,8 @@ double quad_form(const std::vector<double> &d, const std::vector<double> &C, int
 // i lying a little elsewhere; each term's own error says how well the old
 // sky held it); none without errors.
 void joint_tests(const pm_model &old_model, const std::vector<double> &old_err,
-                 const FitOut &f, const FitOut *old_fit, Comparison &c)
+                 const FitOut &f, const FitOut *old_fit, const std::vector<double> *old_cov,
+                 Comparison &c)
 {
     const int P = old_model.n_terms;
     if (f.cov.size() != (size_t)(P * P) || P < 6)
@@ -167,6 +169,12 @@ void joint_tests(const pm_model &old_model, const std::vector<double> &old_err,
         for (size_t k = 0; k < C.size(); k++)
             C[k] += old_fit->cov[k];
         c.old_cov = "the old fit's";
+        c.old_cov_kind = "run";
+    } else if (old_cov && old_cov->size() == (size_t)(P * P)) {
+        for (size_t k = 0; k < C.size(); k++)
+            C[k] += (*old_cov)[k];
+        c.old_cov = "the model file's";
+        c.old_cov_kind = "model_file";
     } else if (old_err.size() >= (size_t)P) {
         for (int i = 0; i < P; i++)
             if (!(f.cov[(size_t)(i * P + i)] > 0))
@@ -180,6 +188,7 @@ void joint_tests(const pm_model &old_model, const std::vector<double> &old_err,
                             : (1 - shrink) * f.cov[(size_t)(i * P + j)] /
                                   std::sqrt(f.cov[(size_t)(i * P + i)] * f.cov[(size_t)(j * P + j)]));
         c.old_cov = "the model file's errors, correlated as the refit's terms";
+        c.old_cov_kind = "errors_only";
         c.old_cov_borrowed = true;
     } else {
         c.old_cov = "none (the model file keeps no errors)";
@@ -311,7 +320,8 @@ double predicted_over(const FitOut &f, const Run &run)
 }
 
 Comparison compare_models(const pm_model &old_in, const std::vector<double> &old_err,
-                          const Run &run, const FitOut *old_fit, const Run *old_run)
+                          const Run &run, const FitOut *old_fit, const Run *old_run,
+                          const std::vector<double> *old_cov)
 {
     // The site is the run's: where the run gives a latitude other than the
     // model's (a portable mount moved, or another mount's model), the model
@@ -405,7 +415,7 @@ Comparison compare_models(const pm_model &old_in, const std::vector<double> &old
         c.old_pred_new = predicted_over(*old_fit, run);
         c.old_pred_old = predicted_over(*old_fit, *old_run);
     }
-    joint_tests(old_model, old_err, f, old_fit, c);
+    joint_tests(old_model, old_err, f, old_fit, old_cov, c);
     c.advice = advice_of(c);
     if (std::isfinite(c.old_pred_new) && c.old_pred_new > 2 * c.old_pred_old &&
         c.old_pred_new > c.sigma_refit) {
@@ -444,7 +454,8 @@ std::string comparison_json(const Comparison &c)
          num(c.rezero_e) + ", \"e_error_arcsec\": " + num(c.rezero_e_err) +
          "}, \"cv_rms_arcsec\": {\"as_is\": " + num(c.cv_as_is) + ", \"rezero\": " +
          num(c.cv_rezero) + ", \"refit\": " + num(c.cv_refit) +
-         "}, \"joint_log10_p\": " + num(c.joint_log10p) + ", \"rest_log10_p\": " +
+         "}, \"old_covariance\": \"" + c.old_cov_kind + "\", \"joint_log10_p\": " +
+         num(c.joint_log10p) + ", \"rest_log10_p\": " +
          num(c.rest_log10p) + ", \"old_predicted_sigma_arcsec\": {\"at_new_points\": " + num(c.old_pred_new) +
          ", \"at_old_points\": " + num(c.old_pred_old) + "}, \"advice\": \"" +
          json_escape(c.advice) + "\", \"notes\": [";
@@ -517,14 +528,17 @@ OldSide old_from_run(const Run &run, int order, const std::vector<std::string> &
     return o;
 }
 
-OldSide old_from_model(const pm_model &m, const pmmodel_info &info)
+OldSide old_from_model(const pm_model &m, const pmmodel_info &info, const std::vector<double> &cov)
 {
     OldSide o;
     o.model = m;
     o.inputs = model_inputs(info);
     o.pier = info.pier;
-    if (info.has_err) /* the fit's errors the file keeps count as a run's do */
+    if (info.has_err) { /* the fit's errors the file keeps count as a run's do */
         o.err.assign(info.err, info.err + m.n_terms);
+        if (cov.size() == (size_t)m.n_terms * (size_t)m.n_terms)
+            o.cov = cov; /* and its covariance (version 5) */
+    }
     return o;
 }
 
@@ -538,9 +552,13 @@ OldSide load_old(const std::string &path, int order, const std::vector<std::stri
         throw std::runtime_error(err);
     if (kind == 1) {
         pmmodel_info info;
-        if (pmmodel_load_info(path.c_str(), &o.model, &info, err, sizeof err) != 0)
+        std::vector<double> cov((size_t)PM_MAX_TERMS * PM_MAX_TERMS);
+        int has_cov = 0;
+        if (pmmodel_load_cov(path.c_str(), &o.model, &info, cov.data(), cov.size(), &has_cov, err,
+                             sizeof err) != 0)
             throw std::runtime_error(err);
-        return old_from_model(o.model, info);
+        cov.resize(has_cov ? (size_t)o.model.n_terms * (size_t)o.model.n_terms : 0);
+        return old_from_model(o.model, info, cov);
     }
     return old_from_run(load_run(path, refraction, skip_bad, format, equinox), order, adds,
                         max_passes);
@@ -551,7 +569,7 @@ Comparison compare_old(const OldSide &os, const Run &run, const std::string &old
     std::vector<std::string> notes;
     Run r = run_for_model(run, os.model, os.inputs, os.pier, old_name, &notes);
     Comparison c = compare_models(os.model, os.err, r, os.is_run ? &os.fit : nullptr,
-                                  os.is_run ? &os.run : nullptr);
+                                  os.is_run ? &os.run : nullptr, os.cov.empty() ? nullptr : &os.cov);
     c.notes = notes;
     return c;
 }

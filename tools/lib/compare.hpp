@@ -40,6 +40,9 @@ struct Comparison {
     double joint_log10p = NAN, rest_log10p = NAN;
     std::string old_cov;
     bool old_cov_borrowed = false; // a model file's errors with the refit's correlations
+    // JSON's "old_covariance": "run", "model_file" (version 5), "errors_only"
+    // (version 4: the refit's correlations borrowed) or "none"
+    std::string old_cov_kind = "none";
     std::string advice;
     std::vector<std::string> notes; // how the run was read for the old model (run_for_model)
     pm_model refit, rezeroed;
@@ -48,17 +51,20 @@ struct Comparison {
 // old_model: the earlier model; old_err: its coefficients' 1-sigma errors
 // (empty when it came from a model file); run: the new night.  Throws
 // std::runtime_error with the reason (mount mismatch, the refit failing).
-// old_fit, old_run: the fit OLD came from (a run), or null (a model file).
+// old_fit, old_run: the fit OLD came from (a run), or null (a model file);
+// old_cov: a model file's covariance (P x P, version 5), or null.
 Comparison compare_models(const pm_model &old_model, const std::vector<double> &old_err,
                           const Run &run, const FitOut *old_fit = nullptr,
-                          const Run *old_run = nullptr);
+                          const Run *old_run = nullptr,
+                          const std::vector<double> *old_cov = nullptr);
 
 // OLD of pmfit compare and pmfit report --compare: a model file, or a run
 // fitted at order + adds (do_fit with max_passes).
 struct OldSide {
     bool is_run = false;
     pm_model model;            // the model file's, or the run's fit (on success)
-    std::vector<double> err;   // the run's fit's 1-sigma errors; empty for a model file
+    std::vector<double> err;   // the fit's 1-sigma errors (a model file's where it keeps them)
+    std::vector<double> cov;   // a model file's covariance (version 5), P x P; else empty
     FitOut fit;                // a run: its fit; check fit.status (the caller words a failure)
     Run run;                   // a run: the run
     // the columns the model reads as ctx.aux[j] (a run's names; a model
@@ -73,7 +79,8 @@ OldSide load_old(const std::string &path, int order, const std::vector<std::stri
 
 // OLD as a model (prepared) and what its file says: its inputs' names, its
 // pier side, its coefficients' errors where it keeps them.
-OldSide old_from_model(const pm_model &m, const pmmodel_info &info);
+OldSide old_from_model(const pm_model &m, const pmmodel_info &info,
+                       const std::vector<double> &cov = std::vector<double>());
 // OLD as a run already read: fitted at order + adds (do_fit with max_passes).
 OldSide old_from_run(const Run &run, int order, const std::vector<std::string> &adds,
                      int max_passes);

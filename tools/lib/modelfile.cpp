@@ -193,8 +193,43 @@ extern "C" int pmmodel_save(const char *path, const pm_model *m, const char *com
     return pmmodel_save_info(path, m, nullptr, comment, err, errlen);
 }
 
-extern "C" int pmmodel_save_info(const char *path, const pm_model *m, const pmmodel_info *info,
-                                 const char *comment, char *err, size_t errlen)
+// The correlation rows of a version-5 file from the covariance (row-major,
+// P x P): 'corr I J r...' lines, I = 2..P, at most 8 values a line, the
+// lower triangle in order; false with err where cov is not a covariance.
+static bool corr_lines(const pm_model *m, const double *cov, const char *path,
+                       std::string *lines, char *err, size_t errlen)
+{
+    const int P = m->n_terms;
+    for (int i = 0; i < P; i++)
+        for (int j = 0; j <= i; j++) {
+            const double c = cov[(size_t)i * P + j];
+            if (!std::isfinite(c) || c != cov[(size_t)j * P + i] || (i == j && c < 0)) {
+                set_err(err, errlen, std::string(path) + ": pmmodel_save_cov: the covariance of " +
+                                         name_of(m, i) + " and " + name_of(m, j) +
+                                         (i == j ? " is not a finite number >= 0"
+                                                 : " is not finite or not symmetric"));
+                return false;
+            }
+        }
+    for (int i = 1; i < P; i++)
+        for (int j0 = 0; j0 < i; j0 += 8) {
+            char b[64];
+            std::snprintf(b, sizeof b, "corr %d %d", i + 1, j0 + 1);
+            *lines += b;
+            for (int j = j0; j < i && j < j0 + 8; j++) {
+                const double vi = cov[(size_t)i * P + i], vj = cov[(size_t)j * P + j];
+                double r = vi > 0 && vj > 0 ? cov[(size_t)i * P + j] / std::sqrt(vi * vj) : 0;
+                r = r > 1 ? 1 : r < -1 ? -1 : r;
+                std::snprintf(b, sizeof b, " %.10g", r);
+                *lines += b;
+            }
+            *lines += "\n";
+        }
+    return true;
+}
+
+static int save_model(const char *path, const pm_model *m, const pmmodel_info *info,
+                      const double *cov, const char *comment, char *err, size_t errlen)
 {
     if (!path || !m || m->n_terms < 6 || m->n_terms > PM_MAX_TERMS) {
         set_err(err, errlen, "pmmodel_save: invalid arguments");
@@ -202,14 +237,25 @@ extern "C" int pmmodel_save_info(const char *path, const pm_model *m, const pmmo
     }
     if (!preparable(m, path, "pmmodel_save", err, errlen))
         return -1;
-    std::string extra;
+    std::string extra, corr;
     if (!info_lines(m, info, path, &extra, err, errlen))
         return -1;
+    if (cov) {
+        if (!info || !info->has_err) {
+            set_err(err, errlen, std::string(path) + ": pmmodel_save_cov: the covariance needs "
+                                     "the errors (info->has_err): the file keeps correlations "
+                                     "beside them");
+            return -1;
+        }
+        if (!corr_lines(m, cov, path, &corr, err, errlen))
+            return -1;
+        extra += "correlations\n"; /* (the 'corr' lines after the terms) */
+    }
     std::string out;
     comment_lines(out, comment, "# ");
     /* (version 3 where there is nothing more to say: a reader of before
-    ** version 4 reads it as before) */
-    out += extra.empty() ? "pm-model 3\n" : "pm-model 4\n";
+    ** version 4 reads it as before; 5 only with correlations) */
+    out += cov ? "pm-model 5\n" : extra.empty() ? "pm-model 3\n" : "pm-model 4\n";
     out += std::string("mount ") + (m->mount == PM_MOUNT_ALTAZ ? "altaz" : "equatorial") + "\n";
     out += "order " + std::to_string(m->order) + "\n";
     if (m->latitude != 0)
@@ -231,8 +277,22 @@ extern "C" int pmmodel_save_info(const char *path, const pm_model *m, const pmmo
         out += buf;
         out += errs ? " " + fmt17(info->err[i]) + "\n" : std::string("\n");
     }
+    if (cov)
+        out += "# correlations of term I with terms J, J+1, ... (the lower triangle)\n" + corr;
     out += "end\n";
     return write_atomic(path, out, err, errlen);
+}
+
+extern "C" int pmmodel_save_info(const char *path, const pm_model *m, const pmmodel_info *info,
+                                 const char *comment, char *err, size_t errlen)
+{
+    return save_model(path, m, info, nullptr, comment, err, errlen);
+}
+
+extern "C" int pmmodel_save_cov(const char *path, const pm_model *m, const pmmodel_info *info,
+                                const double *cov, const char *comment, char *err, size_t errlen)
+{
+    return save_model(path, m, info, cov, comment, err, errlen);
 }
 
 namespace {
@@ -249,6 +309,10 @@ struct Loader {
     pm_model m;
     pmmodel_info info;          // version 4's input and pier lines
     std::vector<int> term_line; // line of each term, for the term-list check
+    bool has_corr = false;      // version 5's 'correlations' line
+    int corr_row = 1, corr_col = 0; // the next correlation (0-based: row > col)
+    std::vector<double> corr;   // P x P, unit diagonal
+    std::vector<int> corr_line; // line of each row's first 'corr' line
     Loader()
     {
         std::memset(&m, 0, sizeof m);
@@ -295,6 +359,19 @@ std::string info_line(Loader &L, const std::vector<std::string> &tok)
     if (L.version < 4)
         return "an '" + tok[0] + "' line in a 'pm-model " + std::to_string(L.version) +
                "' file (version 4 has them)";
+    if (tok[0] == "correlations") {
+        if (L.version < 5)
+            return "a 'correlations' line in a 'pm-model " + std::to_string(L.version) +
+                   "' file (version 5 has it)";
+        if (tok.size() != 1)
+            return "expected 'correlations' alone ('corr' lines after the terms then give them)";
+        if (!L.info.has_err)
+            return "a 'correlations' line without the 'errors' line before it";
+        if (L.has_corr)
+            return "a second 'correlations' line";
+        L.has_corr = true;
+        return "";
+    }
     if (tok[0] == "errors") {
         if (tok.size() != 1)
             return "expected 'errors' alone (each term line then ends in its 1-sigma error)";
@@ -338,9 +415,9 @@ std::string header_line(Loader &L, const std::vector<std::string> &tok)
     switch (L.state) {
     case Loader::HEADER:
         if (tok.size() != 2 || tok[0] != "pm-model")
-            return "expected 'pm-model 3' (is this a pm model file?)";
-        if (tok[1] != "1" && tok[1] != "2" && tok[1] != "3" && tok[1] != "4")
-            return "model file version '" + tok[1] + "' not supported (expected 4 or 3, or 2 "
+            return "expected 'pm-model N' first, N = 1..5 (is this a pm model file?)";
+        if (tok[1] != "1" && tok[1] != "2" && tok[1] != "3" && tok[1] != "4" && tok[1] != "5")
+            return "model file version '" + tok[1] + "' not supported (expected 5, 4 or 3, or 2 "
                    "or 1)";
         L.version = tok[1][0] - '0';
         L.state = Loader::MOUNT;
@@ -366,7 +443,8 @@ std::string header_line(Loader &L, const std::vector<std::string> &tok)
                 return "bad latitude '" + tok[1] + "' (expected radians, |lat| <= pi/2)";
             return "";
         }
-        if (tok[0] == "input" || tok[0] == "pier" || tok[0] == "errors")
+        if (tok[0] == "input" || tok[0] == "pier" || tok[0] == "errors" ||
+            tok[0] == "correlations")
             return info_line(L, tok);
         if (tok.size() != 2 || tok[0] != "terms" || !parse_int(tok[1], 6, 100000, &L.nterms))
             return "expected 'terms P' with an integer P >= 6";
@@ -378,6 +456,11 @@ std::string header_line(Loader &L, const std::vector<std::string> &tok)
         L.m.order = (int)L.order;
         L.m.n_terms = (int)L.nterms;
         L.m.latitude = L.latitude;
+        if (L.has_corr) {
+            L.corr.assign((size_t)(L.nterms * L.nterms), 0.0);
+            for (long i = 0; i < L.nterms; i++)
+                L.corr[(size_t)(i * L.nterms + i)] = 1;
+        }
         L.state = Loader::BODY;
         return "";
     }
@@ -446,6 +529,72 @@ std::string harmonic_term(Loader &L, const std::vector<std::string> &tok)
     return "";
 }
 
+// corr I J r...: term I's correlations with terms J, J+1, ... (1-based),
+// the lower triangle's next values in order: "" or why not.
+std::string corr_line(Loader &L, const std::vector<std::string> &tok)
+{
+    if (!L.has_corr)
+        return "a 'corr' line without the 'correlations' line in the header";
+    if (L.got != L.nterms)
+        return "a 'corr' line before the last term line (correlations come after every term)";
+    if (L.corr_row >= L.nterms)
+        return "more correlations than the " + std::to_string(L.nterms) + " terms have";
+    long I, J;
+    const std::string want = "'corr " + std::to_string(L.corr_row + 1) + " " +
+                             std::to_string(L.corr_col + 1) + " r...'";
+    if (tok.size() < 4 || !parse_int(tok[1], 1, 100000, &I) || !parse_int(tok[2], 1, 100000, &J))
+        return "expected " + want + " (term I's correlations with terms J, J+1, ...)";
+    if (I != L.corr_row + 1 || J != L.corr_col + 1)
+        return "'corr " + tok[1] + " " + tok[2] + "' out of order, expected " + want +
+               " (the lower triangle, row by row)";
+    if ((long)tok.size() - 3 > I - J)
+        return std::to_string(tok.size() - 3) + " correlations from term " + tok[2] +
+               " on, term " + tok[1] + " has " + std::to_string(I - J) + " left before itself";
+    if (L.corr_col == 0)
+        L.corr_line.push_back(L.lineno);
+    const size_t P = (size_t)L.nterms;
+    for (size_t q = 3; q < tok.size(); q++) {
+        double r;
+        if (!parse_double(tok[q], &r) || std::fabs(r) > 1)
+            return "bad correlation '" + tok[q] + "' of terms " + tok[1] + " and " +
+                   std::to_string(L.corr_col + 1) + " (expected a number within -1..1)";
+        L.corr[(size_t)L.corr_row * P + (size_t)L.corr_col] =
+            L.corr[(size_t)L.corr_col * P + (size_t)L.corr_row] = r;
+        if (++L.corr_col == L.corr_row) {
+            L.corr_row++;
+            L.corr_col = 0;
+        }
+    }
+    return "";
+}
+
+// The correlations must be those of a covariance (positive semi-definite,
+// to their 10 digits): "" or why not, L.lineno the row to blame.
+std::string check_correlations(Loader &L)
+{
+    const size_t P = (size_t)L.nterms;
+    std::vector<double> c = L.corr; // Cholesky in place, lower triangle
+    for (size_t j = 0; j < P; j++) {
+        double d = c[j * P + j];
+        for (size_t k = 0; k < j; k++)
+            d -= c[j * P + k] * c[j * P + k];
+        if (d < -1e-6) {
+            L.lineno = j > 0 ? L.corr_line[j - 1] : L.end_line;
+            return "the correlations are not those of a covariance (not positive semi-definite "
+                   "at term " + std::to_string(j + 1) + ", " + name_of(&L.m, (int)j) + ")";
+        }
+        const double s = d > 1e-12 ? std::sqrt(d) : 0;
+        c[j * P + j] = s;
+        for (size_t i = j + 1; i < P; i++) {
+            double v = c[i * P + j];
+            for (size_t k = 0; k < j; k++)
+                v -= c[i * P + k] * c[j * P + k];
+            c[i * P + j] = s > 0 ? v / s : 0;
+        }
+    }
+    return "";
+}
+
 // One line of the file (not blank, not a comment): "" or why it is wrong.
 std::string file_line(Loader &L, const std::vector<std::string> &tok)
 {
@@ -457,10 +606,18 @@ std::string file_line(Loader &L, const std::vector<std::string> &tok)
         if (L.got != L.nterms)
             return "'end' after " + std::to_string(L.got) + " terms; the header says " +
                    std::to_string(L.nterms);
+        if (L.has_corr && L.corr_row < L.nterms)
+            return "'end' before the correlations of term " + std::to_string(L.corr_row + 1) +
+                   " (expected 'corr " + std::to_string(L.corr_row + 1) + " " +
+                   std::to_string(L.corr_col + 1) + " ...': the file's 'correlations' line)";
         L.end_line = L.lineno;
         L.state = Loader::DONE;
         return "";
     }
+    if (tok[0] == "corr")
+        return corr_line(L, tok);
+    if (L.has_corr && L.corr_row > 1)
+        return "a term line after the 'corr' lines (they come after every term)";
     const size_t e = L.info.has_err ? 1 : 0; /* the error field after the value */
     std::string why;
     if (tok.size() == 10 + e && tok[0] == "xterm")
@@ -520,8 +677,8 @@ extern "C" int pmmodel_load(const char *path, pm_model *out, char *err, size_t e
     return pmmodel_load_info(path, out, nullptr, err, errlen);
 }
 
-extern "C" int pmmodel_load_info(const char *path, pm_model *out, pmmodel_info *info, char *err,
-                                 size_t errlen)
+static int load_model(const char *path, pm_model *out, pmmodel_info *info, double *cov,
+                      size_t cov_len, int *has_cov, char *err, size_t errlen)
 {
     if (!path || !out) {
         set_err(err, errlen, "pmmodel_load: invalid arguments");
@@ -569,8 +726,17 @@ extern "C" int pmmodel_load_info(const char *path, pm_model *out, pmmodel_info *
     }
     L.m.n_base = L.base < 0 ? (int)L.nterms : L.base;
     std::string why = check_term_list(L);
+    if (why.empty() && L.has_corr)
+        why = check_correlations(L);
     if (!why.empty())
         return fail(why);
+    const size_t P = (size_t)L.nterms;
+    if (L.has_corr && cov && cov_len < P * P) {
+        set_err(err, errlen, std::string(path) + ": pmmodel_load_cov: the covariance of " +
+                                 std::to_string(P) + " terms needs " + std::to_string(P * P) +
+                                 " doubles, cov_len is " + std::to_string(cov_len));
+        return -1;
+    }
     pm_model &m = L.m;
     pm_status st = pm_model_prepare(&m);
     if (st == PM_ERR_NONFINITE) {
@@ -588,7 +754,27 @@ extern "C" int pmmodel_load_info(const char *path, pm_model *out, pmmodel_info *
     *out = m;
     if (info)
         *info = L.info;
+    if (has_cov)
+        *has_cov = L.has_corr && cov ? 1 : 0;
+    if (L.has_corr && cov)
+        for (size_t i = 0; i < P; i++)
+            for (size_t j = 0; j < P; j++)
+                cov[i * P + j] = L.corr[i * P + j] * L.info.err[i] * L.info.err[j];
     return 0;
+}
+
+extern "C" int pmmodel_load_info(const char *path, pm_model *out, pmmodel_info *info, char *err,
+                                 size_t errlen)
+{
+    return load_model(path, out, info, nullptr, 0, nullptr, err, errlen);
+}
+
+extern "C" int pmmodel_load_cov(const char *path, pm_model *out, pmmodel_info *info, double *cov,
+                                size_t cov_len, int *has_cov, char *err, size_t errlen)
+{
+    if (has_cov)
+        *has_cov = 0;
+    return load_model(path, out, info, cov, cov_len, has_cov, err, errlen);
 }
 
 extern "C" int pmmodel_emit_c(const char *path, const pm_model *m, const char *prefix,

@@ -5,7 +5,8 @@
 **  The model file format (docs/formats.md, "Model files"):
 **
 **     # any comment
-**     pm-model 3                  (versions 1, 2 read as docs/formats.md says)
+**     pm-model 3                  (4: the lines below; 5: correlations;
+**                                  versions 1, 2 read as docs/formats.md says)
 **     mount equatorial            (or altaz)
 **     order 2
 **     input 0 humidity            (version 4 only: pmmodel_info below)
@@ -89,6 +90,29 @@ int pmmodel_save_info(const char *path, const pm_model *m, const pmmodel_info *i
                       const char *comment, char *err, size_t errlen);
 int pmmodel_load_info(const char *path, pm_model *m, pmmodel_info *info, char *err,
                       size_t errlen);
+
+/*
+**  pmmodel_save_cov / pmmodel_load_cov - pmmodel_save_info and
+**  pmmodel_load_info with the fit's covariance of the coefficients
+**  (version 5): cov is n_terms x n_terms, row-major, radians^2.  The file
+**  keeps the correlations, to 10 significant digits, after the term lines
+**  ('corr I J r...'), beside the errors of the term lines; a later
+**  comparison (pmfit compare MODEL RUN) then tests the changes of all terms
+**  together with the old fit's covariance, as it does with the old run.
+**  save: cov NULL is pmmodel_save_info; with cov, info->has_err must be set
+**  (the errors the file gives are info->err, the correlations cov's);
+**  cov must be finite and symmetric with a diagonal >= 0.
+**  load: cov has room for cov_len doubles (NULL: not read); *has_cov (may
+**  be NULL) is 1 where the file keeps correlations and cov was filled,
+**  cov[i*P + j] = r_ij err_i err_j, else 0 and cov untouched.  A file whose
+**  correlations are out of order, incomplete, beyond -1..1 or not those of
+**  a covariance (not positive semi-definite) is refused at its line; a
+**  cov_len below P*P for a file that keeps them is an error.
+*/
+int pmmodel_save_cov(const char *path, const pm_model *m, const pmmodel_info *info,
+                     const double *cov, const char *comment, char *err, size_t errlen);
+int pmmodel_load_cov(const char *path, pm_model *m, pmmodel_info *info, double *cov,
+                     size_t cov_len, int *has_cov, char *err, size_t errlen);
 
 /*
 **  pmmodel_emit_c - write a C89 header holding the model as constant data
