@@ -484,7 +484,7 @@ START_TEST(test_pmfit_columns_by_name)
     ck_assert_msg(run("%s fit %s%s", args, "") == 0, "%s", out);
     rms_fit = tu_json_num(out, "rms_arcsec");
     ck_assert_double_lt(rms_fit, 2.0);
-    snprintf(cmd, sizeof cmd, "grep -c '^input 1 press$' %s && grep -c '^pm-model 4$' %s && "
+    snprintf(cmd, sizeof cmd, "grep -c '^input 1 press$' %s && grep -c '^pm-model 5$' %s && "
              "grep -c \"aux\\[1\\]: the run's column 'press'\" %s", m, m, h);
     ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
 
