@@ -767,10 +767,10 @@ py::dict run_info(const RunData &d)
     i["path"] = d.run.path;
     i["mount"] = d.run.mount == PM_MOUNT_ALTAZ ? "altaz" : "equatorial";
     i["latitude"] = d.run.latitude;
-    i["format"] = d.format == PMRUN_FORMAT_FOUR_COLUMN ? py::object(py::str("four-column"))
-                  : d.format == PMRUN_FORMAT_NAMED     ? py::object(py::str("named"))
-                  : d.format == PMRUN_FORMAT_TPOINT    ? py::object(py::str("tpoint"))
-                                                       : py::object(py::none());
+    // pmfit --format's name of every format (it named three, None for the
+    // CSV, MW4, RTS2 and MMT files: an outside probe)
+    const char *fname = d.format == PMRUN_FORMAT_AUTO ? nullptr : pmrun_format_name(d.format);
+    i["format"] = fname ? py::object(py::str(fname)) : py::object(py::none());
     i["warnings"] = d.run.notes;
     i["skipped"] = d.skipped;
     i["aux_names"] = d.run.aux_names;

@@ -293,6 +293,42 @@ START_TEST(test_errormap_side_never_used)
 }
 END_TEST
 
+/* A model of one pier side (pmfit fit --pier split) is mapped where the
+** mount uses that side: beyond the meridian limit on its own half of the
+** sky, and within it.  Each side's model had been mapped over the whole sky,
+** half of it where the mount never takes that side: flip_gem's 4.2" and
+** 3.8" for 0.32" at the stars, and gem-28's west model "undetermined"
+** (393", 3.35 times its sigma; an outside probe). */
+START_TEST(test_errormap_split_sides)
+{
+    static char out[1 << 16];
+    static const char *const sides[2] = {"\"east\"", "\"west\""};
+    const char *top = getenv("PM_TOP");
+    char path[512], cmd[2048];
+    int k, real;
+    for (real = 0; real < 2; real++) {
+        if (!real)
+            snprintf(path, sizeof path, "%s/tests/data/flip_gem_pm180.dat", top ? top : ".");
+        else if (!tu_real_run("celestial/gem-28.dat", path, sizeof path))
+            break;
+        snprintf(cmd, sizeof cmd, "%s fit '%s' --pier split --json 2>/dev/null", tu_pmfit_path(),
+                 path);
+        ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
+        for (k = 0; k < 2; k++) {
+            const char *sd = strstr(out, sides[k]), *em;
+            ck_assert_ptr_nonnull(sd);
+            em = strstr(sd, "\"error_map\"");
+            ck_assert_ptr_nonnull(em);
+            printf("check_errormap: %s, the %s model: over its side's sky %.3f\", at the stars "
+                   "%.3f\"\n", real ? "gem-28" : "flip_gem", sides[k], tu_json_num(em, "rms_arcsec"),
+                   tu_json_num(em, "at_points_arcsec"));
+            ck_assert(tu_json_num(em, "rms_arcsec") < 3 * tu_json_num(em, "at_points_arcsec"));
+            ck_assert_ptr_nonnull(strstr(em, "\"undetermined\": false"));
+        }
+    }
+}
+END_TEST
+
 /* pm_fit_point_gain against the refit with the star taken: the fall of the
 ** mean predicted variance over the places (each fit's variance scaled by
 ** its own sigma^2, since one more star changes sigma a little). */
@@ -357,6 +393,7 @@ static Suite *suite(void)
     tcase_add_test(t, test_errormap_errors);
     tcase_add_test(t, test_errormap_pmfit);
     tcase_add_test(t, test_errormap_side_never_used);
+    tcase_add_test(t, test_errormap_split_sides);
     tcase_add_test(t, test_point_gain_matches_refit);
     suite_add_tcase(s, t);
     return s;

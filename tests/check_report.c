@@ -376,6 +376,7 @@ START_TEST(test_report_bad_input)
     fitmsg[strcspn(fitmsg, "\n")] = 0;
     ck_assert_int_eq(report(bad, "", "page.html"), 1);
     ck_assert_msg(strstr(out, fitmsg) == out, "report says '%s', fit '%s'", out, fitmsg);
+    ck_assert_msg(strstr(out, "(no page written)") != NULL, "%s", out); /* (as docs/report.md) */
     unchanged("page.html", "an earlier page\n");
     /* a malformed OLD: its file:line, nothing written */
     snprintf(cmd, sizeof cmd, "%s/examples/sim_gem.dat", top());

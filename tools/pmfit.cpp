@@ -110,8 +110,9 @@ void usage(FILE *f)
     std::fprintf(f,
         "usage: pmfit fit RUN [--order L] [--pier joint|split] [--add EFFECT ...] [--json]\n"
         "                     [--residuals FILE] [--save MODEL] [--emit-c HEADER]\n"
-        "                     [--tpoint-terms FILE] [--no-refraction] [--skip-bad]\n"
-        "                     [--robust [--clip K]] [--format NAME] [--equinox J2000|JNow]\n"
+        "                     [--error-map F] [--tpoint-terms FILE] [--no-refraction]\n"
+        "                     [--skip-bad] [--robust [--clip K]] [--format NAME]\n"
+        "                     [--equinox J2000|JNow]\n"
         "\n"
         "  RUN              pointing run: four-column, named-column, TPOINT, RTS2 gpoint,\n"
         "                   MountWizzard4 JSON, CSV log or MMT log (docs/formats.md)\n"
@@ -237,6 +238,7 @@ void usage(FILE *f)
         "usage: pmfit simulate OUT [--n N] [--seed S] [--lat DEG] [--mount equatorial|altaz]\n"
         "                      [--fork] [--el-limit DEG] [--noise ARCSEC] [--order L]\n"
         "                      [--term NAME=ARCSEC ...] [--random-aniso ARCSEC]\n"
+        "                      [--effect EFFECT=SIZE ...] [--phase DEG]\n"
         "\n"
         "  writes a simulated run in the named-column format (docs/formats.md):\n"
         "  --n N            points (default 200)      --seed S        random seed (default 1)\n"
@@ -1611,7 +1613,13 @@ int run_main(int argc, char **argv)
     if (o.cmd == "plan")
         return cmd_plan(o);
 
-    Run run = load_run(o.run, o.refraction, o.skip_bad, o.format, o.equinox);
+    Run run;
+    try {
+        run = load_run(o.run, o.refraction, o.skip_bad, o.format, o.equinox);
+    } catch (const std::exception &x) {
+        // (report says so of every failure; its run's had lacked it)
+        die(std::string(x.what()) + (o.cmd == "report" ? " (no page written)" : ""), 1);
+    }
     for (const std::string &n : run.notes)
         std::fprintf(stderr, "pmfit: note: %s\n", n.c_str());
     std::vector<Obs> &obs = run.obs;

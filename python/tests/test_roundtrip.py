@@ -344,3 +344,13 @@ def test_error_map_and_undetermined_match_pmfit(tmp_path):
         res = pm.fit_run(str(few))
     assert res.to_dict()["error_map"] == out["error_map"]
     assert res.error_map["undetermined"] is True and "do not determine" in res.undetermined
+
+
+def test_run_format_names_every_format():
+    """Run.format is pmfit --format's name for every reader (it was None for
+    the CSV, MW4, RTS2 and MMT files: an outside probe), None for arrays."""
+    data = os.path.join(TOP, "tests", "data")
+    for name, want in (("formats_source_eq.dat", "named"), ("tpoint_equat.dat", "tpoint"),
+                       ("rts2_gpoint.dat", "rts2"), ("mw4_model.json", "mw4"),
+                       ("nina_jnow.csv", "csv"), ("mmt_log.dat", "mmt")):
+        assert pm.read_run(os.path.join(data, name)).format == want, name

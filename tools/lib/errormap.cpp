@@ -85,11 +85,11 @@ struct SideRule {
 
 const double MERIDIAN_LIMIT_DEG = 15;
 
-SideRule side_rule(const Run &run, const FitOut &f)
+SideRule side_rule(const Run &run, const std::vector<int> &idx)
 {
     SideRule r;
     long vote = 0, flipped = 0;
-    for (int i : f.idx) {
+    for (int i : idx) {
         const Obs &o = run.obs[i];
         double x = std::remainder(o.ah, 2 * PI) / DEG;
         int side = o.pier < 0 ? -1 : 1;
@@ -139,7 +139,16 @@ ErrorMap error_map(const Run &run, const FitOut &f, int side)
     e.limit_deg = e.elevation ? std::max(0.0, std::floor(lo)) : std::floor(lo);
     e.at_points_arcsec = np ? std::sqrt(ss / (double)np) * RAD2AS : NAN;
     pm_context ctx = mean_context(run, side);
-    const SideRule rule = altaz || side ? SideRule() : side_rule(run, f);
+    // the side rule of the fitted points, or for a model of one pier side
+    // (pmfit fit --pier split) of the whole run: such a model is mapped
+    // where the mount uses that side only (both sides' models had been
+    // mapped over the whole sky, where each is used on half of it: gem-28's
+    // west model warned of 3.35 times its sigma)
+    std::vector<int> every;
+    if (side)
+        for (size_t i = 0; i < run.obs.size(); i++)
+            every.push_back((int)i);
+    const SideRule rule = altaz ? SideRule() : side_rule(run, side ? every : f.idx);
     double sum = 0, area = 0;
     const double step = 3;
     for (double y = -90 + step / 2; y < 90; y += step) {
@@ -154,11 +163,12 @@ ErrorMap error_map(const Run &run, const FitOut &f, int side)
             // of an equatorial mount: the side the mount takes there, as
             // side_rule says)
             double t = x * DEG, d = y * DEG;
-            int sd = altaz ? 0
-                     : side ? side
-                     : rule.flips && std::fabs(x) > MERIDIAN_LIMIT_DEG
-                         ? (x > 0 ? 1 : -1) * rule.normal_west
-                         : nearest_side(run, f, t, d);
+            const int ruled = rule.flips && std::fabs(x) > MERIDIAN_LIMIT_DEG
+                                  ? (x > 0 ? 1 : -1) * rule.normal_west
+                                  : 0;
+            if (side && ruled && ruled != side)
+                continue; // (the mount takes the other side there)
+            int sd = altaz ? 0 : side ? side : ruled ? ruled : nearest_side(run, f, t, d);
             ctx.pier = sd;
             if (sd < 0)
                 t += PI, d = PI - d;
