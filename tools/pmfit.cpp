@@ -1549,7 +1549,7 @@ int cmd_report(const Options &o, const Run &run, int argc, char **argv)
     if (pmhost::write_atomic(o.output, html, err, sizeof err) != 0)
         die(err, 1);
     if (!o.quiet)
-        std::fprintf(stderr, "pmfit report: wrote %s (%zu kB)\n", o.output.c_str(), (html.size() + 512) / 1024);
+        std::fprintf(stderr, "pmfit report: wrote %s (%zu kB)\n", o.output.c_str(), (html.size() + 500) / 1000);
     return 0;
 }
 
