@@ -113,6 +113,65 @@ static int mf_evaluate(const pm_model *m)
     return 0;
 }
 
+/* Version 5: the file read again with its covariance (pmmodel_load_cov)
+** loads as pmmodel_load_info did (r); where it keeps correlations the
+** covariance is finite, symmetric, its diagonal the errors squared, and a
+** save and a load give it back to 1e-9 (correlations keep 10 digits). */
+static double mf_cov[PM_MAX_TERMS * PM_MAX_TERMS], mf_cov2[PM_MAX_TERMS * PM_MAX_TERMS];
+
+static int mf_load_cov(const char *path, int r, const pm_model *m0)
+{
+    pm_model m, again;
+    pmmodel_info info, info2;
+    char err[512], out[128];
+    const char *dir;
+    int has = 7, has2 = 7, i, j, P, bad = 0;
+    const size_t cap = sizeof mf_cov / sizeof mf_cov[0];
+    int r2 = pmmodel_load_cov(path, &m, &info, mf_cov, cap, &has, err, sizeof err);
+    if (r2 != r)
+        return pmfz_fail("modelfile: pmmodel_load_cov returned %d, pmmodel_load_info %d", r2, r);
+    if (r != 0)
+        return has == 0 ? 0 : pmfz_fail("modelfile: failed load_cov set has_cov %d", has);
+    if (memcmp(&m, m0, sizeof m) != 0)
+        return pmfz_fail("modelfile: pmmodel_load_cov read another model");
+    if (has != 0 && has != 1)
+        return pmfz_fail("modelfile: has_cov %d", has);
+    if (!has)
+        return 0;
+    P = m.n_terms;
+    if (!info.has_err)
+        return pmfz_fail("modelfile: a covariance without errors");
+    for (i = 0; i < P; i++)
+        for (j = 0; j < P; j++) {
+            double c = mf_cov[i * P + j];
+            if (!pmfz_finite(c) || c != mf_cov[j * P + i])
+                return pmfz_fail("modelfile: covariance %d %d is %g, not finite or symmetric", i,
+                                 j, c);
+            if (i == j && c != info.err[i] * info.err[i])
+                return pmfz_fail("modelfile: variance %d is %.17g, the error squared %.17g", i,
+                                 c, info.err[i] * info.err[i]);
+        }
+    dir = pmfz_scratch();
+    if (!dir)
+        return 0;
+    snprintf(out, sizeof out, "%s/cov.pm", dir);
+    if (pmmodel_save_cov(out, &m, &info, mf_cov, NULL, err, sizeof err) != 0)
+        bad = pmfz_fail("modelfile: saving a loaded covariance failed: %s", err);
+    else if (pmmodel_load_cov(out, &again, &info2, mf_cov2, cap, &has2, err, sizeof err) != 0)
+        bad = pmfz_fail("modelfile: reloading a saved covariance failed: %s", err);
+    else if (has2 != 1)
+        bad = pmfz_fail("modelfile: a saved covariance reloaded without it");
+    for (i = 0; !bad && i < P; i++)
+        for (j = 0; !bad && j < P; j++) {
+            double s = sqrt(mf_cov[i * P + i] * mf_cov[j * P + j]);
+            if (!(fabs(mf_cov2[i * P + j] - mf_cov[i * P + j]) <= 1e-9 * s))
+                bad = pmfz_fail("modelfile: covariance %d %d reloaded as %.17g, saved %.17g", i,
+                                j, mf_cov2[i * P + j], mf_cov[i * P + j]);
+        }
+    unlink(out);
+    return bad;
+}
+
 int pmfz_modelfile(const unsigned char *data, size_t size)
 {
     pm_model m, before, again;
@@ -136,7 +195,10 @@ int pmfz_modelfile(const unsigned char *data, size_t size)
     info_before = info;
     memset(err, 'x', sizeof err);
     r = pmmodel_load_info(path, &m, &info, err, sizeof err);
+    bad = mf_load_cov(path, r, &m);
     close(fd);
+    if (bad)
+        return bad;
     if (r != 0) {
         if (r != -1)
             return pmfz_fail("modelfile: pmmodel_load returned %d", r);

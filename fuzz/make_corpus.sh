@@ -133,6 +133,27 @@ term i 6 0 0 3.5e-05 4e-6
 xterm cot(el) zenith 0 0 0 0 0 0 1e-5 2e-6
 end
 MODEL
+cat > $C/modelfile/v5_correlations.pm <<'MODEL'
+# by hand: version 5, errors and the correlations of the six terms
+pm-model 5
+mount equatorial
+order 0
+errors
+correlations
+terms 6
+term a 1 0 0 1e-4 2.5e-6
+term b 2 0 0 -2e-4 2.5e-6
+term c' 3 0 0 0.001 1e-5
+term d 4 0 0 0 3e-6
+term e' 5 0 0 -0.0005 1e-6
+term i 6 0 0 3.5e-05 4e-6
+corr 2 1 -0.25
+corr 3 1 0.1 0.2
+corr 4 1 0 0 -0.5
+corr 5 1 0.05 0 0 0.3
+corr 6 1 0 0.1 -0.9 0.4 0
+end
+MODEL
 printf 'pm-model 2\r\nmount equatorial\r\norder 0\r\nterms 6\r\nterm a 1 0 0 0\r\nterm b 2 0 0 0\r\nterm c 3 0 0 0\r\nterm d 4 0 0 0\r\nterm e 5 0 0 0\r\nterm i 6 0 0 0\r\nend\r\n' \
     > $C/modelfile/crlf_zero.pm
 

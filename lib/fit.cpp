@@ -534,6 +534,41 @@ pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res)
     return st;
 }
 
+/* A start for the two index terms c' and e' (pm_fit_run's Note 1): the
+** circular means of the true-minus-encoder offsets, each encoder reading
+** beyond the pole folded to the sky first (there e' enters with the other
+** sign), the hour-angle offsets weighted by cos^2 of the declination (near
+** the pole they grow as sec).  False where no offset is usable. */
+static bool index_start(const pm_model *m, long n, const double *enc_ha,
+                        const double *enc_dec, const double *app_ha,
+                        const double *app_dec, double *c, double *e)
+{
+    double sc = 0, cc = 0, se = 0, ce = 0;
+    for (long i = 0; i < n; i++) {
+        double h = enc_ha[i], d = enc_dec[i], s = 1;
+        if (!finite(h) || !finite(d) || !finite(app_ha[i]) || !finite(app_dec[i]) ||
+            m_fabs(d) > 1e6 || m_fabs(h) > 1e6)
+            continue;
+        d = wrap_pi(d);
+        if (m->mount != PM_MOUNT_ALTAZ && m_fabs(d) > PI / 2) {
+            h += PI;
+            d = (d > 0 ? PI : -PI) - d;
+            s = -1;
+        }
+        double cd = m_cos(app_dec[i]), w = cd * cd;
+        double dc = app_ha[i] - h, de = s * (app_dec[i] - d);
+        sc += w * m_sin(dc);
+        cc += w * m_cos(dc);
+        se += m_sin(de);
+        ce += m_cos(de);
+    }
+    if (!(sc * sc + cc * cc > 0) || !(se * se + ce * ce > 0))
+        return false;
+    *c = m_atan2(sc, cc);
+    *e = m_atan2(se, ce);
+    return true;
+}
+
 pm_status pm_fit_run(pm_fit *fit, pm_model *model, const pm_context *ctx,
                      long n, const double *enc_ha, const double *enc_dec,
                      const double *app_ha, const double *app_dec,
@@ -546,6 +581,20 @@ pm_status pm_fit_run(pm_fit *fit, pm_model *model, const pm_context *ctx,
     if (st != PM_OK)
         return st;
     pm_model cur = *model;
+    /* index errors beyond PM_FIT_INDEX_START from a start without any:
+    ** started from the offsets (pm.h, pm_fit_run's Note 1) */
+    double c0, e0;
+    if (cur.coef[2] == 0 && cur.coef[4] == 0 &&
+        index_start(&cur, n, enc_ha, enc_dec, app_ha, app_dec, &c0, &e0) &&
+        (m_fabs(c0) > PM_FIT_INDEX_START || m_fabs(e0) > PM_FIT_INDEX_START)) {
+        pm_model s = cur;
+        s.coef[2] = c0;
+        s.coef[4] = e0;
+        if (pm_model_prepare(&s) == PM_OK && pm_fit_init(fit, &s) == PM_OK)
+            cur = s;
+        else if ((st = pm_fit_init(fit, model)) != PM_OK)
+            return st;
+    }
     pm_fit_result r;
     __builtin_memset(&r, 0, sizeof r);
     for (int it = 0; it < max_iter; it++) {

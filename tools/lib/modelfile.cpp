@@ -728,6 +728,12 @@ static int load_model(const char *path, pm_model *out, pmmodel_info *info, doubl
     std::string why = check_term_list(L);
     if (why.empty() && L.has_corr)
         why = check_correlations(L);
+    for (long i = 0; why.empty() && L.has_corr && i < L.nterms; i++)
+        if (!std::isfinite(L.info.err[i] * L.info.err[i])) {
+            L.lineno = L.term_line[(size_t)i];
+            why = "the error of term " + std::to_string(i + 1) + " is too large for a covariance "
+                  "(its square overflows)";
+        }
     if (!why.empty())
         return fail(why);
     const size_t P = (size_t)L.nterms;
@@ -756,10 +762,10 @@ static int load_model(const char *path, pm_model *out, pmmodel_info *info, doubl
         *info = L.info;
     if (has_cov)
         *has_cov = L.has_corr && cov ? 1 : 0;
-    if (L.has_corr && cov)
+    if (L.has_corr && cov) /* (symmetric to the bit: each pair computed once) */
         for (size_t i = 0; i < P; i++)
-            for (size_t j = 0; j < P; j++)
-                cov[i * P + j] = L.corr[i * P + j] * L.info.err[i] * L.info.err[j];
+            for (size_t j = 0; j <= i; j++)
+                cov[i * P + j] = cov[j * P + i] = L.corr[i * P + j] * L.info.err[i] * L.info.err[j];
     return 0;
 }
 
