@@ -269,10 +269,11 @@ std::string advice_of(const Comparison &c)
         }
         std::string a = b;
         if (c.old_cov_borrowed && c.joint_log10p < alpha_log10)
-            a += "; the model file keeps its terms' errors but not their correlations, taken "
-                 "here from the refit: where the two nights saw different parts of the sky that "
-                 "is no change (compare with the old run itself, pmfit compare OLD_RUN RUN, "
-                 "whose covariance is known)";
+            a += "; the model file (version 4) keeps its terms' errors but not their "
+                 "correlations, taken here from the refit: where the two nights saw different "
+                 "parts of the sky that is no change (compare with the old run itself, pmfit "
+                 "compare OLD_RUN RUN, whose covariance is known; pmfit fit --save now keeps it "
+                 "in the model file)";
         return a;
     }
     std::string pre;
@@ -283,9 +284,9 @@ std::string advice_of(const Comparison &c)
                   c.cv_rezero < c.cv_refit ? "a re-zero" : "a refit", c.cv_as_is,
                   std::min(c.cv_refit, c.cv_rezero),
                   c.old_cov_borrowed ? "; terms this sky confounds can move as one, which a "
-                                       "model file's errors without their correlations cannot "
-                                       "show (compare with the old run itself, whose covariance "
-                                       "is known)"
+                                       "version-4 model file's errors without their "
+                                       "correlations cannot show (compare with the old run "
+                                       "itself, whose covariance is known)"
                                      : "");
     if (c.moved.empty() && c.cv_as_is <= 1.05 * c.cv_refit) {
         std::snprintf(b, sizeof b, "the model still holds: no term moved beyond 3 sigma and it "
