@@ -663,7 +663,7 @@ END_TEST
 ** independent gimbal, tests/ref/indep_gen.py, order-2 anisotropy of 10",
 ** 1" noise): the fit starts c' and e' from the run's own offsets and
 ** reaches the noise.  From zero Gauss-Newton stopped in a local minimum and
-** said nothing: sigma 24-98" (an outside probe's alt-az azimuth zero 60 deg
+** said nothing: sigma 23-98" (an outside probe's alt-az azimuth zero 60 deg
 ** off: 14", and explain then invented two gear errors). */
 START_TEST(test_pmfit_large_index_errors)
 {
