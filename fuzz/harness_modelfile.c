@@ -161,6 +161,9 @@ static int mf_load_cov(const char *path, int r, const pm_model *m0)
         bad = pmfz_fail("modelfile: reloading a saved covariance failed: %s", err);
     else if (has2 != 1)
         bad = pmfz_fail("modelfile: a saved covariance reloaded without it");
+    else if (memcmp(&info2.stars_sigma, &info.stars_sigma, sizeof info.stars_sigma) != 0)
+        bad = pmfz_fail("modelfile: stars_sigma reloaded as %.17g, saved %.17g",
+                        info2.stars_sigma, info.stars_sigma);
     for (i = 0; !bad && i < P; i++)
         for (j = 0; !bad && j < P; j++) {
             double s = sqrt(mf_cov[i * P + i] * mf_cov[j * P + j]);

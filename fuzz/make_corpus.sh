@@ -140,6 +140,7 @@ mount equatorial
 order 0
 errors
 correlations
+stars_sigma 1.2e-6
 terms 6
 term a 1 0 0 1e-4 2.5e-6
 term b 2 0 0 -2e-4 2.5e-6

@@ -1064,15 +1064,21 @@ pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res);
 **              pm_status   PM_OK; PM_ERR_DIVERGED (bound reached, model
 **                          unchanged); errors of pm_fit_init/add/solve
 **  Notes:
-**  1) The start: where *model holds no index terms (c' and e' both 0)
-**     and the observations' own offsets put one beyond
-**     PM_FIT_INDEX_START, the fit starts c' and e' there: the circular means of the true-minus-encoder hour angle
-**     (weighted by cos^2 of the declination) and declination, readings
-**     beyond the pole folded to the sky.  Gauss-Newton from zero converges
-**     for index errors of a few degrees; an unsynchronised encoder's tens
-**     stopped in a local minimum that PM_OK reported (an alt-az azimuth
-**     zero 60 deg off: sigma 14" for 1" of noise, c' -12.5 deg, an outside
-**     probe).  Give a non-zero c' or e' to start from your own values.
+**  1) The starts: the fit runs from *model as given; where *model holds no
+**     index terms (c' and e' both 0) and the observations' own offsets put
+**     one beyond PM_FIT_INDEX_START, it runs again from the offsets (the
+**     circular means of the hour-angle and declination offsets, the first
+**     weighted by cos^2 of the declination; readings beyond the pole folded
+**     to the sky, and, for a fork whose declination index takes readings
+**     past 90 deg, not folded) and, for a model beyond the six isotropic
+**     terms, from the six of the best order-0 fit from these starts, and
+**     returns the fit of least chi^2 (the workspace as that fit left it).
+**     Gauss-Newton from zero converges for index errors of a few degrees;
+**     an unsynchronised encoder's tens stopped in a local minimum that
+**     PM_OK reported (an alt-az azimuth zero 60 deg off: sigma 14" for 1"
+**     of noise, c' -12.5 deg; an outside probe).  Give a non-zero c' or e'
+**     to start from your own values only.  Stack: one pm_model more than
+**     one run.
 */
 #define PM_FIT_INDEX_START 0.17453292519943295 /* 10 deg, radians */
 pm_status pm_fit_run(pm_fit *fit, pm_model *model, const pm_context *ctx,

@@ -535,13 +535,16 @@ pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res)
 }
 
 /* A start for the two index terms c' and e' (pm_fit_run's Note 1): the
-** circular means of the true-minus-encoder offsets, each encoder reading
-** beyond the pole folded to the sky first (there e' enters with the other
-** sign), the hour-angle offsets weighted by cos^2 of the declination (near
-** the pole they grow as sec).  False where no offset is usable. */
+** circular means of the encoder-minus-true offsets (c' = true - encoder
+** on axis 1, e' = encoder - true on axis 2: pm.h's P_d(delta - e')), the
+** hour-angle offsets weighted by cos^2 of the declination (near the pole
+** they grow as sec).  fold: an equatorial reading beyond the pole is folded
+** to the sky first (there e' enters with the other sign); a fork whose
+** declination index takes its readings past 90 deg does not flip, so both
+** starts are tried.  False where no offset is usable. */
 static bool index_start(const pm_model *m, long n, const double *enc_ha,
                         const double *enc_dec, const double *app_ha,
-                        const double *app_dec, double *c, double *e)
+                        const double *app_dec, bool fold, double *c, double *e)
 {
     double sc = 0, cc = 0, se = 0, ce = 0;
     for (long i = 0; i < n; i++) {
@@ -550,13 +553,13 @@ static bool index_start(const pm_model *m, long n, const double *enc_ha,
             m_fabs(d) > 1e6 || m_fabs(h) > 1e6)
             continue;
         d = wrap_pi(d);
-        if (m->mount != PM_MOUNT_ALTAZ && m_fabs(d) > PI / 2) {
+        if (fold && m->mount != PM_MOUNT_ALTAZ && m_fabs(d) > PI / 2) {
             h += PI;
             d = (d > 0 ? PI : -PI) - d;
             s = -1;
         }
         double cd = m_cos(app_dec[i]), w = cd * cd;
-        double dc = app_ha[i] - h, de = s * (app_dec[i] - d);
+        double dc = app_ha[i] - h, de = s * (d - app_dec[i]);
         sc += w * m_sin(dc);
         cc += w * m_cos(dc);
         se += m_sin(de);
@@ -567,6 +570,45 @@ static bool index_start(const pm_model *m, long n, const double *enc_ha,
     *c = m_atan2(sc, cc);
     *e = m_atan2(se, ce);
     return true;
+}
+
+/* Gauss-Newton from *m (the loop of pm_fit_run), m updated in place: PM_OK
+** with *m the converged model and *r its statistics. */
+static pm_status run_from(pm_fit *fit, pm_model *m, const pm_context *ctx, long n,
+                          const double *enc_ha, const double *enc_dec, const double *app_ha,
+                          const double *app_dec, int max_iter, pm_fit_result *r)
+{
+    pm_status st = pm_fit_init(fit, m);
+    if (st != PM_OK)
+        return st;
+    __builtin_memset(r, 0, sizeof *r);
+    for (int it = 0; it < max_iter; it++) {
+        for (long i = 0; i < n; i++) {
+            st = pm_fit_add(fit, ctx ? ctx + i : 0, enc_ha[i], enc_dec[i],
+                            app_ha[i], app_dec[i]);
+            if (st != PM_OK)
+                return st;
+        }
+        st = pm_fit_solve(fit, m, r);
+        if (st != PM_OK)
+            return st;
+        if (r->converged)
+            return PM_OK;
+    }
+    return PM_ERR_DIVERGED;
+}
+
+/* *s: the caller's model with the six isotropic terms of start k (k = 0:
+** the caller's own), prepared. */
+static pm_status start_model(const pm_model *model, const double (*iso)[6], int k,
+                             pm_model *s)
+{
+    *s = *model;
+    if (k == 0)
+        return PM_OK;
+    for (int i = 0; i < 6; i++)
+        s->coef[i] = iso[k][i];
+    return pm_model_prepare(s);
 }
 
 pm_status pm_fit_run(pm_fit *fit, pm_model *model, const pm_context *ctx,
@@ -580,41 +622,78 @@ pm_status pm_fit_run(pm_fit *fit, pm_model *model, const pm_context *ctx,
     pm_status st = pm_fit_init(fit, model);
     if (st != PM_OK)
         return st;
-    pm_model cur = *model;
-    /* index errors beyond PM_FIT_INDEX_START from a start without any:
-    ** started from the offsets (pm.h, pm_fit_run's Note 1) */
-    double c0, e0;
-    if (cur.coef[2] == 0 && cur.coef[4] == 0 &&
-        index_start(&cur, n, enc_ha, enc_dec, app_ha, app_dec, &c0, &e0) &&
-        (m_fabs(c0) > PM_FIT_INDEX_START || m_fabs(e0) > PM_FIT_INDEX_START)) {
-        pm_model s = cur;
-        s.coef[2] = c0;
-        s.coef[4] = e0;
-        if (pm_model_prepare(&s) == PM_OK && pm_fit_init(fit, &s) == PM_OK)
-            cur = s;
-        else if ((st = pm_fit_init(fit, model)) != PM_OK)
-            return st;
+    /* The starts (pm.h, Note 1): the caller's model; where it has no index
+    ** terms and the offsets put one beyond PM_FIT_INDEX_START, the
+    ** offsets' (readings beyond the pole folded, and not), and for a model
+    ** beyond the six isotropic terms the six of the best order-0 fit from
+    ** these (a few runs of 12-20 stars near the pole with index
+    ** errors of tens of degrees still stopped short at order 1 from the
+    ** offsets alone).  The fit of least chi^2 is returned.  (Six
+    ** coefficients a start and one model on the stack: firmware refits.) */
+    double iso[4][6];
+    int n_start = 1;
+    for (int i = 0; i < 6; i++)
+        iso[0][i] = model->coef[i];
+    for (int fold = 1; fold >= 0 && model->coef[2] == 0 && model->coef[4] == 0; fold--) {
+        double c0, e0;
+        if (!index_start(model, n, enc_ha, enc_dec, app_ha, app_dec, fold != 0, &c0, &e0) ||
+            !(m_fabs(c0) > PM_FIT_INDEX_START || m_fabs(e0) > PM_FIT_INDEX_START) ||
+            (n_start == 2 && c0 == iso[1][2] && e0 == iso[1][4]))
+            continue; /* (the second: no reading beyond the pole, the same start) */
+        for (int i = 0; i < 6; i++)
+            iso[n_start][i] = model->coef[i];
+        iso[n_start][2] = c0;
+        iso[n_start][4] = e0;
+        n_start++;
     }
+    pm_model s;
     pm_fit_result r;
-    __builtin_memset(&r, 0, sizeof r);
-    for (int it = 0; it < max_iter; it++) {
-        for (long i = 0; i < n; i++) {
-            st = pm_fit_add(fit, ctx ? ctx + i : 0, enc_ha[i], enc_dec[i],
-                            app_ha[i], app_dec[i]);
-            if (st != PM_OK)
-                return st;
-        }
-        st = pm_fit_solve(fit, &cur, &r);
-        if (st != PM_OK)
-            return st;
-        if (r.converged) {
-            *model = cur;
-            if (res)
-                *res = r;
-            return PM_OK;
+    const int n_index = n_start;
+    double iso_chi2 = 0;
+    for (int k = 0; k < n_index && n_index > 1 && model->n_terms > 6; k++) {
+        if (pm_model_init(&s, model->mount, 0) != PM_OK)
+            break;
+        s.latitude = model->latitude;
+        for (int i = 0; i < 6; i++)
+            s.coef[i] = iso[k][i];
+        if (pm_model_prepare(&s) != PM_OK ||
+            run_from(fit, &s, ctx, n, enc_ha, enc_dec, app_ha, app_dec, max_iter, &r) != PM_OK ||
+            (n_start > n_index && !(r.chi2 < iso_chi2)))
+            continue;
+        for (int i = 0; i < 6; i++)
+            iso[n_index][i] = s.coef[i];
+        iso_chi2 = r.chi2;
+        n_start = n_index + 1;
+    }
+    pm_status first = PM_ERR_DIVERGED;
+    double best_chi2 = 0;
+    int best = -1, last = -1;
+    for (int k = 0; k < n_start; k++) {
+        if (start_model(model, iso, k, &s) != PM_OK)
+            continue;
+        st = run_from(fit, &s, ctx, n, enc_ha, enc_dec, app_ha, app_dec, max_iter, &r);
+        last = k;
+        if (k == 0)
+            first = st;
+        if (st == PM_OK && (best < 0 || r.chi2 < best_chi2)) {
+            best = k;
+            best_chi2 = r.chi2;
         }
     }
-    return PM_ERR_DIVERGED;
+    /* the workspace, *model and *res as the chosen start's fit leaves them
+    ** (its passes again where another start ran after it); on no success,
+    ** the caller's start's status (fit->bad_term its) */
+    const int k = best < 0 ? 0 : best;
+    if (k != last) {
+        start_model(model, iso, k, &s); /* (prepared before, so PM_OK) */
+        st = run_from(fit, &s, ctx, n, enc_ha, enc_dec, app_ha, app_dec, max_iter, &r);
+    }
+    if (best < 0)
+        return first;
+    *model = s;
+    if (res)
+        *res = r;
+    return PM_OK;
 }
 
 /* The checks of pm_fit_pointing_sigma and pm_fit_point_gain: a solved fit

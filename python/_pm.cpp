@@ -897,6 +897,8 @@ std::unique_ptr<Fit> fit_points(const Run &run, const std::vector<int> &use, con
     // (its JSON's "error_map", its warning)
     try {
         ErrorMap em = error_map(run, f->out, pier);
+        if (std::isfinite(em.at_points_arcsec)) /* (a saved model keeps it: pm.compare) */
+            f->info.stars_sigma = em.at_points_arcsec / RAD2AS;
         f->error_map = error_map_json(em, f->out.res.sigma * RAD2AS);
         f->undetermined = undetermined_warning(em, f->out.res.sigma * RAD2AS);
     } catch (const std::runtime_error &) {

@@ -341,7 +341,7 @@ START_TEST(test_pmrun_read_csv_excel_sep)
             }
             pmrun_free(run);
         } else {
-            tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 1, "expected 'sep=,' or 'sep=;'");
+            tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, 1, "'sep=<tab>': expected 'sep=,' or 'sep=;'");
         }
         unlink(path);
     }

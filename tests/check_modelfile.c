@@ -470,6 +470,11 @@ START_TEST(test_pmmodel_covariance)
         {"corr 2 1 0\ncorr 3 1 0 0\ncorr 4 1 0 0 0\ncorr 5 1 0 0 0 0\ncorr 6 1 0 0 0 0 0\n"
          "corr 7 1 0\n",
          "18", "more correlations"},
+        /* r21 = 1 (a zero pivot), r31 = 1, r32 = -1: eigenvalues -1, 2, 2; it
+        ** was taken (an outside probe) */
+        {"corr 2 1 1\ncorr 3 1 1 -1\ncorr 4 1 0 0 0\ncorr 5 1 0 0 0 0\n"
+         "corr 6 1 0 0 0 0 0\nend\n",
+         "14", "fully correlated"},
     };
     pm_model a, b;
     pmmodel_info in, got;
@@ -500,6 +505,7 @@ START_TEST(test_pmmodel_covariance)
         }
     for (i = 0; i < P; i++)
         in.err[i] = sqrt(cov[i * P + i]);
+    in.stars_sigma = 1.5e-6; /* (the fit's predicted 1 sigma at its stars) */
     ck_assert_msg(pmmodel_save_cov(path, &a, &in, cov, "c", err, sizeof err) == 0, "%s", err);
     f = fopen(path, "r");
     ck_assert_ptr_nonnull(f);
@@ -514,6 +520,7 @@ START_TEST(test_pmmodel_covariance)
     ck_assert_int_eq(has, 1);
     ck_assert(memcmp(b.coef, a.coef, sizeof(double) * (size_t)P) == 0);
     ck_assert(memcmp(got.err, in.err, sizeof(double) * (size_t)P) == 0);
+    ck_assert(got.stars_sigma == in.stars_sigma);
     for (i = 0; i < P; i++)
         for (j = 0; j < P; j++)
             ck_assert_msg(fabs(back[i * P + j] - cov[i * P + j]) <=
@@ -552,6 +559,12 @@ START_TEST(test_pmmodel_covariance)
                       "without the 'errors' line");
     expect_load_error("pm-model 4\nmount equatorial\norder 0\nerrors\ncorrelations\n", "5",
                       "version 5 has it");
+    expect_load_error("pm-model 4\nmount equatorial\norder 0\nstars_sigma 1e-6\n", "4",
+                      "version 5 has it");
+    expect_load_error("pm-model 5\nmount equatorial\norder 0\nstars_sigma -1e-6\n", "4",
+                      "expected 'stars_sigma S'");
+    expect_load_error("pm-model 5\nmount equatorial\norder 0\nstars_sigma 1e-6\nstars_sigma 1e-6\n",
+                      "5", "second 'stars_sigma'");
     expect_load_error("pm-model 5\nmount equatorial\norder 0\nerrors\nterms 6\n"
                       "term a 1 0 0 0 1e-6\ncorr 2 1 0\n",
                       "7", "without the 'correlations' line");

@@ -1747,6 +1747,8 @@ int run_main(int argc, char **argv)
         // order) and, split, its pier side
         pmmodel_info info = model_info(fits[k].model, aux_names,
                                        fits.size() == 1 ? 0 : (k == 0 ? 1 : -1), fits[k].res.err);
+        if (std::isfinite(maps[k].at_points_arcsec))
+            info.stars_sigma = maps[k].at_points_arcsec / RAD2AS;
         std::string inputs_note;
         for (int j = 0; j < PM_MAX_AUX; j++)
             if (info.input[j][0])

@@ -322,7 +322,7 @@ double predicted_over(const FitOut &f, const Run &run)
 
 Comparison compare_models(const pm_model &old_in, const std::vector<double> &old_err,
                           const Run &run, const FitOut *old_fit, const Run *old_run,
-                          const std::vector<double> *old_cov)
+                          const std::vector<double> *old_cov, double old_stars_sigma)
 {
     // The site is the run's: where the run gives a latitude other than the
     // model's (a portable mount moved, or another mount's model), the model
@@ -415,6 +415,15 @@ Comparison compare_models(const pm_model &old_in, const std::vector<double> &old
     if (old_fit && old_run && old_fit->cov.size() == (size_t)(old_model.n_terms * old_model.n_terms)) {
         c.old_pred_new = predicted_over(*old_fit, run);
         c.old_pred_old = predicted_over(*old_fit, *old_run);
+    } else if (old_cov && old_cov->size() == (size_t)(old_model.n_terms * old_model.n_terms) &&
+               old_stars_sigma > 0) {
+        // a version-5 model file: its covariance at the new stars, and what
+        // its fit predicted at its own (it keeps that), as for a run
+        FitOut of;
+        of.model = old_in; // (at its own latitude, as the run's fit)
+        of.cov = *old_cov;
+        c.old_pred_new = predicted_over(of, run);
+        c.old_pred_old = old_stars_sigma * RAD2AS;
     }
     joint_tests(old_model, old_err, f, old_fit, old_cov, c);
     c.advice = advice_of(c);
@@ -537,8 +546,10 @@ OldSide old_from_model(const pm_model &m, const pmmodel_info &info, const std::v
     o.pier = info.pier;
     if (info.has_err) { /* the fit's errors the file keeps count as a run's do */
         o.err.assign(info.err, info.err + m.n_terms);
-        if (cov.size() == (size_t)m.n_terms * (size_t)m.n_terms)
+        if (cov.size() == (size_t)m.n_terms * (size_t)m.n_terms) {
             o.cov = cov; /* and its covariance (version 5) */
+            o.stars_sigma = info.stars_sigma;
+        }
     }
     return o;
 }
@@ -570,7 +581,8 @@ Comparison compare_old(const OldSide &os, const Run &run, const std::string &old
     std::vector<std::string> notes;
     Run r = run_for_model(run, os.model, os.inputs, os.pier, old_name, &notes);
     Comparison c = compare_models(os.model, os.err, r, os.is_run ? &os.fit : nullptr,
-                                  os.is_run ? &os.run : nullptr, os.cov.empty() ? nullptr : &os.cov);
+                                  os.is_run ? &os.run : nullptr, os.cov.empty() ? nullptr : &os.cov,
+                                  os.stars_sigma);
     c.notes = notes;
     return c;
 }

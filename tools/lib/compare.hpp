@@ -52,11 +52,14 @@ struct Comparison {
 // (empty when it came from a model file); run: the new night.  Throws
 // std::runtime_error with the reason (mount mismatch, the refit failing).
 // old_fit, old_run: the fit OLD came from (a run), or null (a model file);
-// old_cov: a model file's covariance (P x P, version 5), or null.
+// old_cov: a model file's covariance (P x P, version 5), or null;
+// old_stars_sigma: its fit's predicted 1 sigma at its own stars (rad), 0
+// where not known.
 Comparison compare_models(const pm_model &old_model, const std::vector<double> &old_err,
                           const Run &run, const FitOut *old_fit = nullptr,
                           const Run *old_run = nullptr,
-                          const std::vector<double> *old_cov = nullptr);
+                          const std::vector<double> *old_cov = nullptr,
+                          double old_stars_sigma = 0);
 
 // OLD of pmfit compare and pmfit report --compare: a model file, or a run
 // fitted at order + adds (do_fit with max_passes).
@@ -65,6 +68,7 @@ struct OldSide {
     pm_model model;            // the model file's, or the run's fit (on success)
     std::vector<double> err;   // the fit's 1-sigma errors (a model file's where it keeps them)
     std::vector<double> cov;   // a model file's covariance (version 5), P x P; else empty
+    double stars_sigma = 0;    // and its fit's predicted 1 sigma at its stars (rad; 0: none)
     FitOut fit;                // a run: its fit; check fit.status (the caller words a failure)
     Run run;                   // a run: the run
     // the columns the model reads as ctx.aux[j] (a run's names; a model

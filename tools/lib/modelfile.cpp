@@ -250,6 +250,8 @@ static int save_model(const char *path, const pm_model *m, const pmmodel_info *i
         if (!corr_lines(m, cov, path, &corr, err, errlen))
             return -1;
         extra += "correlations\n"; /* (the 'corr' lines after the terms) */
+        if (std::isfinite(info->stars_sigma) && info->stars_sigma > 0)
+            extra += "stars_sigma " + fmt17(info->stars_sigma) + "\n";
     }
     std::string out;
     comment_lines(out, comment, "# ");
@@ -372,6 +374,19 @@ std::string info_line(Loader &L, const std::vector<std::string> &tok)
         L.has_corr = true;
         return "";
     }
+    if (tok[0] == "stars_sigma") {
+        if (L.version < 5)
+            return "a 'stars_sigma' line in a 'pm-model " + std::to_string(L.version) +
+                   "' file (version 5 has it)";
+        double v;
+        if (tok.size() != 2 || !parse_double(tok[1], &v) || !(v > 0))
+            return "expected 'stars_sigma S': the fit's predicted 1-sigma at its stars, radians "
+                   "> 0";
+        if (L.info.stars_sigma > 0)
+            return "a second 'stars_sigma' line";
+        L.info.stars_sigma = v;
+        return "";
+    }
     if (tok[0] == "errors") {
         if (tok.size() != 1)
             return "expected 'errors' alone (each term line then ends in its 1-sigma error)";
@@ -444,7 +459,7 @@ std::string header_line(Loader &L, const std::vector<std::string> &tok)
             return "";
         }
         if (tok[0] == "input" || tok[0] == "pier" || tok[0] == "errors" ||
-            tok[0] == "correlations")
+            tok[0] == "correlations" || tok[0] == "stars_sigma")
             return info_line(L, tok);
         if (tok.size() != 2 || tok[0] != "terms" || !parse_int(tok[1], 6, 100000, &L.nterms))
             return "expected 'terms P' with an integer P >= 6";
@@ -589,6 +604,16 @@ std::string check_correlations(Loader &L)
             double v = c[i * P + j];
             for (size_t k = 0; k < j; k++)
                 v -= c[i * P + k] * c[j * P + k];
+            // a zero pivot: term j is a combination of the earlier ones, and
+            // so must be its correlations with the later ones (r21 = r31 = 1,
+            // r32 = -1 had been taken)
+            if (s == 0 && std::fabs(v) > 1e-6) {
+                L.lineno = L.corr_line[i - 1];
+                return "the correlations are not those of a covariance (not positive "
+                       "semi-definite: term " + std::to_string(j + 1) + ", " +
+                       name_of(&L.m, (int)j) + ", is fully correlated with earlier terms, and "
+                       "term " + std::to_string(i + 1) + "'s correlations do not follow)";
+            }
             c[i * P + j] = s > 0 ? v / s : 0;
         }
     }

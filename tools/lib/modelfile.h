@@ -75,6 +75,11 @@ typedef struct pmmodel_info {
     int has_err;             /* err below holds the fit's 1-sigma errors */
     double err[PM_MAX_TERMS]; /* of each coefficient (radians, the model's
                                term order): a term line's last field */
+    double stars_sigma;      /* the RMS of the fit's predicted 1-sigma at its
+                               own stars (radians; 0: not known); written
+                               with the covariance (version 5), so that a
+                               comparison can tell a new night where the
+                               model extrapolates */
 } pmmodel_info;
 
 /*

@@ -505,10 +505,16 @@ public:
         }
         // Excel's first line 'sep=;' names the delimiter of the CSV that follows
         if (!sep_line_ && excel_sep_line(t)) {
-            if (t.size() != 5 || (t[4] != ',' && t[4] != ';'))
-                return ctx_.fail(n, "Excel's delimiter line '%s': expected 'sep=,' or 'sep=;' (a "
-                                    "CSV log's fields are separated by ',' or ';')",
-                                 excerpt(t).c_str());
+            if (t.size() != 5 || (t[4] != ',' && t[4] != ';')) {
+                // (a tab or a blank is trimmed from t: named from the line)
+                const size_t at = text.find_first_not_of(" \t") + 4;
+                const char c = at < text.size() ? text[at] : '\0';
+                return ctx_.fail(n, "Excel's delimiter line 'sep=%s': expected 'sep=,' or "
+                                    "'sep=;' (a CSV log's fields are separated by ',' or ';')",
+                                 c == '\t'  ? "<tab>"
+                                 : c == ' ' ? "<blank>"
+                                            : excerpt(t.substr(4)).c_str());
+            }
             sep_line_ = n;
             held_.emplace_back(n, text);
             return true;

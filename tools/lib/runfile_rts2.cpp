@@ -77,8 +77,9 @@ public:
         }
         if (!(v[1] > 15000 && v[1] < 100000))
             return ctx_.bad_record(n, format("field 2 (MJD) '%s': out of range, expected a modified "
-                                             "Julian date 15000..100000 (years 1900..2132) or a "
-                                             "Julian date",
+                                             "Julian date between 15000 and 100000 (years "
+                                             "1900..2132) or a Julian date between 2415000.5 "
+                                             "and 2500000.5",
                                              excerpt(tok[1]).c_str()));
         if (std::fabs(v[8]) > 90)
             return ctx_.bad_record(n, format("field 9 (%s) '%s': beyond +-90 deg, expected the "
