@@ -1069,10 +1069,12 @@ pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res);
 **     one beyond PM_FIT_INDEX_START, it runs again from the offsets (the
 **     circular means of the hour-angle and declination offsets, the first
 **     weighted by cos^2 of the declination; readings beyond the pole folded
-**     to the sky, and, for a fork whose declination index takes readings
-**     past 90 deg, not folded) and, for a model beyond the six isotropic
-**     terms, from the six of the best order-0 fit from these starts, and
-**     returns the fit of least chi^2 (the workspace as that fit left it).
+**     to the sky unless the declination offsets agree better unfolded, as
+**     for a fork whose declination index takes readings past 90 deg) and,
+**     for a model beyond the six isotropic terms, from the six of the
+**     better order-0 fit from these two starts, and returns the fit of
+**     least chi^2, a later start only where it is lower beyond rounding
+**     (the workspace as that fit left it).
 **     Gauss-Newton from zero converges for index errors of a few degrees;
 **     an unsynchronised encoder's tens stopped in a local minimum that
 **     PM_OK reported (an alt-az azimuth zero 60 deg off: sigma 14" for 1"

@@ -538,37 +538,41 @@ pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res)
 ** circular means of the encoder-minus-true offsets (c' = true - encoder
 ** on axis 1, e' = encoder - true on axis 2: pm.h's P_d(delta - e')), the
 ** hour-angle offsets weighted by cos^2 of the declination (near the pole
-** they grow as sec).  fold: an equatorial reading beyond the pole is folded
-** to the sky first (there e' enters with the other sign); a fork whose
-** declination index takes its readings past 90 deg does not flip, so both
-** starts are tried.  False where no offset is usable. */
+** they grow as sec).  An equatorial reading beyond the pole is folded to
+** the sky (there e' enters with the other sign), unless the declination
+** offsets agree better unfolded: a fork whose declination index takes its
+** readings past 90 deg does not flip, and a German mount's two sides
+** differ by twice the declination unfolded.  False where no offset is
+** usable. */
 static bool index_start(const pm_model *m, long n, const double *enc_ha,
                         const double *enc_dec, const double *app_ha,
-                        const double *app_dec, bool fold, double *c, double *e)
+                        const double *app_dec, double *c, double *e)
 {
-    double sc = 0, cc = 0, se = 0, ce = 0;
+    double sc[2] = {0, 0}, cc[2] = {0, 0}, se[2] = {0, 0}, ce[2] = {0, 0};
     for (long i = 0; i < n; i++) {
-        double h = enc_ha[i], d = enc_dec[i], s = 1;
-        if (!finite(h) || !finite(d) || !finite(app_ha[i]) || !finite(app_dec[i]) ||
-            m_fabs(d) > 1e6 || m_fabs(h) > 1e6)
+        if (!finite(enc_ha[i]) || !finite(enc_dec[i]) || !finite(app_ha[i]) ||
+            !finite(app_dec[i]) || m_fabs(enc_dec[i]) > 1e6 || m_fabs(enc_ha[i]) > 1e6)
             continue;
-        d = wrap_pi(d);
-        if (fold && m->mount != PM_MOUNT_ALTAZ && m_fabs(d) > PI / 2) {
-            h += PI;
-            d = (d > 0 ? PI : -PI) - d;
-            s = -1;
+        const double cd = m_cos(app_dec[i]), w = cd * cd;
+        for (int fold = 0; fold < 2; fold++) { /* [1]: folded */
+            double h = enc_ha[i], d = wrap_pi(enc_dec[i]), s = 1;
+            if (fold && m->mount != PM_MOUNT_ALTAZ && m_fabs(d) > PI / 2) {
+                h += PI;
+                d = (d > 0 ? PI : -PI) - d;
+                s = -1;
+            }
+            const double dc = app_ha[i] - h, de = s * (d - app_dec[i]);
+            sc[fold] += w * m_sin(dc);
+            cc[fold] += w * m_cos(dc);
+            se[fold] += m_sin(de);
+            ce[fold] += m_cos(de);
         }
-        double cd = m_cos(app_dec[i]), w = cd * cd;
-        double dc = app_ha[i] - h, de = s * (d - app_dec[i]);
-        sc += w * m_sin(dc);
-        cc += w * m_cos(dc);
-        se += m_sin(de);
-        ce += m_cos(de);
     }
-    if (!(sc * sc + cc * cc > 0) || !(se * se + ce * ce > 0))
+    const int k = se[0] * se[0] + ce[0] * ce[0] > se[1] * se[1] + ce[1] * ce[1] ? 0 : 1;
+    if (!(sc[k] * sc[k] + cc[k] * cc[k] > 0) || !(se[k] * se[k] + ce[k] * ce[k] > 0))
         return false;
-    *c = m_atan2(sc, cc);
-    *e = m_atan2(se, ce);
+    *c = m_atan2(sc[k], cc[k]);
+    *e = m_atan2(se[k], ce[k]);
     return true;
 }
 
@@ -624,27 +628,25 @@ pm_status pm_fit_run(pm_fit *fit, pm_model *model, const pm_context *ctx,
         return st;
     /* The starts (pm.h, Note 1): the caller's model; where it has no index
     ** terms and the offsets put one beyond PM_FIT_INDEX_START, the
-    ** offsets' (readings beyond the pole folded, and not), and for a model
-    ** beyond the six isotropic terms the six of the best order-0 fit from
-    ** these (a few runs of 12-20 stars near the pole with index
-    ** errors of tens of degrees still stopped short at order 1 from the
-    ** offsets alone).  The fit of least chi^2 is returned.  (Six
-    ** coefficients a start and one model on the stack: firmware refits.) */
-    double iso[4][6];
+    ** offsets' (index_start), and for a model beyond the six isotropic
+    ** terms the six of the better order-0 fit from these two (a few runs
+    ** of 12-20 stars near the pole with index errors of tens of degrees
+    ** still stopped short at order 1 from the offsets alone).  The fit of
+    ** least chi^2 is returned.  (Six coefficients a start and one model on
+    ** the stack: firmware refits.) */
+    double iso[3][6];
     int n_start = 1;
     for (int i = 0; i < 6; i++)
         iso[0][i] = model->coef[i];
-    for (int fold = 1; fold >= 0 && model->coef[2] == 0 && model->coef[4] == 0; fold--) {
-        double c0, e0;
-        if (!index_start(model, n, enc_ha, enc_dec, app_ha, app_dec, fold != 0, &c0, &e0) ||
-            !(m_fabs(c0) > PM_FIT_INDEX_START || m_fabs(e0) > PM_FIT_INDEX_START) ||
-            (n_start == 2 && c0 == iso[1][2] && e0 == iso[1][4]))
-            continue; /* (the second: no reading beyond the pole, the same start) */
+    double c0, e0;
+    if (model->coef[2] == 0 && model->coef[4] == 0 &&
+        index_start(model, n, enc_ha, enc_dec, app_ha, app_dec, &c0, &e0) &&
+        (m_fabs(c0) > PM_FIT_INDEX_START || m_fabs(e0) > PM_FIT_INDEX_START)) {
         for (int i = 0; i < 6; i++)
-            iso[n_start][i] = model->coef[i];
-        iso[n_start][2] = c0;
-        iso[n_start][4] = e0;
-        n_start++;
+            iso[1][i] = model->coef[i];
+        iso[1][2] = c0;
+        iso[1][4] = e0;
+        n_start = 2;
     }
     pm_model s;
     pm_fit_result r;
@@ -675,7 +677,9 @@ pm_status pm_fit_run(pm_fit *fit, pm_model *model, const pm_context *ctx,
         last = k;
         if (k == 0)
             first = st;
-        if (st == PM_OK && (best < 0 || r.chi2 < best_chi2)) {
+        /* (a later start must be better beyond rounding: two starts that
+        ** reach the same fit, or its alias a turn away, keep the first) */
+        if (st == PM_OK && (best < 0 || r.chi2 < best_chi2 * (1 - 1e-9))) {
             best = k;
             best_chi2 = r.chi2;
         }
