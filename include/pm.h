@@ -1079,7 +1079,7 @@ pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res);
 **     an unsynchronised encoder's tens stopped in a local minimum that
 **     PM_OK reported (an alt-az azimuth zero 60 deg off: sigma 14" for 1"
 **     of noise, c' -12.5 deg; an outside probe).  Give a non-zero c' or e'
-**     to start from your own values only.  Stack: one pm_model more than
+**     to start from your own values only.  Stack: one pm_model, as for
 **     one run.
 */
 #define PM_FIT_INDEX_START 0.17453292519943295 /* 10 deg, radians */
