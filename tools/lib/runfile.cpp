@@ -181,6 +181,11 @@ std::string lower(const std::string &s)
     return r;
 }
 
+bool excel_sep_line(const std::string &t)
+{
+    return t.size() >= 4 && lower(t.substr(0, 4)) == "sep=";
+}
+
 std::string strip_comment(const std::string &s, char c)
 {
     for (size_t i = 0; i < s.size(); ++i)
@@ -450,12 +455,6 @@ bool csv_header(const std::string &line)
         dec += n.find("dec") != std::string::npos ? 1 : 0;
     }
     return ra >= 2 && dec >= 2;   // the mount's and the solved position
-}
-
-// Excel's optional first line of a CSV file, 'sep=;', naming its delimiter.
-bool excel_sep_line(const std::string &t)
-{
-    return t.size() >= 4 && lower(t.substr(0, 4)) == "sep=";
 }
 
 // The first '#' line of an RTS2 gpoint file names its columns

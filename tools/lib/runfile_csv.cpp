@@ -184,7 +184,7 @@ public:
         std::string t = trim(text);
         if (t.empty()) return true;
         if (t[0] == '#') return header_line_ ? true : metadata(n, t.substr(1));
-        if (!header_line_ && !sep_ && t.size() == 5 && lower(t.substr(0, 4)) == "sep=" &&
+        if (!header_line_ && !sep_ && excel_sep_line(t) && t.size() == 5 &&
             (t[4] == ',' || t[4] == ';')) {
             sep_ = t[4];   // Excel's delimiter line (the detector checked it)
             return true;

@@ -94,6 +94,9 @@ std::string format(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 std::vector<std::string> tokens(const std::string &s);
 std::string trim(const std::string &s);
 std::string lower(const std::string &s);
+// Excel's optional first line of a CSV file, 'sep=;' (trimmed): 'sep=' and
+// whatever follows.
+bool excel_sep_line(const std::string &t);
 // The text with a trailing comment (from `c` preceded by whitespace or at
 // the start) removed.
 std::string strip_comment(const std::string &s, char c);
