@@ -293,6 +293,24 @@ static void to_v4(const char *name)
     tu_edited_copy(v5, v4, edit_to_v4, NULL);
 }
 
+/* Two nights of an unchanged mount of the independent gimbal
+** (tests/ref/indep_gen.py: 40 stars, 1" noise, index errors fixed, seeds
+** seed and seed + 1, more of its options in `opts`) as P1.dat and P2.dat in
+** dir, the first fitted and saved as P1.pm. */
+static void gimbal_nights(const char *p, const char *mount, int seed, const char *opts)
+{
+    const char *top = getenv("PM_TOP");
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd,
+             "cd %s && for s in %d %d; do /usr/bin/python3 %s/tests/ref/indep_gen.py %s$s.dat "
+             "--mount %s --n 40 --seed $s --noise 1 --geom 0 --aniso 0 --index 1.5,-0.7 %s "
+             "2>&1 || exit 1; done > /dev/null && mv %s%d.dat %s1.dat && mv %s%d.dat %s2.dat && "
+             "%s fit %s1.dat --save %s1.pm > /dev/null",
+             dir, seed, seed + 1, top ? top : ".", p, mount, opts, p, seed, p, p, seed + 1, p,
+             tu_pmfit_path(), p, p);
+    ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
+}
+
 /* Terms this sky confounds: an alt-az mount's collimation moved by 20"
 ** between two nights (c', d and i nearly one term at order 1).  No single
 ** term moves beyond 3 sigma, the old model leaves 14" where a refit leaves
@@ -347,8 +365,7 @@ END_TEST
 START_TEST(test_compare_model_file_other_half_of_sky)
 {
     static const char *mounts[2] = {"gem", "altaz"};
-    const char *top = getenv("PM_TOP");
-    char cmd[4096], run_advice[2048];
+    char run_advice[2048];
     int m, k, same = 0, pairs = 0;
     if (!dir[0])
         tu_tmpdir(dir, "pm_compare_");
@@ -356,14 +373,7 @@ START_TEST(test_compare_model_file_other_half_of_sky)
         for (k = 0; k < 4; k++) {
             double p_run, p_file, pred_run;
             const char *a;
-            snprintf(cmd, sizeof cmd,
-                     "cd %s && for s in %d %d; do /usr/bin/python3 %s/tests/ref/indep_gen.py h$s.dat "
-                     "--mount %s --n 40 --seed $s --noise 1 --geom 0 --aniso 0 --index 1.5,-0.7 "
-                     "--coverage half 2>&1 || exit 1; done > /dev/null && mv h%d.dat h1.dat && "
-                     "mv h%d.dat h2.dat && %s fit h1.dat --save h1.pm > /dev/null",
-                     dir, 800 + 2 * k, 801 + 2 * k, top ? top : ".", mounts[m], 800 + 2 * k,
-                     801 + 2 * k, tu_pmfit_path());
-            ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
+            gimbal_nights("h", mounts[m], 800 + 2 * k, "--coverage half");
             compare("h1.dat", "h2.dat");
             p_run = tu_json_num(out, "joint_log10_p");
             pred_run = tu_json_num(out, "at_new_points");
@@ -397,22 +407,13 @@ END_TEST
 START_TEST(test_compare_unchanged_mount_holds)
 {
     static const char *mounts[2] = {"gem", "altaz"};
-    const char *top = getenv("PM_TOP");
-    char cmd[4096];
     int m, k, held = 0, pairs = 0;
     if (!dir[0])
         tu_tmpdir(dir, "pm_compare_");
     for (m = 0; m < 2; m++)
         for (k = 0; k < 10; k++) {
             const char *old = k % 2 ? "u1.dat" : "u1.pm";
-            snprintf(cmd, sizeof cmd,
-                     "cd %s && for s in %d %d; do /usr/bin/python3 %s/tests/ref/indep_gen.py u$s.dat "
-                     "--mount %s --n 40 --seed $s --noise 1 --geom 0 --aniso 0 --index 1.5,-0.7 "
-                     "2>&1 || exit 1; done > /dev/null && mv u%d.dat u1.dat && mv u%d.dat u2.dat && "
-                     "%s fit u1.dat --save u1.pm > /dev/null",
-                     dir, 702 + 2 * k, 703 + 2 * k, top ? top : ".", mounts[m], 702 + 2 * k,
-                     703 + 2 * k, tu_pmfit_path());
-            ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
+            gimbal_nights("u", mounts[m], 702 + 2 * k, "");
             compare(old, "u2.dat");
             pairs++;
             if (strstr(out, "\"advice\": \"the model still holds"))
