@@ -962,6 +962,114 @@ START_TEST(test_pmrun_read_header_without_hash)
 }
 END_TEST
 
+/* An angle beyond +-1e6 (degrees or hours) is refused where it is read:
+** fmod had reduced 1e300 exactly to a direction the file never gave, and
+** the run was read without a word (an outside probe).  1e6 itself is an
+** angle in some turn; gpoint's axis counts are not angles. */
+static void read_text_fails(const char *text, int line, const char *needle)
+{
+    char path[64];
+    temp_file(path, sizeof path, text, strlen(text));
+    tu_read_fails(path, NULL, PMRUN_ERR_FORMAT, line, needle);
+    remove(path);
+}
+
+static pmrun *read_text(const char *text)
+{
+    char path[64], err[512];
+    pmrun *run = NULL;
+    temp_file(path, sizeof path, text, strlen(text));
+    int st = pmrun_read(path, NULL, &run, err, sizeof err);
+    ck_assert_msg(st == PMRUN_OK, "%s", err);
+    remove(path);
+    return run;
+}
+
+START_TEST(test_pmrun_read_angle_beyond_turns)
+{
+    static const char *const big[] = {"1e300", "-1e7", "1000000.5"};
+    char text[512];
+    int k;
+    for (k = 0; k < 3; ++k) {
+        snprintf(text, sizeof text, "# tau delta T D\n10 20 10 20\n%s 20 10 20\n", big[k]);
+        read_text_fails(text, 3, "field 1 (tau)");
+        read_text_fails(text, 3, "is beyond +-1e+06: a corrupt value?");
+        snprintf(text, sizeof text, "# tau delta T D\n10 20 10 20\n10 20 %s 20\n", big[k]);
+        read_text_fails(text, 3, "field 3 (T)");
+        snprintf(text, sizeof text, "# tau delta T D\n10 20 10 20\n10 %s 10 20\n", big[k]);
+        read_text_fails(text, 3, "field 2 (delta)");
+    }
+    /* CSV (a sexagesimal field): the mount declination */
+    read_text_fails("# equinox: JNow\n# refraction: no\n"
+                    "LST,Mount RA,Mount Dec,Solved RA,Solved Dec,Pier Side\n"
+                    "8.8607141587,2.7584324228,-1e300,2.7555217120,63.975098125,pierWest\n",
+                    4, "field 3 (mount Dec)");
+    read_text_fails("# equinox: JNow\n# refraction: no\n"
+                    "LST,Mount RA,Mount Dec,Solved RA,Solved Dec,Pier Side\n"
+                    "8.8607141587,2.7584324228,-1000001:00:00,2.7555217120,63.975098125,pierWest\n",
+                    4, "is beyond +-1e+06");
+    /* TPOINT alt-az: the raw azimuth */
+    read_text_fails("Alt-az\n: ALTAZ\n+31 41 19.6 2021 8 21 13.0 741 2608.0 0.75\n"
+                    "90.0 45.0 1e300 45.02\nEND\n",
+                    4, "field 3");
+    /* RTS2: the mount RA, but not the axis counts */
+    static const char rts2_head[] =
+        "#  Observation\t  MJD\t   LST-MNT RA-MNT   DEC-MNT   AXRA\t  AXDEC   RA-TRUE  DEC-TRUE\n"
+        "#observatory 19.0 47.0 500\n";
+    snprintf(text, sizeof text,
+             "%s02a60384e0001o 60384.83333333 132.9107124 1e300 116.026230884 -1055437 1384246 "
+             "41.332825681 63.975098125\n",
+             rts2_head);
+    read_text_fails(text, 3, "field 4 (RA-MNT)");
+    snprintf(text, sizeof text,
+             "%s02a60384e0001o 60384.83333333 132.9107124 221.376486342 116.026230884 "
+             "-1055437000000 1384246 41.332825681 63.975098125\n",
+             rts2_head);
+    pmrun *run = read_text(text);
+    ck_assert_uint_eq(pmrun_count(run), 1);
+    pmrun_free(run);
+    /* 1e6 deg is 2777 turns and 280 deg: read as that angle */
+    run = read_text("# tau delta T D\n1000000 20 -1000000 20\n");
+    const pmrun_obs *o = pmrun_get(run, 0);
+    ck_assert_double_eq_tol(o->enc_ha / DEG, -80.0, 1e-9);
+    ck_assert_double_eq_tol(o->app_ha / DEG, 80.0, 1e-9);
+    pmrun_free(run);
+}
+END_TEST
+
+/* A record on a last line without a line end is read, with a note: a file
+** cut short reads its last number short (an outside probe's truncated run
+** was read silently).  A last line that is not a record, a terminated one
+** and MW4's JSON (which ends without a line end as a rule) get no note. */
+START_TEST(test_pmrun_read_unterminated_last_record)
+{
+    pmrun *run = read_text("# tau delta T D\n10 20 10.001 20.002\n30 40 30.001 40");
+    ck_assert_uint_eq(pmrun_count(run), 2);
+    ck_assert_int_eq(pmrun_n_warnings(run), 1);
+    ck_assert_int_ge(find_warning(run, ":3: ", "the last line has no line end"), 0);
+    pmrun_free(run);
+    run = read_text("# tau delta T D\n10 20 10.001 20.002\n30 40 30.001 40\n");
+    ck_assert_int_eq(pmrun_n_warnings(run), 0);
+    pmrun_free(run);
+    run = read_text("# tau delta T D\n10 20 10.001 20.002\n30 40 30.001 40\n# end");
+    ck_assert_int_eq(pmrun_n_warnings(run), 0);
+    pmrun_free(run);
+    /* MW4 without its last line end */
+    char path[4096], text[200000];
+    data_path(path, sizeof path, "mw4_model.json");
+    FILE *f = fopen(path, "rb");
+    ck_assert_ptr_nonnull(f);
+    size_t n = fread(text, 1, sizeof text - 1, f);
+    fclose(f);
+    ck_assert_uint_lt(n, sizeof text - 1);
+    while (n > 0 && text[n - 1] == '\n') --n;
+    text[n] = '\0';
+    run = read_text(text);
+    ck_assert_int_eq(find_warning(run, "no line end", NULL), -1);
+    pmrun_free(run);
+}
+END_TEST
+
 /* The notes made before an error come with it (the run and its notes are
 ** not returned on error; a TPOINT year of 9999 was noted, then the file
 ** refused for "mixed encoder conventions" without the note: an outside
@@ -1379,6 +1487,8 @@ static Suite *runfile_suite(void)
     tcase_add_test(tc, test_pmrun_read_pier_other_way_round);
     tcase_add_test(tc, test_pmrun_read_header_without_hash);
     tcase_add_test(tc, test_pmrun_read_error_keeps_notes);
+    tcase_add_test(tc, test_pmrun_read_angle_beyond_turns);
+    tcase_add_test(tc, test_pmrun_read_unterminated_last_record);
     tcase_add_test(tc, test_pmrun_read_humidity_out_of_range);
     tcase_add_test(tc, test_pmrun_read_wavelength_not_positive);
     tcase_add_test(tc, test_pmrun_read_temperature_below_absolute_zero);

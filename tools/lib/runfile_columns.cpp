@@ -306,7 +306,7 @@ private:
             break;
         }
         double v;
-        if (!parse_number(tok, v, why)) {
+        if (!parse_angle(tok, v, why)) {
             why += " (degrees)";
             return false;
         }

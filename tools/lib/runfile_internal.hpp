@@ -106,6 +106,13 @@ std::string excerpt(const std::string &s, size_t max = 40);
 // Strict decimal number: [+-]digits[.digits][e[+-]digits].  No NaN, Inf,
 // hex or trailing garbage.  On failure `why` says what was wrong.
 bool parse_number(const std::string &tok, double &v, std::string &why);
+// An angle in a file (degrees or hours) may be written in any turn, but not
+// beyond +-kMaxAngle: fmod reduces 1e300 exactly, to a direction the file
+// never gave (an outside probe's run read it silently).  On failure `why`
+// says so.  parse_angle: parse_number and this.
+const double kMaxAngle = 1e6;
+bool angle_in_range(double v, std::string &why);
+bool parse_angle(const std::string &tok, double &v, std::string &why);
 // Does the token look like a number (parse_number would accept it)?
 bool is_number(const std::string &tok);
 

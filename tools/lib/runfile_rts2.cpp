@@ -60,7 +60,9 @@ public:
         double v[9];
         for (size_t i = 1; i < 9; ++i) {
             std::string why;
-            if (!parse_number(tok[i], v[i], why))
+            // (fields 2, 6 and 7 are the MJD and axis counts, the rest angles)
+            const bool angle = i != 1 && i != 5 && i != 6;
+            if (!(angle ? parse_angle(tok[i], v[i], why) : parse_number(tok[i], v[i], why)))
                 return ctx_.bad_record(n, format("field %zu (%s) '%s': %s (degrees)", i + 1,
                                                  names[i], excerpt(tok[i]).c_str(), why.c_str()));
         }

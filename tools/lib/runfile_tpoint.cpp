@@ -459,7 +459,7 @@ private:
         double v[4];
         for (size_t i = 0; i < 4; ++i) {
             std::string w;
-            if (!parse_number(tok[i], v[i], w))
+            if (!parse_angle(tok[i], v[i], w))
                 return ctx_.bad_record(n, format("field %zu (%s) '%s': %s (degrees)", i + 1,
                                                  kAzFields[i], excerpt(tok[i]).c_str(), w.c_str()));
             // the observed elevation is a place on the sky; the other three

@@ -63,7 +63,7 @@ bool parse_sexagesimal(const std::string &text, double &value, std::string &why)
     std::string w;
     if (parse_number(s, v, w)) {
         value = v;
-        return true;
+        return angle_in_range(v, why);
     }
     std::string l = lower(s);
     if (l == "nan" || l == "+nan" || l == "-nan" || l.find("inf") != std::string::npos) {
@@ -119,7 +119,7 @@ bool parse_sexagesimal(const std::string &text, double &value, std::string &why)
         }
     double mag = part[0] + part[1] / 60.0 + part[2] / 3600.0;
     value = neg ? -mag : mag;
-    return true;
+    return angle_in_range(value, why);
 }
 
 namespace {
