@@ -1044,6 +1044,10 @@ pm_status pm_fit_add(pm_fit *fit, const pm_context *ctx,
 **  6) On error *out and *res are unchanged and the accumulated pass is kept
 **     (more observations can be added and the solve retried); the
 **     covariance of the previous solve is no longer available.
+**  7) The index terms c' and e' (coef[2], coef[4]: axis zero points,
+**     applied exactly as rotations) come back reduced into (-pi, pi]: the
+**     same model to rounding, where a start or a step turns away had given
+**     c' = -36179 deg (an outside probe).  The other terms are not reduced.
 */
 pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res);
 

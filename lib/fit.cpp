@@ -376,6 +376,18 @@ pm_status pm_fit_add(pm_fit *fit, const pm_context *ctx, double enc_ha,
 }
 
 /* pm_fit_solve but for the covariance's state after an error (there). */
+/* The two index terms c' and e' (axis zero points, applied exactly as
+** rotations) reduced into (-pi, pi]: the model is the same to rounding,
+** and a Gauss-Newton step that went a turn or a hundred away (-36179 deg,
+** an outside probe, from a start of 0) no longer comes back as the fit.
+** A non-finite step is left to pm_model_prepare's PM_ERR_NONFINITE. */
+static void wrap_index(pm_model *m)
+{
+    for (int k = 2; k <= 4; k += 2)
+        if (finite(m->coef[k]))
+            m->coef[k] = wrap_pi(m->coef[k]);
+}
+
 static pm_status solve(pm_fit *fit, pm_model *out, pm_fit_result *res)
 {
     if (!fit || !out)
@@ -406,6 +418,7 @@ static pm_status solve(pm_fit *fit, pm_model *out, pm_fit_result *res)
                 fit->step[i] *= 0.5;
             next.coef[i] = fit->base_coef[i] + (give_up ? 0.0 : fit->step[i]);
         }
+        wrap_index(&next);
         pm_status st = pm_model_prepare(&next);
         if (st != PM_OK)
             return st;
@@ -459,6 +472,7 @@ static pm_status solve(pm_fit *fit, pm_model *out, pm_fit_result *res)
     pm_model next = fit->lin;
     for (int i = 0; i < P; i++)
         next.coef[i] += step[i];
+    wrap_index(&next);
     /* a step that overflows: PM_ERR_NONFINITE from the prepare */
     pm_status st = pm_model_prepare(&next);
     if (st != PM_OK)

@@ -1185,6 +1185,33 @@ START_TEST(test_pm_fit_run_noiseless_converges)
 }
 END_TEST
 
+/* The index terms come back in (-pi, pi]: a start turns away (or a
+** Gauss-Newton step that went there: -36179 deg from a start of 0, an
+** outside probe) gave the same model with c' and e' turns away, and the
+** TPOINT export and model files passed them on. */
+START_TEST(test_pm_fit_run_index_turns_reduced)
+{
+    static pm_model truth, m;
+    pm_fit_result res;
+    tu_run run;
+    int i;
+    make_truth(&truth, 1, 1);
+    simulate(&run, &truth, N_OBS, 0.0, 77);
+    make_zero(&m, 1);
+    m.coef[2] = truth.coef[2] + 7 * 2 * M_PI;
+    m.coef[4] = truth.coef[4] - 3 * 2 * M_PI;
+    ck_assert_int_eq(pm_model_prepare(&m), PM_OK);
+    ck_assert_int_eq(pm_fit_run(&g_fit, &m, NULL, run.n, run.eh, run.ed, run.ah, run.ad,
+                                MAX_ITER, &res),
+                     PM_OK);
+    ck_assert_double_le(fabs(m.coef[2]), M_PI);
+    ck_assert_double_le(fabs(m.coef[4]), M_PI);
+    for (i = 0; i < m.n_terms; i++)
+        ck_assert_double_eq_tol(m.coef[i], truth.coef[i], TOL_EXACT_RAD);
+    tu_run_free(&run);
+}
+END_TEST
+
 /* ---------------------------------------------------------------------- */
 
 static Suite *fit_suite(void)
@@ -1228,6 +1255,7 @@ static Suite *fit_suite(void)
     tc = tcase_create("offsets");
     tcase_set_timeout(tc, 60);
     tcase_add_loop_test(tc, test_pm_fit_run_offsets_noiseless_exact, 0, 3);
+    tcase_add_test(tc, test_pm_fit_run_index_turns_reduced);
     tcase_add_loop_test(tc, test_pm_fit_run_offsets_zscores, 1, 3);
     tcase_add_loop_test(tc, test_pm_fit_solve_single_pass_biased, 1, 3);
     suite_add_tcase(s, tc);
