@@ -631,9 +631,9 @@ START_TEST(test_badinput_angles_out_of_range)
 END_TEST
 
 /* What the docs allow is not an error: a German mount's encoder dec beyond
-** +-90 (over the pole), written in -180..180 or 0..360 deg, and any finite
-** encoder angle: reduced exactly into (-180, 180], the file's value kept in
-** enc_raw. */
+** +-90 (over the pole), written in -180..180 or 0..360 deg, and any encoder
+** angle within +-2^31 deg: reduced exactly into (-180, 180], the file's
+** value kept in enc_raw. */
 START_TEST(test_badinput_angles_legitimate)
 {
     char path[256];

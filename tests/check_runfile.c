@@ -962,9 +962,9 @@ START_TEST(test_pmrun_read_header_without_hash)
 }
 END_TEST
 
-/* An angle beyond +-1e6 (degrees or hours) is refused where it is read:
+/* An angle beyond +-2^31 (degrees or hours) is refused where it is read:
 ** fmod had reduced 1e300 exactly to a direction the file never gave, and
-** the run was read without a word (an outside probe).  1e6 itself is an
+** the run was read without a word (an outside probe).  2^31 itself is an
 ** angle in some turn; gpoint's axis counts are not angles. */
 static void read_text_fails(const char *text, int line, const char *needle)
 {
@@ -987,13 +987,13 @@ static pmrun *read_text(const char *text)
 
 START_TEST(test_pmrun_read_angle_beyond_turns)
 {
-    static const char *const big[] = {"1e300", "-1e7", "1000000.5"};
+    static const char *const big[] = {"1e300", "-1e10", "2147483648.5"};
     char text[512];
     int k;
     for (k = 0; k < 3; ++k) {
         snprintf(text, sizeof text, "# tau delta T D\n10 20 10 20\n%s 20 10 20\n", big[k]);
         read_text_fails(text, 3, "field 1 (tau)");
-        read_text_fails(text, 3, "is beyond +-1e+06: a corrupt value?");
+        read_text_fails(text, 3, "is beyond +-2^31 (2.147e+09): a corrupt value?");
         snprintf(text, sizeof text, "# tau delta T D\n10 20 10 20\n10 20 %s 20\n", big[k]);
         read_text_fails(text, 3, "field 3 (T)");
         snprintf(text, sizeof text, "# tau delta T D\n10 20 10 20\n10 %s 10 20\n", big[k]);
@@ -1006,8 +1006,8 @@ START_TEST(test_pmrun_read_angle_beyond_turns)
                     4, "field 3 (mount Dec)");
     read_text_fails("# equinox: JNow\n# refraction: no\n"
                     "LST,Mount RA,Mount Dec,Solved RA,Solved Dec,Pier Side\n"
-                    "8.8607141587,2.7584324228,-1000001:00:00,2.7555217120,63.975098125,pierWest\n",
-                    4, "is beyond +-1e+06");
+                    "8.8607141587,2.7584324228,-2147483649:00:00,2.7555217120,63.975098125,pierWest\n",
+                    4, "is beyond +-2^31");
     /* TPOINT alt-az: the raw azimuth */
     read_text_fails("Alt-az\n: ALTAZ\n+31 41 19.6 2021 8 21 13.0 741 2608.0 0.75\n"
                     "90.0 45.0 1e300 45.02\nEND\n",
@@ -1028,11 +1028,11 @@ START_TEST(test_pmrun_read_angle_beyond_turns)
     pmrun *run = read_text(text);
     ck_assert_uint_eq(pmrun_count(run), 1);
     pmrun_free(run);
-    /* 1e6 deg is 2777 turns and 280 deg: read as that angle */
-    run = read_text("# tau delta T D\n1000000 20 -1000000 20\n");
+    /* 2^31 deg is 5965232 turns and 128 deg: read as that angle */
+    run = read_text("# tau delta T D\n2147483648 20 -2147483648 20\n");
     const pmrun_obs *o = pmrun_get(run, 0);
-    ck_assert_double_eq_tol(o->enc_ha / DEG, -80.0, 1e-9);
-    ck_assert_double_eq_tol(o->app_ha / DEG, 80.0, 1e-9);
+    ck_assert_double_eq_tol(o->enc_ha / DEG, 128.0, 1e-9);
+    ck_assert_double_eq_tol(o->app_ha / DEG, -128.0, 1e-9);
     pmrun_free(run);
 }
 END_TEST

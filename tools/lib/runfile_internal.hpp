@@ -107,10 +107,12 @@ std::string excerpt(const std::string &s, size_t max = 40);
 // hex or trailing garbage.  On failure `why` says what was wrong.
 bool parse_number(const std::string &tok, double &v, std::string &why);
 // An angle in a file (degrees or hours) may be written in any turn, but not
-// beyond +-kMaxAngle: fmod reduces 1e300 exactly, to a direction the file
-// never gave (an outside probe's run read it silently).  On failure `why`
-// says so.  parse_angle: parse_number and this.
-const double kMaxAngle = 1e6;
+// beyond +-kMaxAngle = 2^31: fmod reduces 1e300 exactly, to a direction the
+// file never gave (an outside probe's run read it silently).  Below 2^31 a
+// double's spacing is at most 2.4e-7 (0.001" in degrees), and no mount
+// counts millions of turns.  On failure `why` says so.  parse_angle:
+// parse_number and this.
+const double kMaxAngle = 2147483648.0;
 bool angle_in_range(double v, std::string &why);
 bool parse_angle(const std::string &tok, double &v, std::string &why);
 // Does the token look like a number (parse_number would accept it)?
