@@ -264,6 +264,90 @@ START_TEST(test_errormap_pmfit)
 }
 END_TEST
 
+/* Keep the records of a named-column run below 40 deg (the 4th field). */
+static int below_40(char *line, size_t size, void *arg)
+{
+    double v[4];
+    (void)size;
+    (void)arg;
+    if (line[0] == '#' || sscanf(line, "%lf %lf %lf %lf", &v[0], &v[1], &v[2], &v[3]) != 4)
+        return 1;
+    return v[3] < 40;
+}
+
+/* The map's RMS is the average over the sky's area: pmfit fit's rms_arcsec
+** against the C API's predicted sigma at 40,000 places drawn uniformly on
+** the sphere above the map's limit (2%), for an alt-az run whose stars lie
+** below 40 deg.  The cells had been weighted by cos(el) on top of their
+** equal areas, so by cos^2: 27.7" for this run's 52.1" (the zenith, which
+** its stars do not reach, counted for little; an outside probe: actual/
+** predicted 1.78 on such runs, 0.94 weighted by area). */
+START_TEST(test_errormap_rms_is_area_average)
+{
+    static double eh[400], ed[400], ah[400], ad[400];
+    static char out[1 << 16];
+    char dir[64], all[128], low[128], cmd[1024], err[512];
+    pmrun_options ro;
+    pmrun *run = NULL;
+    pm_model m;
+    pm_fit_result res;
+    tu_rng r;
+    size_t i, n;
+    long k, nk = 0;
+    double ss = 0, lim, rms, mc;
+    const char *em;
+    tu_tmpdir(dir, "pm_errormap_");
+    snprintf(all, sizeof all, "%s/all.dat", dir);
+    snprintf(low, sizeof low, "%s/low.dat", dir);
+    snprintf(cmd, sizeof cmd, "%s simulate '%s' --mount altaz --n 300 --seed 11 --el-limit 15",
+             tu_pmfit_path(), all);
+    ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
+    tu_edited_copy(all, low, below_40, NULL);
+    snprintf(cmd, sizeof cmd, "%s fit '%s' --json", tu_pmfit_path(), low);
+    ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
+    em = strstr(out, "\"error_map\"");
+    ck_assert_ptr_nonnull(em);
+    lim = tu_json_num(em, "limit_deg");
+    rms = tu_json_num(em, "rms_arcsec");
+    pmrun_options_default(&ro);
+    ck_assert_msg(pmrun_read(low, &ro, &run, err, sizeof err) == 0, "%s", err);
+    n = pmrun_count(run);
+    ck_assert(n > 40 && n <= 400);
+    for (i = 0; i < n; i++) {
+        const pmrun_obs *o = pmrun_get(run, i);
+        eh[i] = o->enc_ha;
+        ed[i] = o->enc_dec;
+        ah[i] = o->app_ha;
+        ad[i] = o->app_dec;
+    }
+    pmrun_free(run);
+    ck_assert_int_eq(pm_model_init(&m, PM_MOUNT_ALTAZ, 1), PM_OK);
+    ck_assert_int_eq(pm_fit_run(&fit, &m, NULL, (long)n, eh, ed, ah, ad, 50, &res), PM_OK);
+    tu_seed(&r, 2024);
+    while (nk < 40000) {
+        double az = 2 * M_PI * tu_uniform(&r), el = asin(2 * tu_uniform(&r) - 1), s;
+        if (el < lim * DEG)
+            continue;
+        ck_assert_int_eq(pm_fit_pointing_sigma(&fit, &res, &m, NULL, az, el, &s, NULL), PM_OK);
+        ss += s * s;
+        nk++;
+    }
+    mc = sqrt(ss / (double)nk) / ARCSEC;
+    for (k = 0, ss = 0; k < (long)n; k++) {
+        double s;
+        ck_assert_int_eq(pm_fit_pointing_sigma(&fit, &res, &m, NULL, eh[k], ed[k], &s, NULL),
+                         PM_OK);
+        ss += s * s;
+    }
+    printf("check_errormap: %zu alt-az stars below 40 deg: the map's RMS above %.0f deg %.3f\", "
+           "the area average %.3f\" (at the stars %.3f\", C API %.3f\")\n",
+           n, lim, rms, mc, tu_json_num(em, "at_points_arcsec"), sqrt(ss / (double)n) / ARCSEC);
+    ck_assert(fabs(tu_json_num(em, "at_points_arcsec") - sqrt(ss / (double)n) / ARCSEC) <=
+              1e-4 * tu_json_num(em, "at_points_arcsec")); /* the same fit */
+    ck_assert_msg(fabs(rms / mc - 1) <= 0.02, "map %.3f\", area average %.3f\"", rms, mc);
+}
+END_TEST
+
 /* A German run all on its flipped side (the independent gimbal's W records,
 ** beyond the pole and west of the meridian: tests/ref/indep_gen.py, the
 ** file's first lines): the map takes the east sky on the side the mount
@@ -298,7 +382,10 @@ END_TEST
 ** sky, and within it.  Each side's model had been mapped over the whole sky,
 ** half of it where the mount never takes that side: flip_gem's 4.2" and
 ** 3.8" for 0.32" at the stars, and gem-28's west model "undetermined"
-** (393", 3.35 times its sigma; an outside probe). */
+** (393", 3.35 times its sigma; an outside probe).  Those RMS were weighted
+** by cos^2 of the declination; weighted by area (stop 42), flip_gem's sides
+** read 0.87" and 1.01", 2.7 and 3.1 times their value at the stars, so the
+** bound is 5 times (the whole sky had been 13 times). */
 START_TEST(test_errormap_split_sides)
 {
     static char out[1 << 16];
@@ -322,7 +409,7 @@ START_TEST(test_errormap_split_sides)
             printf("check_errormap: %s, the %s model: over its side's sky %.3f\", at the stars "
                    "%.3f\"\n", real ? "gem-28" : "flip_gem", sides[k], tu_json_num(em, "rms_arcsec"),
                    tu_json_num(em, "at_points_arcsec"));
-            ck_assert(tu_json_num(em, "rms_arcsec") < 3 * tu_json_num(em, "at_points_arcsec"));
+            ck_assert(tu_json_num(em, "rms_arcsec") < 5 * tu_json_num(em, "at_points_arcsec"));
             ck_assert_ptr_nonnull(strstr(em, "\"undetermined\": false"));
         }
     }
@@ -394,6 +481,7 @@ static Suite *suite(void)
     tcase_add_test(t, test_errormap_pmfit);
     tcase_add_test(t, test_errormap_side_never_used);
     tcase_add_test(t, test_errormap_split_sides);
+    tcase_add_test(t, test_errormap_rms_is_area_average);
     tcase_add_test(t, test_point_gain_matches_refit);
     suite_add_tcase(s, t);
     return s;
