@@ -303,6 +303,63 @@ START_TEST(test_inject_own_column)
 }
 END_TEST
 
+/* explain takes the run's own columns as candidates (aux:NAME, on c' and
+** e' as pmfit fit --add aux:NAME fits them): a column 'hum' added to the
+** bundled run and to the three real ones (as injection writes them, a
+** named-column run) is not a finding when nothing follows it, and is
+** found, with its size (25%), when an effect of about 1.5 sigma per axis
+** follows it (its coefficient sigma/14 per unit; hum spreads by 21).
+** Before, a column the run recorded was never looked at. */
+START_TEST(test_inject_own_column_explained)
+{
+    static const char *real[3] = {"mmt/k_and_e.dat", "celestial/gem-28.dat",
+                                  "celestial/cgx-l-data.dat"};
+    const char *d = tu_data_dir();
+    char src[512], named[512], col[512], dst[512], err[512], spec[64];
+    int k, j;
+    pmx_result r;
+    setup();
+    snprintf(named, sizeof named, "%s/named.dat", tmpdir);
+    snprintf(col, sizeof col, "%s/hum.dat", tmpdir);
+    snprintf(dst, sizeof dst, "%s/hum_in.dat", tmpdir);
+    for (k = -1; k < 3; k++) {
+        double p;
+        int found = 0;
+        if (k < 0) {
+            flip_path(src, sizeof src);
+        } else {
+            if (!d)
+                break;
+            snprintf(src, sizeof src, "%s/%s", d, real[k]);
+            if (access(src, R_OK) != 0)
+                continue;
+        }
+        ck_assert_msg(inject(src, "refraction=0", NULL, named) == 0, "%s", out);
+        with_column(named, col);
+        ck_assert_msg(pmx_explain(col, 1, 0.01, &r, err, sizeof err) == 0, "%s", err);
+        for (j = 0; j < r.n_findings; j++)
+            ck_assert_msg(strcmp(r.findings[j].effect, "aux:hum") != 0,
+                          "%s: aux:hum found in nothing", src);
+        p = r.base_sigma_arcsec / 14;
+        snprintf(spec, sizeof spec, "aux:hum=%.6g", p);
+        ck_assert_msg(inject(col, spec, NULL, dst) == 0, "%s", out);
+        ck_assert_msg(pmx_explain(dst, 1, 0.01, &r, err, sizeof err) == 0, "%s", err);
+        for (j = 0; j < r.n_findings; j++)
+            if (!strcmp(r.findings[j].effect, "aux:hum")) {
+                found = 1;
+                printf("check_inject: %s + aux:hum %.4g\"/unit: found %.4g\" +- %.4g\" "
+                       "(finding %d of %d)\n",
+                       k < 0 ? "flip_gem" : real[k], p, r.findings[j].amplitude_arcsec,
+                       r.findings[j].amplitude_err_arcsec, j + 1, r.n_findings);
+                ck_assert(fabs(r.findings[j].amplitude_arcsec - p) <= 0.25 * p);
+            }
+        ck_assert_msg(found, "%s: aux:hum of %g\"/unit not found", src, p);
+    }
+    if (!d)
+        printf("check_inject: ../shared/data absent: the real runs skipped\n");
+}
+END_TEST
+
 static double sag_reading(const char *path)
 {
     pmx_result r;
@@ -364,6 +421,7 @@ static Suite *suite(void)
     tcase_add_test(t, test_inject_found);
     tcase_add_test(t, test_inject_misuse);
     tcase_add_test(t, test_inject_own_column);
+    tcase_add_test(t, test_inject_own_column_explained);
     tcase_add_test(t, test_inject_sag_read_back);
     suite_add_tcase(s, t);
     return s;

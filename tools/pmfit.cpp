@@ -1178,6 +1178,14 @@ double finding_variable(const Run &run, const Finding &f, const Obs &o, size_t j
         *xlab = "time (h)";
         return o.ctx.time_h;
     }
+    if (f.effect.rfind("aux:", 0) == 0) {
+        auto it = std::find(run.aux_names.begin(), run.aux_names.end(), f.effect.substr(4));
+        size_t col = (size_t)(it - run.aux_names.begin());
+        if (col < run.aux_names.size() && col < (size_t)PM_MAX_AUX) {
+            *xlab = "the run's column " + f.effect.substr(4);
+            return o.ctx.aux[col];
+        }
+    }
     if (f.effect == "hysteresis") {
         *xlab = "direction of the last slew on axis 1 (-1, +1; jittered)";
         return o.ctx.dir + 0.1 * ((double)(j % 7) - 3) / 3; // jitter to see the spread

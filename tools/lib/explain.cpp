@@ -467,6 +467,20 @@ bool input_usable(const Run &run, const std::vector<int> &use, int which)
     return hi - lo > (which == 0 ? 0.2 : which == 1 ? 0.05 : 1);
 }
 
+// Does the run's column j vary, and is it known everywhere in `use`?
+bool aux_usable(const Run &run, const std::vector<int> &use, size_t j)
+{
+    double lo = 1e300, hi = -1e300;
+    for (int i : use) {
+        double x = run.obs[i].ctx.aux[j];
+        if (!std::isfinite(x))
+            return false;
+        lo = std::min(lo, x);
+        hi = std::max(hi, x);
+    }
+    return hi > lo;
+}
+
 // The chi^2 excess of a group of residuals (components: 1 axis 1, 2 axis 2,
 // 3 both), with the fit's sigma: Wilson-Hilferty tail.
 void add_group(std::vector<Located> &out, const FitOut &f, double s2, double rms,
@@ -833,6 +847,22 @@ void physical_candidates(const Run &run, const State &st, std::vector<Candidate>
         h.push_back("aux:dec_dir:e'");
     if (!h.empty())
         add_candidate(cands, st, "hysteresis", h);
+    // the run's own columns (a tube temperature, a focus position, TPOINT's
+    // auxiliary readings): each a cause the run recorded, on c' and e' as
+    // `--add aux:NAME` fits it.  Not the axes' own positions (gpoint's axis
+    // counts, MountWizzard's angular positions: the geometry again, as a
+    // line) nor the derived slew direction (hysteresis above).
+    for (size_t j = 0; j < run.aux_names.size() && j < (size_t)PM_MAX_AUX; j++) {
+        const std::string &name = run.aux_names[j];
+        static const char *const position[] = {"dec_dir", "axra",         "axdec",
+                                               "axaz",    "axalt",        "angularPosRA",
+                                               "angularPosDEC"};
+        if (std::any_of(std::begin(position), std::end(position),
+                        [&](const char *p) { return name == p; }) ||
+            !aux_usable(run, st.use, j))
+            continue;
+        add_candidate(cands, st, "aux:" + name, {"aux:" + name});
+    }
 }
 
 // The observations of `use` not in `drop`.

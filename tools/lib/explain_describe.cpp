@@ -161,9 +161,16 @@ std::string values_of(const Run &run, const pm_model &m, const pm_fit_result &re
 {
     std::string vals;
     for (int i : newi) {
+        // two decimals, or more where the error is below 0.1 (a column's
+        // coefficient per unit of it: "0.06 +- 0.00" said nothing)
+        int dp = 2;
+        const double e = std::fabs(arcsec(res.err[i]));
+        while (dp < 6 && e > 0 && e < std::pow(10.0, 1 - dp))
+            dp++;
         char v[160];
-        std::snprintf(v, sizeof v, "%s%s = %.2f +- %.2f", vals.empty() ? "" : ", ",
-                      input_name(run, m, i).c_str(), arcsec(m.coef[i]), arcsec(res.err[i]));
+        std::snprintf(v, sizeof v, "%s%s = %.*f +- %.*f", vals.empty() ? "" : ", ",
+                      input_name(run, m, i).c_str(), dp, arcsec(m.coef[i]), dp,
+                      arcsec(res.err[i]));
         vals += v;
     }
     return vals;
@@ -354,6 +361,13 @@ const char *family_words(const Run &run, const std::string &e, double sign)
     if (e == "time_drift")
         return "the pointing drifts through the night (arcsec per hour): settling, slipping "
                "encoders or a clock error";
+    if (e.rfind("aux:", 0) == 0)
+        return az ? "the pointing follows the run's own column (arcsec per unit of it, about its "
+                    "mean), on the azimuth and elevation index: a cause the run recorded (a "
+                    "focus position, a second temperature ...)"
+                  : "the pointing follows the run's own column (arcsec per unit of it, about its "
+                    "mean), on the hour-angle and declination index: a cause the run recorded (a "
+                    "focus position, a second temperature ...)";
     return az ? "the pointing depends on the direction of the last slew: cable-wrap or bearing "
                 "hysteresis, or backlash in the drive (half the offset per unit of direction)"
               : "the pointing depends on the direction of the last slew: backlash or hysteresis "

@@ -539,6 +539,15 @@ double finding_x(const Data &d, const Finding &f, const Obs &o, size_t j, std::s
         *label = "time (h)";
         return o.ctx.time_h;
     }
+    if (f.effect.rfind("aux:", 0) == 0) {
+        const std::vector<std::string> &names = d.run.aux_names;
+        size_t col = (size_t)(std::find(names.begin(), names.end(), f.effect.substr(4)) -
+                              names.begin());
+        if (col < names.size() && col < (size_t)PM_MAX_AUX) {
+            *label = "the run's column " + f.effect.substr(4) + " (its unit)";
+            return o.ctx.aux[col];
+        }
+    }
     if (f.effect == "hysteresis") {
         *label = "direction of the last slew on axis 1 (+1 or -1, no unit; spread for visibility)";
         return o.ctx.dir + 0.1 * ((double)(j % 7) - 3) / 3;
