@@ -14,10 +14,13 @@ extern "C" {
 #define PMX_MAX_FINDINGS 8
 #define PMX_MAX_ALTERNATIVES 4
 #define PMX_MAX_READINGS 12
+/* an effect's name with its NUL: ha_periodic ..., or aux:NAME for the
+** run's own column NAME (a longer name is cut) */
+#define PMX_EFFECT_LEN 64
 
 /* Another reading of the same residuals with close evidence. */
 typedef struct pmx_alternative {
-    char effect[24];
+    char effect[PMX_EFFECT_LEN];
     double delta_bic;                /* BIC(alternative) - BIC(chosen); negative where BIC
                                         (which does not count the periods or candidates
                                         tried) prefers the alternative */
@@ -39,7 +42,7 @@ typedef struct pmx_reading {
 } pmx_reading;
 
 typedef struct pmx_finding {
-    char effect[24];                 /* ha_periodic, refraction, ... */
+    char effect[PMX_EFFECT_LEN];     /* ha_periodic, refraction, aux:NAME ... */
     double cycles_per_rev;           /* periodic effects, else 0 */
     double cycles_lo, cycles_hi;     /* periodic: the periods that fit as well (95%),
                                         cycles_per_rev itself where the run fixes it */
@@ -50,7 +53,7 @@ typedef struct pmx_finding {
     int n_params_after;
     int n_lines;                     /* outliers: how many points */
     int lines[16];                   /* their file lines (the first 16) */
-    char with[24];                   /* found as a pair with this effect, else "" */
+    char with[PMX_EFFECT_LEN];       /* found as a pair with this effect, else "" */
     int n_alternatives;
     pmx_alternative alternatives[PMX_MAX_ALTERNATIVES];
 } pmx_finding;
@@ -70,14 +73,14 @@ typedef struct pmx_result {
     pmx_reading readings[PMX_MAX_READINGS];
     int physical_reading;            /* 1: order 0 + one term predicts as well as order 1 */
     int n_withdrawn;                 /* found, then not needed once later findings were in */
-    char withdrawn[PMX_MAX_FINDINGS][24];
+    char withdrawn[PMX_MAX_FINDINGS][PMX_EFFECT_LEN];
     double compose_rms_arcsec;       /* the composition taken out, RMS per axis (0: none) */
     int n_cv_left_out;               /* points the baseline cannot predict from the others, */
     int cv_left_out_lines[16];       /* left out of every CV RMS: their file lines (first 16) */
     /* where the search ended, the most significant family that does not
     ** predict better ("significant, not modelled": the residuals hold it,
     ** the run's points cannot fit it usefully); "" if none */
-    char unmodelled[48];
+    char unmodelled[PMX_EFFECT_LEN];
     double unmodelled_log10_fap;     /* its false-alarm probability (log10) */
     double unmodelled_sigma_arcsec, unmodelled_cv_rms_arcsec; /* with it */
     double unmodelled_cv_before_arcsec; /* the CV RMS of the model it was tried on */
