@@ -466,6 +466,42 @@ START_TEST(test_compare_guards)
 }
 END_TEST
 
+/* A new night too small to cross-validate a full refit (13 stars for 22
+** terms: each fold's 4/5 cannot fit them): the refit's figure is "not
+** available", never "nan"", and the advice says so (an outside probe's
+** advice read "a full refit predicts nan""); the JSON's refit is null.
+** An index moved 10": whatever the advice, not "still holds". */
+START_TEST(test_compare_refit_not_cross_validated)
+{
+    char cmd[2048];
+    int s;
+    if (!dir[0])
+        tu_tmpdir(dir, "pm_compare_");
+    for (s = 1; s <= 3; s++) {
+        snprintf(cmd, sizeof cmd,
+                 "cd %s && %s simulate s1.dat --mount altaz --n 60 --seed %d --term \"c'=100\" "
+                 "&& %s simulate s2.dat --mount altaz --n 13 --seed %d --term \"c'=110\" && %s "
+                 "fit s1.dat --save s1.pm > /dev/null",
+                 dir, tu_pmfit_path(), s, tu_pmfit_path(), s + 70, tu_pmfit_path());
+        ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
+        snprintf(cmd, sizeof cmd, "cd %s && %s compare s1.pm s2.dat", dir, tu_pmfit_path());
+        ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
+        {
+            const char *adv = out, *q;
+            while ((q = strstr(adv, "\n\n  ")) != NULL)
+                adv = q + 4; /* the last paragraph: the advice */
+            printf("check_compare: 60 then 13 stars, seed %d: %.200s\n", s, adv);
+        }
+        ck_assert_msg(strstr(out, "nan") == NULL, "%s", out);
+        ck_assert_msg(strstr(out, "full refit not available (13 points, too few in 4/5 of them "
+                                  "for 22 terms)") != NULL, "%s", out);
+        ck_assert_msg(strstr(out, "the model still holds") == NULL, "%s", out);
+        compare("s1.pm", "s2.dat");
+        ck_assert_ptr_nonnull(strstr(out, "\"refit\": null"));
+    }
+}
+END_TEST
+
 START_TEST(test_compare_misuse)
 {
     static const char *bad[][2] = {
@@ -534,6 +570,7 @@ static Suite *suite(void)
     tcase_add_test(t, test_compare_real_halves);
     tcase_add_test(t, test_compare_other_site);
     tcase_add_test(t, test_compare_misuse);
+    tcase_add_test(t, test_compare_refit_not_cross_validated);
     tcase_add_test(t, test_compare_confounded_terms_moved);
     tcase_add_test(t, test_compare_unchanged_mount_holds);
     tcase_add_test(t, test_compare_guards);

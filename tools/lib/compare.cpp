@@ -230,8 +230,18 @@ std::string advice_of(const Comparison &c)
     // alone), and a re-zero more than twice worse than a refit is not
     // advised (it was, 2-5 times worse, in 9 of an outside probe's 4,500
     // comparisons).
-    const bool far_worse = c.cv_as_is > 2 * std::min(c.cv_refit, c.cv_rezero);
-    const bool rezero_far_worse = c.cv_rezero > 2 * c.cv_refit;
+    // A refit that cannot be cross-validated (a fold's 4/5 of a small
+    // night's points too few for the terms: 13 stars for 22) is not
+    // compared: the advice had said "a full refit predicts nan"", and the
+    // guard could not act (an outside probe).
+    const bool refit_cv = std::isfinite(c.cv_refit);
+    const double best_cv = refit_cv ? std::min(c.cv_refit, c.cv_rezero) : c.cv_rezero;
+    const std::string refit_s =
+        refit_cv ? fmt("%.3g\"", c.cv_refit)
+                 : fmt("not cross-validated (%ld points, too few in 4/5 of them for %d terms)",
+                       c.n_obs, c.n_terms);
+    const bool far_worse = c.cv_as_is > 2 * best_cv;
+    const bool rezero_far_worse = refit_cv && c.cv_rezero > 2 * c.cv_refit;
     const char *moved = c.old_cov_borrowed ? "differ from the model file's" : "moved";
     if (std::isfinite(c.joint_log10p) && std::isfinite(c.rest_log10p) &&
         !(c.joint_log10p >= alpha_log10 && far_worse)) {
@@ -243,16 +253,17 @@ std::string advice_of(const Comparison &c)
                              c.moved[0].name.c_str(), std::fabs(c.moved[0].z), c.n_terms);
             std::snprintf(b, sizeof b, "the model still holds: its %d terms together have not "
                                        "moved beyond both fits' errors (joint test, %s)%s; "
-                                       "cross-validated %.3g\" as is, %.3g\" refitted",
+                                       "cross-validated %.3g\" as is, refitted %s",
                           c.n_terms, p_text(c.joint_log10p).c_str(), single.c_str(), c.cv_as_is,
-                          c.cv_refit);
+                          refit_s.c_str());
         } else if (c.rest_log10p >= alpha_log10 && !rezero_far_worse) {
             std::snprintf(b, sizeof b, "re-zero the index terms (c' %+.2f\", e' %+.2f\"): the "
                                        "terms %s together (joint test, %s), but beyond the "
                                        "indices not (%s); cross-validated %.3g\" re-zeroed, "
-                                       "%.3g\" refitted, %.3g\" as is",
+                                       "%.3g\" as is, refitted %s",
                           c.rezero_c, c.rezero_e, moved, p_text(c.joint_log10p).c_str(),
-                          p_text(c.rest_log10p).c_str(), c.cv_rezero, c.cv_refit, c.cv_as_is);
+                          p_text(c.rest_log10p).c_str(), c.cv_rezero, c.cv_as_is,
+                          refit_s.c_str());
         } else if (c.rest_log10p >= alpha_log10) {
             std::snprintf(b, sizeof b, "refit: the terms %s together (joint test, %s), beyond the "
                                        "indices within their errors (%s), but a re-zero of the "
@@ -260,12 +271,19 @@ std::string advice_of(const Comparison &c)
                                        "%.3g\" (cross-validated; as is %.3g\")",
                           moved, p_text(c.joint_log10p).c_str(), p_text(c.rest_log10p).c_str(),
                           c.cv_rezero, c.cv_refit, c.cv_as_is);
-        } else {
+        } else if (refit_cv) {
             std::snprintf(b, sizeof b, "refit: terms beyond the indices %s (joint test, %s); "
                                        "a re-zero of the index terms leaves %.3g\" where a full "
                                        "refit predicts %.3g\" (cross-validated; as is %.3g\")",
                           moved, p_text(c.rest_log10p).c_str(), c.cv_rezero, c.cv_refit,
                           c.cv_as_is);
+        } else {
+            std::snprintf(b, sizeof b, "refit: terms beyond the indices %s (joint test, %s); "
+                                       "a re-zero of the index terms leaves %.3g\" "
+                                       "(cross-validated; as is %.3g\"), a full refit is %s: "
+                                       "take more stars before refitting",
+                          moved, p_text(c.rest_log10p).c_str(), c.cv_rezero, c.cv_as_is,
+                          refit_s.c_str());
         }
         std::string a = b;
         if (c.old_cov_borrowed && c.joint_log10p < alpha_log10)
@@ -281,17 +299,22 @@ std::string advice_of(const Comparison &c)
         pre = fmt("the terms are within their errors (joint test, %s), yet the old model predicts "
                   "this night far worse than %s (cross-validated %.3g\" against %.3g\")%s: ",
                   p_text(c.joint_log10p).c_str(),
-                  c.cv_rezero < c.cv_refit ? "a re-zero" : "a refit", c.cv_as_is,
-                  std::min(c.cv_refit, c.cv_rezero),
+                  !refit_cv || c.cv_rezero < c.cv_refit ? "a re-zero" : "a refit", c.cv_as_is,
+                  best_cv,
                   c.old_cov_borrowed ? "; terms this sky confounds can move as one, which a "
                                        "version-4 model file's errors without their "
                                        "correlations cannot show (compare with the old run "
                                        "itself, whose covariance is known)"
                                      : "");
-    if (c.moved.empty() && c.cv_as_is <= 1.05 * c.cv_refit) {
+    if (c.moved.empty() && (refit_cv ? c.cv_as_is <= 1.05 * c.cv_refit
+                                     : c.cv_as_is <= 1.05 * c.cv_rezero)) {
         std::snprintf(b, sizeof b, "the model still holds: no term moved beyond 3 sigma and it "
-                                   "predicts this night as well as a refit would (%.3g\" vs %.3g\")",
-                      c.cv_as_is, c.cv_refit);
+                                   "predicts this night as well as %s would (%.3g\" vs %.3g\")",
+                      refit_cv ? "a refit" : "a re-zero", c.cv_as_is, best_cv);
+    } else if (!refit_cv) {
+        std::snprintf(b, sizeof b, "re-zero the index terms (c' %+.2f\", e' %+.2f\"): "
+                                   "cross-validated %.3g\" (as is %.3g\"); a full refit is %s",
+                      c.rezero_c, c.rezero_e, c.cv_rezero, c.cv_as_is, refit_s.c_str());
     } else if (c.cv_rezero <= 1.05 * c.cv_refit) {
         std::snprintf(b, sizeof b, "re-zero the index terms (c' %+.2f\", e' %+.2f\"): that predicts "
                                    "as well as a full refit (cross-validated %.3g\" vs %.3g\"; as "
@@ -510,7 +533,13 @@ void print_comparison(const Comparison &c, const std::string &old_name, const st
     std::printf("\n  re-zero (only c' and e' refitted): c' %+.2f\" +- %.2f\", e' %+.2f\" +- %.2f\"\n",
                 c.rezero_c, c.rezero_c_err, c.rezero_e, c.rezero_e_err);
     std::printf("  cross-validated RMS per axis (5-fold): as is %.3f\", re-zero %.3f\", full refit "
-                "%.3f\"\n", c.cv_as_is, c.cv_rezero, c.cv_refit);
+                "%s\n",
+                c.cv_as_is, c.cv_rezero,
+                std::isfinite(c.cv_refit)
+                    ? fmt("%.3f\"", c.cv_refit).c_str()
+                    : fmt("not available (%ld points, too few in 4/5 of them for %d terms)",
+                          c.n_obs, c.n_terms)
+                          .c_str());
     if (std::isfinite(c.old_pred_new))
         std::printf("  the old fit's predicted error (1 sigma per axis): %.3f\" at the new run's "
                     "points, %.3f\" at its own\n", c.old_pred_new, c.old_pred_old);
