@@ -375,7 +375,6 @@ pm_status pm_fit_add(pm_fit *fit, const pm_context *ctx, double enc_ha,
     return PM_OK;
 }
 
-/* pm_fit_solve but for the covariance's state after an error (there). */
 /* The two index terms c' and e' (axis zero points, applied exactly as
 ** rotations) reduced into (-pi, pi]: the model is the same to rounding,
 ** and a Gauss-Newton step that went a turn or a hundred away (-36179 deg,
@@ -388,8 +387,10 @@ static void wrap_index(pm_model *m)
             m->coef[k] = wrap_pi(m->coef[k]);
 }
 
-/* keep: the statistics and covariance at the pass's own point, which is
-** returned unmoved (pm_fit_run's last pass, Note 2 there); no damping. */
+/* pm_fit_solve but for the covariance's state after an error (there).
+** keep: the statistics and covariance at the pass's own point, which is
+** returned unmoved (pm_fit_run's last pass, Note 2 there); no damping, and
+** a pass after it is taken as from an accepted point with no step. */
 static pm_status solve(pm_fit *fit, pm_model *out, pm_fit_result *res, bool keep = false)
 {
     if (!fit || !out)
@@ -517,7 +518,7 @@ static pm_status solve(pm_fit *fit, pm_model *out, pm_fit_result *res, bool keep
     fit->iterations++;
     fit->cov_valid = 1;
     fit->base_chi2 = fit->chi2;
-    fit->base_pred = pred;
+    fit->base_pred = keep ? 0.0 : pred;
     fit->halvings = 0;
     if (res) {
         res->accepted = 1;

@@ -128,6 +128,19 @@ def _as_float(name, value, what="numbers"):
     is not a number."""
     if value is None:
         raise ArgumentError("%s is None: not a number" % name)
+    if isinstance(value, _np.ma.MaskedArray):
+        # np.asarray takes the data under the mask: masked points would be
+        # fitted or evaluated as if they were good (astropy reads a CSV's
+        # missing values as masked; an outside probe's five masked points
+        # took sigma from 2.19" to 171")
+        m = _np.ma.getmaskarray(value)
+        if m.any():
+            i = int(_np.argmax(m.reshape(-1)))
+            raise ArgumentError(
+                "%s%s is masked (%d of %d values): a masked array's data under the mask "
+                "would be used; drop those points from every array, or fill them" % (
+                    name, _index(m, i), int(m.sum()), m.size))
+        value = _np.ma.getdata(value)
     try:
         a = _np.asarray(value)
     except (TypeError, ValueError) as e:
@@ -389,6 +402,8 @@ class Model(_pm.Model):
         (pier side, temperature, time, slew direction, auxiliary columns) are
         needed only by models with such terms.  Raises NonFiniteError for a
         NaN or infinity, naming the element."""
+        if threads is not None:
+            _ctx_args({}, threads)  # checked on every way, the one-point way too
         if (isinstance(enc_ha, float) and isinstance(enc_dec, float) and _isfinite(enc_ha) and
                 _isfinite(enc_dec) and pier is None and not self.needs_context):
             return self.apply_point(enc_ha, enc_dec)  # one point: the C call itself
