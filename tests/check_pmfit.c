@@ -719,6 +719,48 @@ START_TEST(test_pmfit_large_index_errors)
 }
 END_TEST
 
+/* On an alt-az mount the slew direction derived for axis 2 is the
+** elevation drive's, el_dir: explain and the model file had called it
+** dec_dir ("e'*dec_dir" for the elevation index).  A model file of such a
+** run written before (its input "dec_dir") still reads the derived one. */
+START_TEST(test_pmfit_altaz_elevation_direction)
+{
+    char sim[300], m[300], mold[300], args[1200];
+    double rms;
+    make_tmpdir();
+    snprintf(sim, sizeof sim, "%s/azh.dat", tmpdir);
+    snprintf(m, sizeof m, "%s/azh.pm", tmpdir);
+    snprintf(mold, sizeof mold, "%s/azh_old.pm", tmpdir);
+    snprintf(args, sizeof args, "%s --mount altaz --n 200 --seed 4 --effect hysteresis=3", sim);
+    ck_assert_msg(run("%s simulate %s%s", args, "") == 0, "%s", out);
+    ck_assert_msg(run("%s explain %s%s", sim, "") == 0, "%s", out);
+    ck_assert_msg(strstr(out, "1. hysteresis:") != NULL && strstr(out, "e'*el_dir = ") != NULL &&
+                      strstr(out, "--add \"aux:el_dir:e'\"") != NULL &&
+                      strstr(out, "dec_dir") == NULL,
+                  "%s", out);
+    snprintf(args, sizeof args, "%s --add hysteresis --add \"aux:el_dir:e'\" --save %s", sim, m);
+    ck_assert_msg(run("%s fit %s%s", args, "") == 0, "%s", out);
+    {
+        char *text = tu_slurp(m), *p;
+        FILE *f;
+        ck_assert_ptr_nonnull(text);
+        p = strstr(text, "input 0 el_dir\n");
+        ck_assert_msg(p != NULL, "%s", text);
+        f = fopen(mold, "w");
+        ck_assert_ptr_nonnull(f);
+        fprintf(f, "%.*sinput 0 dec_dir%s", (int)(p - text), text, p + strlen("input 0 el_dir"));
+        fclose(f);
+        free(text);
+    }
+    snprintf(args, sizeof args, "%s %s --json", m, sim);
+    ck_assert_msg(run("%s eval %s%s", args, "") == 0, "%s", out);
+    rms = tu_json_num(out, "rms_arcsec");
+    snprintf(args, sizeof args, "%s %s --json", mold, sim);
+    ck_assert_msg(run("%s eval %s%s", args, "") == 0, "%s", out);
+    ck_assert_double_eq_tol(tu_json_num(out, "rms_arcsec"), rms, 1e-9);
+}
+END_TEST
+
 static Suite *suite(void)
 {
     Suite *s = suite_create("pmfit");
@@ -742,6 +784,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_pmfit_printed_commands_quote);
     tcase_add_test(tc, test_pmfit_explain_period_seam);
     tcase_add_test(tc, test_pmfit_explain_no_composition_undetermined);
+    tcase_add_test(tc, test_pmfit_altaz_elevation_direction);
     tcase_set_timeout(tc, 60);
     suite_add_tcase(s, tc);
     return s;

@@ -1762,7 +1762,8 @@ int run_main(int argc, char **argv)
             if (info.input[j][0])
                 inputs_note += "\npm_context.aux[" + std::to_string(j) + "]: the run's column '" +
                                info.input[j] + "'" +
-                               (std::string(info.input[j]) == "dec_dir" && run.dec_dir_derived
+                               (std::string(info.input[j]) == axis2_dir_name(run.mount) &&
+                                        run.dec_dir_derived
                                     ? " (the sign of the axis-2 move from the previous "
                                       "position, derived)"
                                     : "");

@@ -839,12 +839,14 @@ void physical_candidates(const Run &run, const State &st, std::vector<Candidate>
     if (input_usable(run, st.use, 1))
         add_candidate(cands, st, "time_drift", {"time_drift"});
     // backlash: the last slew direction on axis 1 (HA index) and, when
-    // known, on axis 2 (the derived "dec_dir" input, Dec index)
+    // known, on axis 2 (the derived "dec_dir" input, Dec index; "el_dir" on
+    // an alt-az mount, elevation index)
     std::vector<std::string> h;
     if (input_usable(run, st.use, 2))
         h.push_back("hysteresis");
-    if (has(run.aux_names, "dec_dir"))
-        h.push_back("aux:dec_dir:e'");
+    const std::string dir2 = axis2_dir_name(run.mount);
+    if (has(run.aux_names, dir2))
+        h.push_back("aux:" + dir2 + ":e'");
     if (!h.empty())
         add_candidate(cands, st, "hysteresis", h);
     // the run's own columns (a tube temperature, a focus position, TPOINT's
@@ -854,10 +856,10 @@ void physical_candidates(const Run &run, const State &st, std::vector<Candidate>
     // line) nor the derived slew direction (hysteresis above).
     for (size_t j = 0; j < run.aux_names.size() && j < (size_t)PM_MAX_AUX; j++) {
         const std::string &name = run.aux_names[j];
-        static const char *const position[] = {"dec_dir", "axra",         "axdec",
-                                               "axaz",    "axalt",        "angularPosRA",
-                                               "angularPosDEC"};
-        if (std::any_of(std::begin(position), std::end(position),
+        static const char *const position[] = {"axra", "axdec", "axaz", "axalt",
+                                               "angularPosRA", "angularPosDEC"};
+        if (name == dir2 ||
+            std::any_of(std::begin(position), std::end(position),
                         [&](const char *p) { return name == p; }) ||
             !aux_usable(run, st.use, j))
             continue;

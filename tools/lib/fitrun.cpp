@@ -106,6 +106,11 @@ static bool axis_cut(const std::vector<double> &ang, double *cut)
     return true;
 }
 
+const char *axis2_dir_name(int mount)
+{
+    return mount == PM_MOUNT_ALTAZ ? "el_dir" : "dec_dir";
+}
+
 void derive_directions(Run &r)
 {
     std::vector<double> e1, e2;
@@ -129,14 +134,17 @@ void derive_directions(Run &r)
             r.obs[i].ctx.dir = move_sign(r.obs[i - 1].eh, r.obs[i].eh, cut1, ok1);
     }
     // The slew direction on axis 2, likewise from the sequence, as the input
-    // "dec_dir" (backlash of the declination/elevation drive), when the run
-    // has no such column and a context slot is free.
+    // "dec_dir" ("el_dir" on an alt-az mount; backlash of the declination or
+    // elevation drive), when the run has no such column and a context slot
+    // is free.  (An alt-az run's had been called dec_dir: "e'*dec_dir" for
+    // the elevation index.)
+    const std::string dir2 = axis2_dir_name(r.mount);
     bool have_dec_dir = false;
     for (const std::string &n : r.aux_names)
-        have_dec_dir = have_dec_dir || n == "dec_dir";
+        have_dec_dir = have_dec_dir || n == dir2;
     if (!have_dec_dir && (int)r.aux_names.size() < PM_MAX_AUX && r.obs.size() > 1) {
         int j = (int)r.aux_names.size();
-        r.aux_names.push_back("dec_dir");
+        r.aux_names.push_back(dir2);
         r.dec_dir_derived = true;
         r.obs[0].ctx.aux[j] = 0;
         for (size_t i = 1; i < r.obs.size(); i++)
@@ -682,7 +690,9 @@ Run run_for_model(const Run &run, const pm_model &m, const std::vector<std::stri
         std::string c;
         for (const std::string &n : run.aux_names)
             c += (c.empty() ? "" : ", ") + n +
-                 (n == "dec_dir" && run.dec_dir_derived ? " (derived from the sequence)" : "");
+                 (n == axis2_dir_name(run.mount) && run.dec_dir_derived
+                      ? " (derived from the sequence)"
+                      : "");
         return c.empty() ? std::string("none") : c;
     };
     for (size_t j = 0; j < (size_t)PM_MAX_AUX; j++) {
@@ -703,6 +713,12 @@ Run run_for_model(const Run &run, const pm_model &m, const std::vector<std::stri
         } else if (used[j]) {
             for (size_t q = 0; q < run.aux_names.size() && from < 0; q++)
                 if (run.aux_names[q] == name)
+                    from = (long)q;
+            // a model file of an alt-az run from before stop 42 names the
+            // derived elevation direction dec_dir
+            for (size_t q = 0; q < run.aux_names.size() && from < 0; q++)
+                if (run.dec_dir_derived && run.mount == PM_MOUNT_ALTAZ && name == "dec_dir" &&
+                    run.aux_names[q] == "el_dir")
                     from = (long)q;
             if (from < 0)
                 throw std::runtime_error(model_name + ": its " + terms_read +

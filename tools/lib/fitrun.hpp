@@ -64,8 +64,12 @@ Run load_run(const std::string &path, bool refraction, bool skip_bad, int format
 Run run_from_pmrun(const pmrun *run, const std::string &path);
 // What load_run derives from the sequence of the observations: the slew
 // direction on axis 1 where no observation has one, and the input "dec_dir"
-// where the run has no such column and a context slot is free.
+// ("el_dir" on an alt-az mount: axis2_dir_name) where the run has no such
+// column and a context slot is free.
 void derive_directions(Run &r);
+// The name of the derived slew direction on axis 2: "el_dir" on an alt-az
+// mount, "dec_dir" on an equatorial one.
+const char *axis2_dir_name(int mount);
 // The widest empty arc of the angles (radians) on the circle: its width
 // (2 pi for fewer than two angles), and where middle is given its middle,
 // in (-pi, pi].  (explain's sampled extent of an axis is the circle less
