@@ -761,6 +761,46 @@ START_TEST(test_pmfit_altaz_elevation_direction)
 }
 END_TEST
 
+/* A copy of a simulated run with a column "tube": its temperature (field 6)
+** + 0.5 and a small deterministic jitter (arg: the records so far). */
+static int edit_tube(char *line, size_t size, void *arg)
+{
+    int *i = (int *)arg;
+    size_t n = strcspn(line, "\r\n");
+    char f[8][40];
+    line[n] = 0;
+    if (!strncmp(line, "# tau", 5))
+        snprintf(line + n, size - n, " tube\n");
+    else if (line[0] == '#' || sscanf(line, "%39s %39s %39s %39s %39s %39s", f[0], f[1], f[2], f[3],
+                                      f[4], f[5]) != 6)
+        snprintf(line + n, size - n, "\n");
+    else
+        snprintf(line + n, size - n, " %.3f\n", atof(f[5]) + 0.5 + 0.02 * sin(1.3 * (*i)++));
+    return 1;
+}
+
+/* The run's own column that follows the temperature is as good a reading
+** as the temperature, and explain says which observation tells them apart
+** (it had said "more points where the two readings differ most"). */
+START_TEST(test_pmfit_explain_column_follows_temperature)
+{
+    char sim[300], tube[300], args[600];
+    int k = 0;
+    make_tmpdir();
+    snprintf(sim, sizeof sim, "%s/tt.dat", tmpdir);
+    snprintf(tube, sizeof tube, "%s/tt_tube.dat", tmpdir);
+    snprintf(args, sizeof args, "%s --n 200 --seed 8 --effect temperature=2", sim);
+    ck_assert_msg(run("%s simulate %s%s", args, "") == 0, "%s", out);
+    tu_edited_copy(sim, tube, edit_tube, &k);
+    ck_assert_msg(run("%s explain %s%s", tube, "") == 0, "%s", out);
+    ck_assert_msg(strstr(out, "1. temperature:") != NULL || strstr(out, "1. aux:tube:") != NULL,
+                  "%s", out);
+    ck_assert_msg(strstr(out, "to separate them: points where the column tube does not follow "
+                              "the temperature, or a second night") != NULL,
+                  "%s", out);
+}
+END_TEST
+
 static Suite *suite(void)
 {
     Suite *s = suite_create("pmfit");
@@ -785,6 +825,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_pmfit_explain_period_seam);
     tcase_add_test(tc, test_pmfit_explain_no_composition_undetermined);
     tcase_add_test(tc, test_pmfit_altaz_elevation_direction);
+    tcase_add_test(tc, test_pmfit_explain_column_follows_temperature);
     tcase_set_timeout(tc, 60);
     suite_add_tcase(s, tc);
     return s;

@@ -1231,6 +1231,19 @@ std::string separating(const std::string &a, const std::string &b)
         return "one star followed at fixed elevation while the temperature changes";
     if (pair_is("temperature", "time_drift"))
         return "a night whose temperature does not follow the clock, or a second night";
+    // the run's own column against another input (a tube temperature that
+    // follows the air's, a focus that follows the clock)
+    auto input_words = [](const std::string &e) -> std::string {
+        if (e == "temperature")
+            return "the temperature";
+        if (e == "time_drift")
+            return "the clock";
+        return e.rfind("aux:", 0) == 0 ? "the column " + e.substr(4) : std::string();
+    };
+    const std::string wa = input_words(a), wb = input_words(b);
+    if (!wa.empty() && !wb.empty() && (a.rfind("aux:", 0) == 0 || b.rfind("aux:", 0) == 0))
+        return "points where " + (a.rfind("aux:", 0) == 0 ? wa : wb) + " does not follow " +
+               (a.rfind("aux:", 0) == 0 ? wb : wa) + ", or a second night";
     if (one_is("hysteresis"))
         return "the same places approached from both directions";
     if (one_is("ha_periodic") || one_is("dec_periodic"))
