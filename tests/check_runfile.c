@@ -1037,10 +1037,12 @@ START_TEST(test_pmrun_read_angle_beyond_turns)
 }
 END_TEST
 
-/* A record on a last line without a line end is read, with a note: a file
-** cut short reads its last number short (an outside probe's truncated run
-** was read silently).  A last line that is not a record, a terminated one
-** and MW4's JSON (which ends without a line end as a rule) get no note. */
+/* A record on a last line without a line end whose last number has fewer
+** decimals than the line before's is read, with a note: a file cut short
+** reads its last number short (an outside probe's truncated run was read
+** silently).  One as long as the line before's, a last line that is not a
+** record, a terminated one and MW4's JSON (which ends without a line end as
+** a rule) get no note. */
 START_TEST(test_pmrun_read_unterminated_last_record)
 {
     pmrun *run = read_text("# tau delta T D\n10 20 10.001 20.002\n30 40 30.001 40");
@@ -1049,6 +1051,10 @@ START_TEST(test_pmrun_read_unterminated_last_record)
     ck_assert_int_ge(find_warning(run, ":3: ", "the last line has no line end"), 0);
     pmrun_free(run);
     run = read_text("# tau delta T D\n10 20 10.001 20.002\n30 40 30.001 40\n");
+    ck_assert_int_eq(pmrun_n_warnings(run), 0);
+    pmrun_free(run);
+    /* its last number as long as the line before's: complete, no note */
+    run = read_text("# tau delta T D\n10 20 10.001 20.002\n30 40 30.001 40.000");
     ck_assert_int_eq(pmrun_n_warnings(run), 0);
     pmrun_free(run);
     run = read_text("# tau delta T D\n10 20 10.001 20.002\n30 40 30.001 40\n# end");

@@ -737,6 +737,38 @@ void unfold_sky_convention(Context &ctx)
              "mount's axes, (HA + 180, 180 - dec) (docs/formats.md, \"Beyond the pole\")");
 }
 
+// Does the last field of `last` (a record on the last line, which has no
+// line end) look cut short against `prev` (the record before it): fewer
+// fields, or a last number with fewer decimals?
+bool cut_short(const std::string &last, const std::string &prev)
+{
+    auto fields = [](const std::string &t) {
+        std::vector<std::string> f;
+        std::string cur;
+        for (char c : t) {
+            if (c == ' ' || c == '\t' || c == ',' || c == ';' || c == '\r') {
+                if (!cur.empty()) f.push_back(cur);
+                cur.clear();
+            } else {
+                cur += c;
+            }
+        }
+        if (!cur.empty()) f.push_back(cur);
+        return f;
+    };
+    auto decimals = [](const std::string &t) {
+        size_t dot = t.find('.');
+        if (dot == std::string::npos) return 0;
+        size_t k = dot + 1;
+        while (k < t.size() && t[k] >= '0' && t[k] <= '9') ++k;
+        return (int)(k - dot - 1);
+    };
+    std::vector<std::string> a = fields(last), b = fields(prev);
+    if (a.size() < b.size()) return true;
+    if (a.empty() || b.empty() || !is_number(a.back()) || !is_number(b.back())) return false;
+    return decimals(a.back()) < decimals(b.back());
+}
+
 // One encoder convention per run (docs/formats.md, "Beyond the pole"): a
 // pier column must relate to the encoder declination the same way for all
 // records of a side, and the encoder axis 1 (beyond the pole turned back by
@@ -876,12 +908,16 @@ int read_file(Context &ctx)
         if (!equinox_applies(ctx, forced))
             return ctx.status();
     }
-    std::string line;
+    std::string line, last_text, prev_text; // the last two lines (cut_short)
     bool nul = false;
     bool any_text = false, any_line = false;
     for (;;) {
         LineReader::Result r = rd.next(line, nul);
         if (r == LineReader::kEof) break;
+        if (r == LineReader::kLine) {
+            prev_text.swap(last_text);
+            last_text = line;
+        }
         if (r == LineReader::kIoError) {
             if (rd.io_error())
                 ctx.fail_with(PMRUN_ERR_IO, rd.number() + 1, "read error: %s", std::strerror(errno));
@@ -924,12 +960,18 @@ int read_file(Context &ctx)
     if (!parser->finish(rd.number())) return ctx.status();
     // A record on a last line without a line end: a file cut short reads
     // its last number short (12.3 of 12.3456), and that record is wrong
-    // without an error.  Noted; JSON (MW4) ends without one as a rule.
+    // without an error.  Noted where its last number has fewer decimals
+    // than the record before it has there (or there is no record before it
+    // to tell); JSON (MW4) ends without a line end as a rule.
     const std::vector<pmrun_obs> &obs = ctx.run()->obs;
     if (rd.unterminated() && ctx.run()->format != PMRUN_FORMAT_MW4 && !obs.empty() &&
-        obs.back().line == rd.number())
-        ctx.warn(rd.number(), "the last line has no line end: if the file was cut short, this "
-                              "record is incomplete (read as written)");
+        obs.back().line == rd.number()) {
+        const bool prev_record = obs.size() > 1 && obs[obs.size() - 2].line == rd.number() - 1;
+        if (!prev_record || cut_short(last_text, prev_text))
+            ctx.warn(rd.number(), "the last line has no line end and its last number has fewer "
+                                  "decimals than the line before: if the file was cut short, "
+                                  "this record is incomplete (read as written)");
+    }
     unfold_sky_convention(ctx);
     if (!check_conventions(ctx)) return ctx.status();
     check_duplicates(ctx);
