@@ -1093,6 +1093,15 @@ pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res);
 **     a predicted error at the stars of 6.2" for sigma 1.39" (a linear
 **     fit's cannot exceed sigma), 1.19" at the returned model (an outside
 **     probe).  pm_fit_solve's passes are the caller's to repeat.
+**  3) Two aliases of the isotropic terms point exactly alike: (e' + pi,
+**     pi - i), the tube through the pole and turned round, and (c' + pi,
+**     pi - d, e' + pi), the axes turned round.  Where the fit comes to a
+**     collimation i or non-perpendicularity d beyond 90 deg, it runs once
+**     more from the alias with both within 90 deg and keeps that fit where
+**     its chi^2 is no larger beyond rounding: a fork whose HA encoder read
+**     180 deg off had come back with e' 180 deg and i -180 deg, an alt-az
+**     run with its azimuth 180 deg off with d -180 deg (an outside probe).
+**     Stack: the same pm_model.
 */
 #define PM_FIT_INDEX_START 0.17453292519943295 /* 10 deg, radians */
 pm_status pm_fit_run(pm_fit *fit, pm_model *model, const pm_context *ctx,

@@ -673,7 +673,7 @@ pm_status pm_fit_run(pm_fit *fit, pm_model *model, const pm_context *ctx,
     ** still stopped short at order 1 from the offsets alone).  The fit of
     ** least chi^2 is returned.  (Six coefficients a start and one model on
     ** the stack: firmware refits.) */
-    double iso[3][6];
+    double iso[4][6];
     int n_start = 1;
     for (int i = 0; i < 6; i++)
         iso[0][i] = model->coef[i];
@@ -733,6 +733,40 @@ pm_status pm_fit_run(pm_fit *fit, pm_model *model, const pm_context *ctx,
     }
     if (best < 0)
         return first;
+    /* Two aliases of the isotropic terms point exactly alike: (e' + pi,
+    ** pi - i), the tube through the pole and turned round, and (c' + pi,
+    ** pi - d, e' + pi), the axes turned round.  Where the fit came to a
+    ** collimation or a non-perpendicularity beyond 90 deg (a fork whose HA
+    ** encoder read 180 deg off: e' 180 deg and i -180 deg, which TPOINT's CH
+    ** cannot mean; an alt-az azimuth 180 deg off: d -180 deg; an outside
+    ** probe), it runs once more from the alias with both within 90 deg and
+    ** keeps that fit where its chi^2 is no larger beyond rounding (pm.h,
+    ** Note 3). */
+    if (m_fabs(s.coef[5]) > PI / 2 || m_fabs(s.coef[3]) > PI / 2) {
+        double *a = iso[n_start];
+        for (int i = 0; i < 6; i++)
+            a[i] = s.coef[i];
+        if (m_fabs(a[5]) > PI / 2) {
+            a[4] = wrap_pi(a[4] + PI);
+            a[5] = wrap_pi(PI - a[5]);
+        }
+        if (m_fabs(a[3]) > PI / 2) {
+            a[2] = wrap_pi(a[2] + PI);
+            a[3] = wrap_pi(PI - a[3]);
+            a[4] = wrap_pi(a[4] + PI);
+        }
+        const double chi2 = r.chi2;
+        pm_fit_result ra;
+        if (start_model(model, iso, n_start, &s) == PM_OK &&
+            run_from(fit, &s, ctx, n, enc_ha, enc_dec, app_ha, app_dec, max_iter, &ra) == PM_OK &&
+            ra.chi2 <= chi2 * (1 + 1e-9) && m_fabs(s.coef[5]) <= PI / 2 &&
+            m_fabs(s.coef[3]) <= PI / 2) {
+            r = ra;
+        } else {
+            start_model(model, iso, k, &s);
+            run_from(fit, &s, ctx, n, enc_ha, enc_dec, app_ha, app_dec, max_iter, &r);
+        }
+    }
     *model = s;
     if (res)
         *res = r;

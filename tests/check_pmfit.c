@@ -801,6 +801,100 @@ START_TEST(test_pmfit_explain_column_follows_temperature)
 }
 END_TEST
 
+/* A copy of a column run with its first field (the encoder's axis 1)
+** moved by *(double *)arg degrees. */
+static int edit_shift_tau(char *line, size_t size, void *arg)
+{
+    double t;
+    int k;
+    if (line[0] == '#' || sscanf(line, "%lf%n", &t, &k) != 1)
+        return 1;
+    {
+        char rest[4096];
+        snprintf(rest, sizeof rest, "%s", line + k);
+        snprintf(line, size, "%.9f%s", t + *(const double *)arg, rest);
+    }
+    return 1;
+}
+
+/* Encoders read 180 deg off on axis 1 (a fork synchronised 12 h wrong, an
+** alt-az azimuth from the other side): the fit has two exact aliases of
+** the isotropic terms (pm.h, pm_fit_run Note 3) and comes back with the one
+** whose collimation and non-perpendicularity are within 90 deg, with c'
+** near 180 deg and the sigma of the unshifted run.  It had come back with
+** e' 180 deg and i -180 deg (a fork), or d -180 deg (alt-az; an outside
+** probe).  compare of two nights on either side of c' = 180 deg reads no
+** change: the refit's c' had been a turn away (-1295971", 68335 sigma). */
+START_TEST(test_pmfit_index_half_turn)
+{
+    static const struct { const char *mount; double shift; } k[] = {
+        {"--fork", -180.0005}, {"--fork", 179.9995}, {"--mount altaz", 179.9},
+        {"--mount altaz", -180.0}};
+    char base[300], sh[300], sh2[300], pmf[300], args[1200];
+    size_t i;
+    int order;
+    make_tmpdir();
+    snprintf(base, sizeof base, "%s/h0.dat", tmpdir);
+    snprintf(sh, sizeof sh, "%s/h1.dat", tmpdir);
+    snprintf(sh2, sizeof sh2, "%s/h2.dat", tmpdir);
+    snprintf(pmf, sizeof pmf, "%s/h1.pm", tmpdir);
+    for (i = 0; i < sizeof k / sizeof k[0]; i++) {
+        double shift = k[i].shift;
+        snprintf(args, sizeof args, "%s %s --n 80 --seed 4", base, k[i].mount);
+        ck_assert_msg(run("%s simulate %s%s", args, "") == 0, "%s", out);
+        tu_edited_copy(base, sh, edit_shift_tau, &shift);
+        for (order = 0; order <= 1; order++) {
+            double s0, s1, c, d, e, ci;
+            const char *t;
+            snprintf(args, sizeof args, "%s --order %d --json", base, order);
+            ck_assert_msg(run("%s fit %s%s", args, "") == 0, "%s", out);
+            s0 = tu_json_num(out, "sigma_arcsec");
+            snprintf(args, sizeof args, "%s --order %d --json", sh, order);
+            ck_assert_msg(run("%s fit %s%s", args, "") == 0, "%s", out);
+            s1 = tu_json_num(out, "sigma_arcsec");
+            t = strstr(out, "{\"name\": \"c'\"");
+            ck_assert_ptr_nonnull(t);
+            c = tu_json_num(t, "value_arcsec") / 3600;
+            t = strstr(out, "{\"name\": \"d\"");
+            ck_assert_ptr_nonnull(t);
+            d = tu_json_num(t, "value_arcsec") / 3600;
+            t = strstr(out, "{\"name\": \"e'\"");
+            ck_assert_ptr_nonnull(t);
+            e = tu_json_num(t, "value_arcsec") / 3600;
+            t = strstr(out, "{\"name\": \"i\"");
+            ck_assert_ptr_nonnull(t);
+            ci = tu_json_num(t, "value_arcsec") / 3600;
+            printf("check_pmfit: %s, axis 1 moved %+.4f deg, order %d: sigma %.4f\" (%.4f\" "
+                   "unmoved), c' %.4f, d %.4f, e' %.4f, i %.4f deg\n",
+                   k[i].mount, shift, order, s1, s0, c, d, e, ci);
+            ck_assert(fabs(s1 - s0) < 1e-3 * s0);
+            ck_assert(fabs(d) < 1 && fabs(e) < 1 && fabs(ci) < 1);
+            ck_assert(fabs(fabs(c) - 180) < 1);
+        }
+    }
+    /* compare: two fork nights either side of c' = 180 deg */
+    {
+        double a = -179.999, b = -180.001;
+        snprintf(args, sizeof args, "%s --fork --n 80 --seed 4", base);
+        ck_assert_msg(run("%s simulate %s%s", args, "") == 0, "%s", out);
+        tu_edited_copy(base, sh, edit_shift_tau, &a);
+        snprintf(args, sizeof args, "%s --fork --n 80 --seed 5", base);
+        ck_assert_msg(run("%s simulate %s%s", args, "") == 0, "%s", out);
+        tu_edited_copy(base, sh2, edit_shift_tau, &b);
+        snprintf(args, sizeof args, "%s --save %s", sh, pmf);
+        ck_assert_msg(run("%s fit %s%s", args, "") == 0, "%s", out);
+        snprintf(args, sizeof args, "%s %s --json", pmf, sh2);
+        ck_assert_msg(run("%s compare %s%s", args, "") == 0, "%s", out);
+        ck_assert_msg(strstr(out, "\"moved\": []") != NULL, "%s", out);
+        ck_assert_ptr_nonnull(strstr(out, "\"rezero\": {"));
+        printf("check_pmfit: fork nights at c' -179.999 and -180.001 deg: re-zero c' %+.2f\"\n",
+               tu_json_num(strstr(out, "\"rezero\": {"), "c_arcsec"));
+        ck_assert_msg(fabs(tu_json_num(strstr(out, "\"rezero\": {"), "c_arcsec") - 7.2) < 1,
+                      "%s", out);
+    }
+}
+END_TEST
+
 static Suite *suite(void)
 {
     Suite *s = suite_create("pmfit");
@@ -826,6 +920,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_pmfit_explain_no_composition_undetermined);
     tcase_add_test(tc, test_pmfit_altaz_elevation_direction);
     tcase_add_test(tc, test_pmfit_explain_column_follows_temperature);
+    tcase_add_test(tc, test_pmfit_index_half_turn);
     tcase_set_timeout(tc, 60);
     suite_add_tcase(s, tc);
     return s;
