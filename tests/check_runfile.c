@@ -993,7 +993,7 @@ START_TEST(test_pmrun_read_angle_beyond_turns)
     for (k = 0; k < 3; ++k) {
         snprintf(text, sizeof text, "# tau delta T D\n10 20 10 20\n%s 20 10 20\n", big[k]);
         read_text_fails(text, 3, "field 1 (tau)");
-        read_text_fails(text, 3, "is beyond +-2^31 (2.147e+09): a corrupt value?");
+        read_text_fails(text, 3, "is beyond +-2^31 (2147483648): a corrupt value?");
         snprintf(text, sizeof text, "# tau delta T D\n10 20 10 20\n10 20 %s 20\n", big[k]);
         read_text_fails(text, 3, "field 3 (T)");
         snprintf(text, sizeof text, "# tau delta T D\n10 20 10 20\n10 %s 10 20\n", big[k]);
@@ -1008,6 +1008,20 @@ START_TEST(test_pmrun_read_angle_beyond_turns)
                     "LST,Mount RA,Mount Dec,Solved RA,Solved Dec,Pier Side\n"
                     "8.8607141587,2.7584324228,-2147483649:00:00,2.7555217120,63.975098125,pierWest\n",
                     4, "is beyond +-2^31");
+    /* TPOINT equatorial: the raw RA's hours, the raw Dec's degrees */
+    read_text_fails("Bad input test run\n:EQUAT\n+39 00 25 2023 9 1 21.70 992.00 228.00 0.96 0.5500 "
+                    "0.0065\n12 00 00.0000 +77 47 53.139 1e300 04 46.8191 +77 36 25.053  22 41.127\n",
+                    4, "field 7");
+    read_text_fails("Bad input test run\n:EQUAT\n+39 00 25 2023 9 1 21.70 992.00 228.00 0.96 0.5500 "
+                    "0.0065\n12 00 00.0000 +77 47 53.139 18 04 46.8191 -1e300 36 25.053  22 41.127\n",
+                    4, "field 10");
+    /* MMT: the raw (RAA) and observed (TAA) azimuths */
+    read_text_fails("CAT: FK5-0711        18:55:20.111 +43:56:45.99 +00.214 +008.25  3.9  M3  J2000.0\n"
+                    "RAA:   77.3475476  1e300\nTAA:   77.3484799  -12.3860283\nLST: 19:11:22.950\n",
+                    2, "RAA: azimuth '1e300'");
+    read_text_fails("CAT: FK5-0711        18:55:20.111 +43:56:45.99 +00.214 +008.25  3.9  M3  J2000.0\n"
+                    "RAA:   77.3475476  347.2778909\nTAA:   77.3484799  -3e9\nLST: 19:11:22.950\n",
+                    3, "TAA: azimuth '-3e9'");
     /* TPOINT alt-az: the raw azimuth */
     read_text_fails("Alt-az\n: ALTAZ\n+31 41 19.6 2021 8 21 13.0 741 2608.0 0.75\n"
                     "90.0 45.0 1e300 45.02\nEND\n",

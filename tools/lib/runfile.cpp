@@ -274,8 +274,8 @@ bool parse_number(const std::string &tok, double &v, std::string &why)
 bool angle_in_range(double v, std::string &why)
 {
     if (std::fabs(v) <= kMaxAngle) return true;
-    why = format("%.4g is beyond +-2^31 (%.4g): a corrupt value? expected an angle (in any turn, "
-                 "within +-2^31)",
+    why = format("%.10g is beyond +-2^31 (%.0f): a corrupt value? expected an angle (in any "
+                 "turn, within +-2^31)",
                  v, kMaxAngle);
     return false;
 }

@@ -75,7 +75,7 @@ public:
             double v[2];
             for (int k = 0; k < 2; ++k) {
                 std::string why;
-                if (!parse_number(tok[k], v[k], why))
+                if (!parse_angle(tok[k], v[k], why))
                     return bad(n, format("%s: %s '%s': %s (degrees)", key.c_str(),
                                          k == 0 ? "elevation" : "azimuth",
                                          excerpt(tok[k]).c_str(), why.c_str()));

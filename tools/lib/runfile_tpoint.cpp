@@ -164,7 +164,7 @@ private:
         for (int k = 0; k < parts; ++k) {
             const std::string &s = t[i + static_cast<size_t>(k)];
             std::string w;
-            if (!parse_number(s, v[k], w)) {
+            if (!parse_angle(s, v[k], w)) {
                 why = format("field %zu (%s) '%s': %s", i + static_cast<size_t>(k) + 1,
                              names[i + static_cast<size_t>(k)], excerpt(s).c_str(), w.c_str());
                 return false;
