@@ -360,6 +360,58 @@ START_TEST(test_inject_own_column_explained)
 }
 END_TEST
 
+/* flip_gem with six columns c1..c6 (deterministic values) */
+static int edit_six_columns(char *line, size_t size, void *arg)
+{
+    int *i = (int *)arg, k;
+    size_t n = strcspn(line, "\r\n");
+    line[n] = 0;
+    if (!strncmp(line, "# tau", 5)) {
+        snprintf(line + n, size - n, " c1 c2 c3 c4 c5 c6\n");
+        return 1;
+    }
+    if (line[0] == '#' || !line[0]) {
+        snprintf(line + n, size - n, "\n");
+        return 1;
+    }
+    for (k = 1; k <= 6; k++) {
+        n = strlen(line);
+        snprintf(line + n, size - n, " %.4f", 10 * sin(0.7 * k + 1.3 * (*i)));
+    }
+    n = strlen(line);
+    snprintf(line + n, size - n, "\n");
+    (*i)++;
+    return 1;
+}
+
+/* A run of more columns than the core takes (PM_MAX_AUX, 4): the injected
+** run keeps all of them, readable (its header named six and its records
+** held four: "12 fields, expected 14"; an outside probe), and the fifth and
+** sixth as read. */
+START_TEST(test_inject_keeps_every_column)
+{
+    char src[512], six[512], dst[512];
+    pmrun *a, *b;
+    size_t i;
+    int k = 0, j;
+    setup();
+    flip_path(src, sizeof src);
+    snprintf(six, sizeof six, "%s/six.dat", tmpdir);
+    snprintf(dst, sizeof dst, "%s/six_in.dat", tmpdir);
+    tu_edited_copy(src, six, edit_six_columns, &k);
+    ck_assert_msg(inject(six, "aux:c2=0.5", NULL, dst) == 0, "%s", out);
+    a = read_run(six);
+    b = read_run(dst);
+    ck_assert_int_eq(pmrun_n_aux(b), 6);
+    ck_assert_uint_eq(pmrun_count(a), pmrun_count(b));
+    for (i = 0; i < pmrun_count(a); i++)
+        for (j = 0; j < 6; j++)
+            ck_assert(fabs(pmrun_get(a, i)->aux[j] - pmrun_get(b, i)->aux[j]) < 1e-9);
+    pmrun_free(a);
+    pmrun_free(b);
+}
+END_TEST
+
 static double sag_reading(const char *path)
 {
     pmx_result r;
@@ -422,6 +474,7 @@ static Suite *suite(void)
     tcase_add_test(t, test_inject_misuse);
     tcase_add_test(t, test_inject_own_column);
     tcase_add_test(t, test_inject_own_column_explained);
+    tcase_add_test(t, test_inject_keeps_every_column);
     tcase_add_test(t, test_inject_sag_read_back);
     suite_add_tcase(s, t);
     return s;

@@ -234,7 +234,8 @@ void write_named_run(const Run &run, const std::string &path,
         std::snprintf(b, sizeof b, fmt, v);
         return std::string(b);
     };
-    for (const Obs &o : run.obs) {
+    for (size_t i = 0; i < run.obs.size(); i++) {
+        const Obs &o = run.obs[i];
         double T = o.ah / DEG;
         if (altaz)
             T = std::fmod(std::fmod(T, 360.0) + 360.0, 360.0);
@@ -243,8 +244,15 @@ void write_named_run(const Run &run, const std::string &path,
                       val(o.ctx.temp_c, "%.4f").c_str(), val(o.ctx.time_h, "%.8f").c_str(),
                       o.ctx.dir > 0 ? "+1" : (o.ctx.dir < 0 ? "-1" : "0"));
         out += buf;
-        for (size_t j = 0; j < run.aux_names.size() && j < PM_MAX_AUX; j++)
-            out += " " + val(o.ctx.aux[j], "%.10g");
+        // every column the header names (beyond the contexts' first
+        // PM_MAX_AUX from the run's columns as read: a run of six had its
+        // header name six and its records hold four, unreadable)
+        for (size_t j = 0; j < run.aux_names.size(); j++)
+            out += " " + val(j < (size_t)PM_MAX_AUX ? o.ctx.aux[j]
+                             : j < run.aux_values.size() && i < run.aux_values[j].size()
+                                 ? run.aux_values[j][i]
+                                 : std::nan(""),
+                             "%.10g");
         out += "\n";
     }
     char err[1024];
