@@ -384,6 +384,24 @@ static int edit_six_columns(char *line, size_t size, void *arg)
     return 1;
 }
 
+/* The tenth record's last field made '-' (unknown); arg: the counts so far,
+** and that record's line. */
+typedef struct { int lines, records, at; } tenth_state;
+static int edit_tenth_unknown(char *line, size_t size, void *arg)
+{
+    tenth_state *t = (tenth_state *)arg;
+    char *sp;
+    (void)size;
+    t->lines++;
+    if (line[0] == '#' || line[0] == '\n' || ++t->records != 10)
+        return 1;
+    sp = strrchr(line, ' ');
+    ck_assert_ptr_nonnull(sp);
+    strcpy(sp, " -\n");
+    t->at = t->lines;
+    return 1;
+}
+
 /* A run of more columns than the core takes (PM_MAX_AUX, 4): the injected
 ** run keeps all of them, readable (its header named six and its records
 ** held four: "12 fields, expected 14"; an outside probe), and the fifth and
@@ -409,6 +427,29 @@ START_TEST(test_inject_keeps_every_column)
             ck_assert(fabs(pmrun_get(a, i)->aux[j] - pmrun_get(b, i)->aux[j]) < 1e-9);
     pmrun_free(a);
     pmrun_free(b);
+    /* explain says which columns it could not try, and why (it had passed
+    ** them over without a word: an outside probe) */
+    {
+        char cmd[1200];
+        snprintf(cmd, sizeof cmd, "%s explain '%s'", tu_pmfit_path(), six);
+        ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
+        ck_assert_msg(strstr(out, "not tried: aux:c5: beyond the first 4 columns") != NULL &&
+                          strstr(out, "not tried: aux:c6: beyond the first 4 columns") != NULL &&
+                          strstr(out, "not tried: aux:c1") == NULL,
+                      "%s", out);
+    }
+    {   /* a column without a value at one point */
+        char col[512], gap[512], cmd[1200];
+        tenth_state t = {0, 0, 0};
+        snprintf(col, sizeof col, "%s/hum6.dat", tmpdir);
+        snprintf(gap, sizeof gap, "%s/hum_gap.dat", tmpdir);
+        with_column(src, col);
+        tu_edited_copy(col, gap, edit_tenth_unknown, &t);
+        snprintf(cmd, sizeof cmd, "%s explain '%s'", tu_pmfit_path(), gap);
+        ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
+        snprintf(cmd, sizeof cmd, "not tried: aux:hum: no value at line %d", t.at);
+        ck_assert_msg(strstr(out, cmd) != NULL, "%s: %s", cmd, out);
+    }
 }
 END_TEST
 

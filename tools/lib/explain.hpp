@@ -169,9 +169,12 @@ std::vector<Interpretation> interpret(const Run &run, const FitOut &f);
 // text on stdout.
 std::string explain_json(const Run &run, const Explanation &ex, int order);
 // The candidate effects the run cannot have tried, and so not found: an
-// equatorial run without a latitude cannot try refraction and tube flexure
-// (the JSON's "not_tried", a line of the text).
+// equatorial run without a latitude cannot try refraction and tube flexure,
+// nor the run's own column beyond the first PM_MAX_AUX, one with a point
+// without a value, or one the same everywhere (the JSON's "not_tried", a
+// line each of the text, with the reason).
 std::vector<std::string> not_tried(const Run &run);
+std::vector<std::pair<std::string, std::string>> not_tried_why(const Run &run);
 // "significant, not modelled" in words: its sizes and what would fit it.
 std::string unmodelled_text(const Unmodelled &u);
 // A candidate whose fit did not converge, in words.

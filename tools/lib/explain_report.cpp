@@ -94,13 +94,53 @@ std::string left_out_lines(const Run &run, const Explanation &ex)
 
 } // namespace
 
-std::vector<std::string> not_tried(const Run &run)
+std::vector<std::pair<std::string, std::string>> not_tried_why(const Run &run)
 {
+    std::vector<std::pair<std::string, std::string>> out;
     // (physical_candidates: the elevation of an equatorial run needs its
     // latitude)
-    if (run.mount == PM_MOUNT_EQUATORIAL && std::isnan(run.latitude))
-        return {"refraction", "tube_flexure"};
-    return {};
+    if (run.mount == PM_MOUNT_EQUATORIAL && std::isnan(run.latitude)) {
+        out.push_back({"refraction", "the run gives no latitude"});
+        out.push_back({"tube_flexure", "the run gives no latitude"});
+    }
+    // the run's own columns that cannot be candidates (an outside probe: a
+    // column's effect was not looked for, and nothing said so)
+    for (size_t j = 0; j < run.aux_names.size(); j++) {
+        const std::string &name = run.aux_names[j];
+        if (name == axis2_dir_name(run.mount) && run.dec_dir_derived)
+            continue;
+        std::string why;
+        if (j >= (size_t)PM_MAX_AUX) {
+            why = "beyond the first " + std::to_string(PM_MAX_AUX) +
+                  " columns, which are all a fit can read (put it among them)";
+        } else {
+            int missing = 0;
+            double lo = 1e300, hi = -1e300;
+            for (const Obs &o : run.obs) {
+                const double x = o.ctx.aux[j];
+                if (!std::isfinite(x) && !missing)
+                    missing = o.line;
+                if (std::isfinite(x))
+                    lo = std::min(lo, x), hi = std::max(hi, x);
+            }
+            if (missing)
+                why = "no value at line " + std::to_string(missing) +
+                      " (a candidate needs it at every point)";
+            else if (!(hi > lo))
+                why = "the same at every point";
+        }
+        if (!why.empty())
+            out.push_back({"aux:" + name, why});
+    }
+    return out;
+}
+
+std::vector<std::string> not_tried(const Run &run)
+{
+    std::vector<std::string> names;
+    for (const auto &w : not_tried_why(run))
+        names.push_back(w.first);
+    return names;
 }
 
 std::string explain_json(const Run &run, const Explanation &ex, int order)
@@ -158,10 +198,10 @@ std::string explain_json(const Run &run, const Explanation &ex, int order)
              num(b.error_order1_arcsec) + "}";
     }
     j += "], \"not_tried\": [";
-    const std::vector<std::string> nt = not_tried(run);
+    const auto nt = not_tried_why(run);
     for (size_t i = 0; i < nt.size(); i++)
-        j += std::string(i ? ", " : "") + "{\"effect\": " + str(nt[i]) +
-             ", \"why\": \"the run gives no latitude\"}";
+        j += std::string(i ? ", " : "") + "{\"effect\": " + str(nt[i].first) +
+             ", \"why\": " + str(nt[i].second) + "}";
     return j + "], \"final\": {\"sigma_arcsec\": " + num(ex.final_sigma_arcsec) +
            ", \"cv_rms_arcsec\": " + num(ex.final_cv_rms_arcsec) +
            ", \"n_params\": " + std::to_string(ex.final_n_params) + "}";
@@ -332,11 +372,19 @@ void print_explain_text(const Run &run, const Explanation &ex, int order, bool a
     for (const Finding &f : ex.findings)
         std::printf("  %-22s %5d %10.3f %s\n", ("+ " + f.effect).c_str(), f.n_params_after,
                     f.sigma_after_arcsec, cv_cell(f.cv_rms_after_arcsec).c_str());
-    const std::vector<std::string> nt = not_tried(run);
-    if (!nt.empty())
-        std::printf("\n  not tried: refraction and tube flexure, which depend on the elevation: "
-                    "the run gives no\n  latitude (add a line '# latitude: DEG' to a column "
-                    "file)\n");
+    const auto nt = not_tried_why(run);
+    for (size_t k = 0; k < nt.size(); k++) {
+        if (nt[k].first == "tube_flexure")
+            continue; // (said with refraction)
+        if (nt[k].first == "refraction")
+            std::printf("%s  not tried: refraction and tube flexure, which depend on the "
+                        "elevation: the run gives no\n  latitude (add a line '# latitude: DEG' "
+                        "to a column file)\n",
+                        k ? "" : "\n");
+        else
+            std::printf("%s  not tried: %s: %s\n", k ? "" : "\n", nt[k].first.c_str(),
+                        nt[k].second.c_str());
+    }
     std::printf("\n  pmfit fit %s --order %d", shell_word(run.path).c_str(), ex.final_order);
     for (const std::string &a : ex.final_adds)
         std::printf(" --add %s", add_word(a).c_str());
