@@ -128,19 +128,24 @@ def _as_float(name, value, what="numbers"):
     is not a number."""
     if value is None:
         raise ArgumentError("%s is None: not a number" % name)
-    if isinstance(value, _np.ma.MaskedArray):
+    mask = getattr(value, "mask", None)
+    if isinstance(value, _np.ma.MaskedArray) or (
+            mask is not None and not callable(mask) and hasattr(mask, "shape")):
         # np.asarray takes the data under the mask: masked points would be
         # fitted or evaluated as if they were good (astropy reads a CSV's
         # missing values as masked; an outside probe's five masked points
-        # took sigma from 2.19" to 171")
-        m = _np.ma.getmaskarray(value)
+        # took sigma from 2.19" to 171").  numpy's masked arrays, and any
+        # array with a mask of its own (astropy's Masked)
+        m = (_np.ma.getmaskarray(value) if isinstance(value, _np.ma.MaskedArray)
+             else _np.broadcast_to(_np.asarray(mask, dtype=bool), _np.shape(value)))
         if m.any():
             i = int(_np.argmax(m.reshape(-1)))
             raise ArgumentError(
                 "%s%s is masked (%d of %d values): a masked array's data under the mask "
                 "would be used; drop those points from every array, or fill them" % (
                     name, _index(m, i), int(m.sum()), m.size))
-        value = _np.ma.getdata(value)
+        value = (_np.ma.getdata(value) if isinstance(value, _np.ma.MaskedArray)
+                 else getattr(value, "unmasked", value))
     try:
         a = _np.asarray(value)
     except (TypeError, ValueError) as e:
@@ -276,7 +281,8 @@ def _points(model, named, pier=None, temp_c=None, time_h=None, dir=None, aux=Non
 def _ctx_args(kw, threads=None):
     if threads is None:
         threads = 0
-    elif isinstance(threads, bool) or not isinstance(threads, (int, _np.integer)) or threads < 1:
+    elif (isinstance(threads, bool) or not isinstance(threads, (int, _np.integer)) or
+          not 1 <= threads <= 1 << 30):
         raise ArgumentError("threads: expected a positive integer, or None for all cores")
     return (kw.get("pier"), kw.get("temp_c"), kw.get("time_h"), kw.get("dir"), kw.get("aux"),
             int(threads))

@@ -317,13 +317,21 @@ def test_masked_arrays_are_argument_errors():
     ha = np.ma.array([0.1, 0.2], mask=[0, 1])
     with pytest.raises(pm.ArgumentError, match=r"^enc_ha\[1\] is masked"):
         m.apply(ha, 0.2)
+    # astropy's Masked (its own mask; np.asarray takes the data under it)
+    masked = pytest.importorskip("astropy.utils.masked")
+    x = masked.Masked(run.app_ha.copy(), mask=np.r_[np.ones(5, bool), np.zeros(a.size - 5, bool)])
+    with pytest.raises(pm.ArgumentError, match=r"^app_ha\[0\] is masked \(5 of 300 values\)"):
+        pm.fit(run.enc_ha, run.enc_dec, x, run.app_dec, order=1, latitude=run.latitude)
+    clean = pm.fit(run.enc_ha, run.enc_dec, masked.Masked(run.app_ha), run.app_dec, order=1,
+                   latitude=run.latitude)
+    assert np.array_equal(plain.model.coefficients, clean.model.coefficients)
 
 
 def test_threads_checked_on_every_way():
     """threads=0 or -1 is refused for one point as for many (the one-point
     way had taken it)."""
     m = pm.Model(order=1)
-    for t in (0, -1, True, 1.5):
+    for t in (0, -1, True, 1.5, 10**12):
         for h in (0.1, np.array([0.1, 0.2])):
             with pytest.raises(pm.ArgumentError, match=r"^threads: expected a positive integer"):
                 m.apply(h, 0.2, threads=t)
