@@ -238,7 +238,7 @@ std::string advice_of(const Comparison &c)
     const double best_cv = refit_cv ? std::min(c.cv_refit, c.cv_rezero) : c.cv_rezero;
     const std::string refit_s =
         refit_cv ? fmt("%.3g\"", c.cv_refit)
-                 : fmt("not cross-validated (%ld points, too few in 4/5 of them for %d terms)",
+                 : fmt("not available (%ld points, too few in 4/5 of them for %d terms)",
                        c.n_obs, c.n_terms);
     const bool far_worse = c.cv_as_is > 2 * best_cv;
     const bool rezero_far_worse = refit_cv && c.cv_rezero > 2 * c.cv_refit;
