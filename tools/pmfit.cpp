@@ -760,8 +760,13 @@ void print_table(const char *title, const FitOut &f, const std::vector<Obs> &obs
     for (int i = 0; i < m.n_terms; i++) {
         double v = m.coef[i] * RAD2AS, e = f.res.err[i] * RAD2AS;
         double z = e > 0 ? std::fabs(v) / e : 0;
-        std::printf("  %-12s %-38s %13.2f %10.2f %6.1f%s\n", term_name(m, i).c_str(),
-                    meaning(m, i, &aux_names).c_str(), v, e, z, z >= 3 ? " *" : "");
+        // (a term per unit of a column of large values has an error below
+        // 0.005: significant digits, not "0.00 0.00" with signif 11.5)
+        const bool tiny = e > 0 && e < 0.005;
+        std::printf(tiny ? "  %-12s %-38s %13.4g %10.3g %6.1f%s\n"
+                         : "  %-12s %-38s %13.2f %10.2f %6.1f%s\n",
+                    term_name(m, i).c_str(), meaning(m, i, &aux_names).c_str(), v, e, z,
+                    z >= 3 ? " *" : "");
     }
     if (std::fabs(f.corr) > 0.999)
         std::printf("\n  warning: %s and %s are nearly degenerate for this sky coverage "

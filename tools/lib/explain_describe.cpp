@@ -163,14 +163,19 @@ std::string values_of(const Run &run, const pm_model &m, const pm_fit_result &re
     for (int i : newi) {
         // two decimals, or more where the error is below 0.1 (a column's
         // coefficient per unit of it: "0.06 +- 0.00" said nothing)
+        // (and significant digits below 1e-5: a column of large values)
         int dp = 2;
         const double e = std::fabs(arcsec(res.err[i]));
         while (dp < 6 && e > 0 && e < std::pow(10.0, 1 - dp))
             dp++;
         char v[160];
-        std::snprintf(v, sizeof v, "%s%s = %.*f +- %.*f", vals.empty() ? "" : ", ",
-                      input_name(run, m, i).c_str(), dp, arcsec(m.coef[i]), dp,
-                      arcsec(res.err[i]));
+        if (e > 0 && e < 1e-5)
+            std::snprintf(v, sizeof v, "%s%s = %.3g +- %.2g", vals.empty() ? "" : ", ",
+                          input_name(run, m, i).c_str(), arcsec(m.coef[i]), arcsec(res.err[i]));
+        else
+            std::snprintf(v, sizeof v, "%s%s = %.*f +- %.*f", vals.empty() ? "" : ", ",
+                          input_name(run, m, i).c_str(), dp, arcsec(m.coef[i]), dp,
+                          arcsec(res.err[i]));
         vals += v;
     }
     return vals;
