@@ -817,6 +817,17 @@ static int edit_shift_tau(char *line, size_t size, void *arg)
     return 1;
 }
 
+/* The value (degrees) of term `name` in pmfit fit --json's output. */
+static double term_deg(const char *name)
+{
+    char key[64];
+    const char *t;
+    snprintf(key, sizeof key, "{\"name\": \"%s\"", name);
+    t = strstr(out, key);
+    ck_assert_msg(t != NULL, "%s: %s", key, out);
+    return tu_json_num(t, "value_arcsec") / 3600;
+}
+
 /* Encoders read 180 deg off on axis 1 (a fork synchronised 12 h wrong, an
 ** alt-az azimuth from the other side): the fit has two exact aliases of
 ** the isotropic terms (pm.h, pm_fit_run Note 3) and comes back with the one
@@ -845,25 +856,16 @@ START_TEST(test_pmfit_index_half_turn)
         tu_edited_copy(base, sh, edit_shift_tau, &shift);
         for (order = 0; order <= 1; order++) {
             double s0, s1, c, d, e, ci;
-            const char *t;
             snprintf(args, sizeof args, "%s --order %d --json", base, order);
             ck_assert_msg(run("%s fit %s%s", args, "") == 0, "%s", out);
             s0 = tu_json_num(out, "sigma_arcsec");
             snprintf(args, sizeof args, "%s --order %d --json", sh, order);
             ck_assert_msg(run("%s fit %s%s", args, "") == 0, "%s", out);
             s1 = tu_json_num(out, "sigma_arcsec");
-            t = strstr(out, "{\"name\": \"c'\"");
-            ck_assert_ptr_nonnull(t);
-            c = tu_json_num(t, "value_arcsec") / 3600;
-            t = strstr(out, "{\"name\": \"d\"");
-            ck_assert_ptr_nonnull(t);
-            d = tu_json_num(t, "value_arcsec") / 3600;
-            t = strstr(out, "{\"name\": \"e'\"");
-            ck_assert_ptr_nonnull(t);
-            e = tu_json_num(t, "value_arcsec") / 3600;
-            t = strstr(out, "{\"name\": \"i\"");
-            ck_assert_ptr_nonnull(t);
-            ci = tu_json_num(t, "value_arcsec") / 3600;
+            c = term_deg("c'");
+            d = term_deg("d");
+            e = term_deg("e'");
+            ci = term_deg("i");
             printf("check_pmfit: %s, axis 1 moved %+.4f deg, order %d: sigma %.4f\" (%.4f\" "
                    "unmoved), c' %.4f, d %.4f, e' %.4f, i %.4f deg\n",
                    k[i].mount, shift, order, s1, s0, c, d, e, ci);
