@@ -1044,10 +1044,11 @@ pm_status pm_fit_add(pm_fit *fit, const pm_context *ctx,
 **  6) On error *out and *res are unchanged and the accumulated pass is kept
 **     (more observations can be added and the solve retried); the
 **     covariance of the previous solve is no longer available.
-**  7) The index terms c' and e' (coef[2], coef[4]: axis zero points,
-**     applied exactly as rotations) come back reduced into (-pi, pi]: the
-**     same model to rounding, where a start or a step turns away had given
-**     c' = -36179 deg (an outside probe).  The other terms are not reduced.
+**  7) The four terms applied exactly as rotations, c', d, e' and i
+**     (coef[2] to coef[5]), come back reduced into (-pi, pi]: the same
+**     model to rounding, where a start or a step turns away had given
+**     c' = -36179 deg or i = 360.06 deg (outside probes).  The polar axis's
+**     a and b and the anisotropic terms are not reduced.
 */
 pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res);
 
@@ -1093,15 +1094,24 @@ pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res);
 **     a predicted error at the stars of 6.2" for sigma 1.39" (a linear
 **     fit's cannot exceed sigma), 1.19" at the returned model (an outside
 **     probe).  pm_fit_solve's passes are the caller's to repeat.
-**  3) Two aliases of the isotropic terms point exactly alike: (e' + pi,
-**     pi - i), the tube through the pole and turned round, and (c' + pi,
-**     pi - d, e' + pi), the axes turned round.  Where the fit comes to a
-**     collimation i or non-perpendicularity d beyond 90 deg, it runs once
-**     more from the alias with both within 90 deg and keeps that fit where
-**     its chi^2 is no larger beyond rounding: a fork whose HA encoder read
-**     180 deg off had come back with e' 180 deg and i -180 deg, an alt-az
-**     run with its azimuth 180 deg off with d -180 deg (an outside probe).
-**     Stack: the same pm_model.
+**  3) Two aliases of the six isotropic terms point exactly alike where
+**     they are the whole model (order 0): (e' + pi, pi - i), the tube
+**     through the pole and turned round, and (c' + pi, pi - d, e' + pi),
+**     the axes turned round.  The fit returns the one with the collimation
+**     i and the non-perpendicularity d within 90 deg, whose sides are the
+**     encoders' (in the other a fork's every star is beyond the pole, and
+**     pm_model_invert's normal side with it).  The order-0 fits that seed
+**     higher orders are taken there; where the fit still comes to |d| or
+**     |i| beyond 90 deg from a start within it, it runs once more from that
+**     alias of its six and keeps it where it converges there (at order 0:
+**     where its chi^2 is no larger beyond rounding).  At higher orders the
+**     anisotropic terms, which live in the mechanical frame, make the two
+**     different models, and the other's chi^2 may be a little lower (a
+**     fork's sigma 1.10" against 1.12"; outside probes).  A fork whose HA
+**     encoder read 180 deg off had come back with e' 180 deg and i -180
+**     deg, an alt-az run with its azimuth 180 deg off with d -180 deg.  A
+**     start with |d| or |i| beyond 90 deg (a refit from such a model) keeps
+**     its alias.  Stack: the same pm_model.
 */
 #define PM_FIT_INDEX_START 0.17453292519943295 /* 10 deg, radians */
 pm_status pm_fit_run(pm_fit *fit, pm_model *model, const pm_context *ctx,

@@ -375,16 +375,37 @@ pm_status pm_fit_add(pm_fit *fit, const pm_context *ctx, double enc_ha,
     return PM_OK;
 }
 
-/* The two index terms c' and e' (axis zero points, applied exactly as
-** rotations) reduced into (-pi, pi]: the model is the same to rounding,
-** and a Gauss-Newton step that went a turn or a hundred away (-36179 deg,
-** an outside probe, from a start of 0) no longer comes back as the fit.
-** A non-finite step is left to pm_model_prepare's PM_ERR_NONFINITE. */
+/* The four terms applied exactly as rotations, c', d, e' and i, reduced
+** into (-pi, pi]: the model is the same to rounding, and a Gauss-Newton
+** step that went a turn or a hundred away (c' -36179 deg, i 360.06 deg;
+** outside probes) no longer comes back as the fit.  A non-finite step is
+** left to pm_model_prepare's PM_ERR_NONFINITE. */
 static void wrap_index(pm_model *m)
 {
-    for (int k = 2; k <= 4; k += 2)
+    for (int k = 2; k <= 5; k++)
         if (finite(m->coef[k]))
             m->coef[k] = wrap_pi(m->coef[k]);
+}
+
+/* The isotropic terms a[6] (reduced into (-pi, pi]) at their alias with
+** |d| and |i| within pi/2: (e' + pi, pi - i) and (c' + pi, pi - d, e' +
+** pi) point exactly alike where these six are all the model (pm.h,
+** pm_fit_run Note 3).  True if it changed them. */
+static bool canonical_alias(double *a)
+{
+    bool changed = false;
+    if (m_fabs(a[5]) > PI / 2) {
+        a[4] = wrap_pi(a[4] + PI);
+        a[5] = wrap_pi(PI - a[5]);
+        changed = true;
+    }
+    if (m_fabs(a[3]) > PI / 2) {
+        a[2] = wrap_pi(a[2] + PI);
+        a[3] = wrap_pi(PI - a[3]);
+        a[4] = wrap_pi(a[4] + PI);
+        changed = true;
+    }
+    return changed;
 }
 
 /* pm_fit_solve but for the covariance's state after an error (there).
@@ -703,6 +724,11 @@ pm_status pm_fit_run(pm_fit *fit, pm_model *model, const pm_context *ctx,
             continue;
         for (int i = 0; i < 6; i++)
             iso[n_index][i] = s.coef[i];
+        /* (an order-0 fit: its alias with d and i within 90 deg is the same
+        ** fit; the order-L fit from either is not, and rounding had chosen
+        ** between them: an outside probe's fits from the other came back
+        ** with i -180 deg and a worse chi^2) */
+        canonical_alias(iso[n_index]);
         iso_chi2 = r.chi2;
         n_start = n_index + 1;
     }
@@ -733,34 +759,32 @@ pm_status pm_fit_run(pm_fit *fit, pm_model *model, const pm_context *ctx,
     }
     if (best < 0)
         return first;
-    /* Two aliases of the isotropic terms point exactly alike: (e' + pi,
-    ** pi - i), the tube through the pole and turned round, and (c' + pi,
-    ** pi - d, e' + pi), the axes turned round.  Where the fit came to a
-    ** collimation or a non-perpendicularity beyond 90 deg (a fork whose HA
-    ** encoder read 180 deg off: e' 180 deg and i -180 deg, which TPOINT's CH
-    ** cannot mean; an alt-az azimuth 180 deg off: d -180 deg; an outside
-    ** probe), it runs once more from the alias with both within 90 deg and
-    ** keeps that fit where its chi^2 is no larger beyond rounding (pm.h,
-    ** Note 3). */
-    if (m_fabs(s.coef[5]) > PI / 2 || m_fabs(s.coef[3]) > PI / 2) {
-        double *a = iso[n_start];
-        for (int i = 0; i < 6; i++)
-            a[i] = s.coef[i];
-        if (m_fabs(a[5]) > PI / 2) {
-            a[4] = wrap_pi(a[4] + PI);
-            a[5] = wrap_pi(PI - a[5]);
-        }
-        if (m_fabs(a[3]) > PI / 2) {
-            a[2] = wrap_pi(a[2] + PI);
-            a[3] = wrap_pi(PI - a[3]);
-            a[4] = wrap_pi(a[4] + PI);
-        }
+    /* The alias (pm.h, Note 3): where the fit came to a collimation or a
+    ** non-perpendicularity beyond 90 deg from a start within it (a fork
+    ** whose HA encoder read 180 deg off: e' 180 deg and i -180 deg, which
+    ** TPOINT's CH cannot mean; an alt-az azimuth 180 deg off: d -180 deg;
+    ** outside probes), once more from the alias of its six isotropic terms
+    ** with both within 90 deg, whose sides are the encoders' (the other
+    ** put a fork's every star beyond the pole, and the inverse's normal
+    ** side there).  Kept where that fit converges, its d and i within 90
+    ** deg, and at order 0 where its chi^2 is no larger beyond rounding (the
+    ** same pointing); at higher orders the aliases are different models and
+    ** the other's chi^2 may be a little lower (a fork's 1.10" against
+    ** 1.12").  A caller's start beyond 90 deg keeps its alias (a refit
+    ** from an old model: compare). */
+    double a0[6];
+    for (int i = 0; i < 6; i++)
+        a0[i] = wrap_pi(model->coef[i]);
+    double *a = iso[n_start];
+    for (int i = 0; i < 6; i++)
+        a[i] = s.coef[i];
+    if (!canonical_alias(a0) && canonical_alias(a)) {
         const double chi2 = r.chi2;
         pm_fit_result ra;
         if (start_model(model, iso, n_start, &s) == PM_OK &&
             run_from(fit, &s, ctx, n, enc_ha, enc_dec, app_ha, app_dec, max_iter, &ra) == PM_OK &&
-            ra.chi2 <= chi2 * (1 + 1e-9) && m_fabs(s.coef[5]) <= PI / 2 &&
-            m_fabs(s.coef[3]) <= PI / 2) {
+            m_fabs(s.coef[3]) <= PI / 2 && m_fabs(s.coef[5]) <= PI / 2 &&
+            (model->n_terms > 6 || ra.chi2 <= chi2 * (1 + 1e-9))) {
             r = ra;
         } else {
             start_model(model, iso, k, &s);

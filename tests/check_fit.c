@@ -1200,12 +1200,14 @@ START_TEST(test_pm_fit_run_index_turns_reduced)
     make_zero(&m, 1);
     m.coef[2] = truth.coef[2] + 7 * 2 * M_PI;
     m.coef[4] = truth.coef[4] - 3 * 2 * M_PI;
+    m.coef[5] = truth.coef[5] + 2 * M_PI; /* i of 361 deg (an outside probe's fit: 360.06) */
     ck_assert_int_eq(pm_model_prepare(&m), PM_OK);
     ck_assert_int_eq(pm_fit_run(&g_fit, &m, NULL, run.n, run.eh, run.ed, run.ah, run.ad,
                                 MAX_ITER, &res),
                      PM_OK);
     ck_assert_double_le(fabs(m.coef[2]), M_PI);
     ck_assert_double_le(fabs(m.coef[4]), M_PI);
+    ck_assert_double_le(fabs(m.coef[5]), M_PI);
     for (i = 0; i < m.n_terms; i++)
         ck_assert_double_eq_tol(m.coef[i], truth.coef[i], TOL_EXACT_RAD);
     tu_run_free(&run);

@@ -894,6 +894,47 @@ START_TEST(test_pmfit_index_half_turn)
         ck_assert_msg(fabs(tu_json_num(strstr(out, "\"rezero\": {"), "c_arcsec") - 7.2) < 1,
                       "%s", out);
     }
+    /* compare from a model file in the other alias (e' + pi, pi - i; an
+    ** order-0 model written so by the build before): the refit keeps the
+    ** old model's alias, and an unchanged mount still holds (the refit had
+    ** been turned to the canonical alias: e' moved 1,641,614 sigma, "refit";
+    ** an outside probe) */
+    {
+        char alias[300];
+        FILE *in, *o;
+        char line[1024];
+        snprintf(args, sizeof args, "%s --fork --n 80 --seed 4", base);
+        ck_assert_msg(run("%s simulate %s%s", args, "") == 0, "%s", out);
+        snprintf(args, sizeof args, "%s --order 0 --save %s", base, pmf);
+        ck_assert_msg(run("%s fit %s%s", args, "") == 0, "%s", out);
+        snprintf(alias, sizeof alias, "%s/alias.pm", tmpdir);
+        in = fopen(pmf, "r");
+        o = fopen(alias, "w");
+        ck_assert(in && o);
+        while (fgets(line, sizeof line, in)) {
+            double v, e, r[5];
+            int nr;
+            if (sscanf(line, "term e' 5 0 0 %lf %lf", &v, &e) == 2)
+                fprintf(o, "term e' 5 0 0 %.17g %.17g\n", v + M_PI, e);
+            else if (sscanf(line, "term i 6 0 0 %lf %lf", &v, &e) == 2)
+                fprintf(o, "term i 6 0 0 %.17g %.17g\n", M_PI - v, e);
+            else if ((nr = sscanf(line, "corr 6 1 %lf %lf %lf %lf %lf", &r[0], &r[1], &r[2], &r[3],
+                                  &r[4])) == 5)
+                fprintf(o, "corr 6 1 %.10g %.10g %.10g %.10g %.10g\n", -r[0], -r[1], -r[2], -r[3],
+                        -r[4]);
+            else
+                fputs(line, o);
+        }
+        fclose(in);
+        fclose(o);
+        snprintf(args, sizeof args, "%s --fork --n 80 --seed 5", base);
+        ck_assert_msg(run("%s simulate %s%s", args, "") == 0, "%s", out);
+        snprintf(args, sizeof args, "%s %s --json", alias, base);
+        ck_assert_msg(run("%s compare %s%s", args, "") == 0, "%s", out);
+        ck_assert_msg(strstr(out, "\"moved\": []") != NULL &&
+                          strstr(out, "\"advice\": \"the model still holds") != NULL,
+                      "%s", out);
+    }
 }
 END_TEST
 
