@@ -404,11 +404,11 @@ Comparison compare_models(const pm_model &old_in, const std::vector<double> &old
                                "(temperature, time, slew direction or a column)")
                  : "the fit does not converge (status " + std::to_string((int)f.status) + ")") +
             "; compare needs a run that determines the model (or a lower --order)");
-    // the refit's index terms in the old model's turn (the same model): a c'
-    // of -179.99 deg against 179.99 deg is a change of 0.02 deg, not of a
-    // turn (the fit reduces them into (-pi, pi]; an outside probe read
-    // "moved -1295971" (68335 sigma)")
-    for (int k = 2; k <= 4; k += 2)
+    // the refit's rotation terms (c', d, e', i) in the old model's turn (the
+    // same model): a c' of -179.99 deg against 179.99 deg is a change of
+    // 0.02 deg, not of a turn (the fit reduces them into (-pi, pi]; an
+    // outside probe read "moved -1295971" (68335 sigma)")
+    for (int k = 2; k <= 5; k++)
         f.model.coef[k] = old_model.coef[k] +
                           std::remainder(f.model.coef[k] - old_model.coef[k], 2 * PI);
     if (pm_model_prepare(&f.model) != PM_OK)
