@@ -968,9 +968,10 @@ int read_file(Context &ctx)
         obs.back().line == rd.number()) {
         const bool prev_record = obs.size() > 1 && obs[obs.size() - 2].line == rd.number() - 1;
         if (!prev_record || cut_short(last_text, prev_text))
-            ctx.warn(rd.number(), "the last line has no line end and its last number has fewer "
-                                  "decimals than the line before: if the file was cut short, "
-                                  "this record is incomplete (read as written)");
+            ctx.warn(rd.number(), "the last line has no line end%s: if the file was cut short, "
+                                  "this record is incomplete (read as written)",
+                     prev_record ? " and fewer fields or decimals at its end than the line before"
+                                 : "");
     }
     unfold_sky_convention(ctx);
     if (!check_conventions(ctx)) return ctx.status();
