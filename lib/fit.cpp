@@ -614,6 +614,19 @@ static bool index_start(const pm_model *m, long n, const double *enc_ha,
     return true;
 }
 
+/* One pass's observations into the workspace (pm_fit_add each). */
+static pm_status add_pass(pm_fit *fit, const pm_context *ctx, long n, const double *enc_ha,
+                          const double *enc_dec, const double *app_ha, const double *app_dec)
+{
+    for (long i = 0; i < n; i++) {
+        pm_status st = pm_fit_add(fit, ctx ? ctx + i : 0, enc_ha[i], enc_dec[i], app_ha[i],
+                                  app_dec[i]);
+        if (st != PM_OK)
+            return st;
+    }
+    return PM_OK;
+}
+
 /* Gauss-Newton from *m (the loop of pm_fit_run), m updated in place: PM_OK
 ** with *m the converged model and *r its statistics. */
 static pm_status run_from(pm_fit *fit, pm_model *m, const pm_context *ctx, long n,
@@ -625,12 +638,9 @@ static pm_status run_from(pm_fit *fit, pm_model *m, const pm_context *ctx, long 
         return st;
     __builtin_memset(r, 0, sizeof *r);
     for (int it = 0; it < max_iter; it++) {
-        for (long i = 0; i < n; i++) {
-            st = pm_fit_add(fit, ctx ? ctx + i : 0, enc_ha[i], enc_dec[i],
-                            app_ha[i], app_dec[i]);
-            if (st != PM_OK)
-                return st;
-        }
+        st = add_pass(fit, ctx, n, enc_ha, enc_dec, app_ha, app_dec);
+        if (st != PM_OK)
+            return st;
         st = pm_fit_solve(fit, m, r);
         if (st != PM_OK)
             return st;
@@ -647,12 +657,9 @@ static pm_status run_from(pm_fit *fit, pm_model *m, const pm_context *ctx, long 
                 stepped = stepped || fit->step[i] != 0;
             if (!r->accepted || !stepped)
                 return PM_OK;
-            for (long i = 0; i < n; i++) {
-                st = pm_fit_add(fit, ctx ? ctx + i : 0, enc_ha[i], enc_dec[i], app_ha[i],
-                                app_dec[i]);
-                if (st != PM_OK)
-                    return st;
-            }
+            st = add_pass(fit, ctx, n, enc_ha, enc_dec, app_ha, app_dec);
+            if (st != PM_OK)
+                return st;
             st = solve(fit, m, r, true);
             if (st != PM_OK)
                 fit->cov_valid = 0;
