@@ -225,6 +225,21 @@ double cv_of(const Run &run, const std::vector<int> &use, int order,
     return cv_rms(run, use, order, adds, opt.folds, opt.seed, {}, warm_of(fit), &skip);
 }
 
+// (explain_internal.hpp)
+std::string column_unusable(const Run &run, const std::vector<int> &use, size_t j)
+{
+    double lo = 1e300, hi = -1e300;
+    for (int i : use) {
+        const double x = run.obs[i].ctx.aux[j];
+        if (!std::isfinite(x))
+            return "no value at line " + std::to_string(run.obs[i].line) +
+                   " (a candidate needs it at every point)";
+        lo = std::min(lo, x);
+        hi = std::max(hi, x);
+    }
+    return hi > lo ? std::string() : std::string("the same at every point");
+}
+
 } // namespace xdetail
 
 using namespace xdetail;
@@ -465,20 +480,6 @@ bool input_usable(const Run &run, const std::vector<int> &use, int which)
     if (which == 2 && zero * 10 > use.size())
         return false;
     return hi - lo > (which == 0 ? 0.2 : which == 1 ? 0.05 : 1);
-}
-
-// Does the run's column j vary, and is it known everywhere in `use`?
-bool aux_usable(const Run &run, const std::vector<int> &use, size_t j)
-{
-    double lo = 1e300, hi = -1e300;
-    for (int i : use) {
-        double x = run.obs[i].ctx.aux[j];
-        if (!std::isfinite(x))
-            return false;
-        lo = std::min(lo, x);
-        hi = std::max(hi, x);
-    }
-    return hi > lo;
 }
 
 // The chi^2 excess of a group of residuals (components: 1 axis 1, 2 axis 2,
@@ -861,7 +862,7 @@ void physical_candidates(const Run &run, const State &st, std::vector<Candidate>
         if (name == dir2 ||
             std::any_of(std::begin(position), std::end(position),
                         [&](const char *p) { return name == p; }) ||
-            !aux_usable(run, st.use, j))
+            !column_unusable(run, st.use, j).empty())
             continue;
         add_candidate(cands, st, "aux:" + name, {"aux:" + name});
     }

@@ -83,6 +83,10 @@ struct Candidate {
 
 double elevation_of(const Run &run, const Obs &o);
 bool has(const std::vector<std::string> &v, const std::string &s);
+// Why the run's column j (j < PM_MAX_AUX) cannot be a candidate over the
+// observations `use`: "no value at line N (...)", "the same at every
+// point"; empty where it can (physical_candidates, not_tried_why).
+std::string column_unusable(const Run &run, const std::vector<int> &use, size_t j);
 // Angular size (radians) of model b minus model a at each observation.
 std::vector<double> model_difference(const Run &run, const std::vector<int> &use,
                                      const pm_model &a, const pm_model &b);

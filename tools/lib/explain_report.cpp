@@ -105,30 +105,18 @@ std::vector<std::pair<std::string, std::string>> not_tried_why(const Run &run)
     }
     // the run's own columns that cannot be candidates (an outside probe: a
     // column's effect was not looked for, and nothing said so)
+    std::vector<int> all(run.obs.size());
+    for (size_t i = 0; i < all.size(); i++)
+        all[i] = (int)i;
     for (size_t j = 0; j < run.aux_names.size(); j++) {
         const std::string &name = run.aux_names[j];
         if (name == axis2_dir_name(run.mount) && run.dec_dir_derived)
             continue;
-        std::string why;
-        if (j >= (size_t)PM_MAX_AUX) {
-            why = "beyond the first " + std::to_string(PM_MAX_AUX) +
-                  " columns, which are all a fit can read (put it among them)";
-        } else {
-            int missing = 0;
-            double lo = 1e300, hi = -1e300;
-            for (const Obs &o : run.obs) {
-                const double x = o.ctx.aux[j];
-                if (!std::isfinite(x) && !missing)
-                    missing = o.line;
-                if (std::isfinite(x))
-                    lo = std::min(lo, x), hi = std::max(hi, x);
-            }
-            if (missing)
-                why = "no value at line " + std::to_string(missing) +
-                      " (a candidate needs it at every point)";
-            else if (!(hi > lo))
-                why = "the same at every point";
-        }
+        const std::string why = j >= (size_t)PM_MAX_AUX
+                                    ? "beyond the first " + std::to_string(PM_MAX_AUX) +
+                                          " columns, which are all a fit can read (put it "
+                                          "among them)"
+                                    : xdetail::column_unusable(run, all, j);
         if (!why.empty())
             out.push_back({"aux:" + name, why});
     }
