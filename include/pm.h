@@ -1074,8 +1074,11 @@ pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res);
 **     one beyond PM_FIT_INDEX_START, it runs again from the offsets (the
 **     circular means of the hour-angle and declination offsets, the first
 **     weighted by cos^2 of the declination; readings beyond the pole folded
-**     to the sky unless the declination offsets agree better unfolded, as
-**     for a fork whose declination index takes readings past 90 deg) and,
+**     to the sky, where "beyond" is measured from the declination offsets'
+**     own mean where that makes them agree better (a German mount whose
+**     declination encoder reads half a turn off reads its normal side
+**     beyond 90 deg), or unfolded where that does (a fork whose declination
+**     index takes readings past 90 deg) and,
 **     for a model beyond the six isotropic terms, from the six of the
 **     better order-0 fit from these two starts, and returns the fit of
 **     least chi^2, a later start only where it is lower beyond rounding

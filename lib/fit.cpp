@@ -572,45 +572,81 @@ pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res)
     return st;
 }
 
-/* A start for the two index terms c' and e' (pm_fit_run's Note 1): the
-** circular means of the encoder-minus-true offsets (c' = true - encoder
-** on axis 1, e' = encoder - true on axis 2: pm.h's P_d(delta - e')), the
-** hour-angle offsets weighted by cos^2 of the declination (near the pole
-** they grow as sec).  An equatorial reading beyond the pole is folded to
-** the sky (there e' enters with the other sign), unless the declination
-** offsets agree better unfolded: a fork whose declination index takes its
-** readings past 90 deg does not flip, and a German mount's two sides
-** differ by twice the declination unfolded.  False where no offset is
-** usable. */
-static bool index_start(const pm_model *m, long n, const double *enc_ha,
-                        const double *enc_dec, const double *app_ha,
-                        const double *app_dec, double *c, double *e)
+/* The circular sums of index_start for one reading of the sides: fold < 0
+** none, else readings whose declination minus fold_e lies beyond +-90 deg
+** folded to the sky (there e' enters with the other sign).  Returns the
+** squared resultant of the declination offsets (how well they agree). */
+static double index_sums(const pm_model *m, long n, const double *enc_ha,
+                         const double *enc_dec, const double *app_ha,
+                         const double *app_dec, int fold, double fold_e, double *sums)
 {
-    double sc[2] = {0, 0}, cc[2] = {0, 0}, se[2] = {0, 0}, ce[2] = {0, 0};
+    for (int j = 0; j < 4; j++)
+        sums[j] = 0;
     for (long i = 0; i < n; i++) {
         if (!finite(enc_ha[i]) || !finite(enc_dec[i]) || !finite(app_ha[i]) ||
             !finite(app_dec[i]) || m_fabs(enc_dec[i]) > 1e6 || m_fabs(enc_ha[i]) > 1e6)
             continue;
         const double cd = m_cos(app_dec[i]), w = cd * cd;
-        for (int fold = 0; fold < 2; fold++) { /* [1]: folded */
-            double h = enc_ha[i], d = wrap_pi(enc_dec[i]), s = 1;
-            if (fold && m->mount != PM_MOUNT_ALTAZ && m_fabs(d) > PI / 2) {
-                h += PI;
-                d = (d > 0 ? PI : -PI) - d;
-                s = -1;
+        double h = enc_ha[i], d = wrap_pi(enc_dec[i]), s = 1;
+        if (fold >= 0 && m->mount != PM_MOUNT_ALTAZ && m_fabs(wrap_pi(d - fold_e)) > PI / 2) {
+            h += PI;
+            d = (d > 0 ? PI : -PI) - d;
+            s = -1;
+        }
+        const double dc = app_ha[i] - h, de = s * (d - app_dec[i]);
+        sums[0] += w * m_sin(dc);
+        sums[1] += w * m_cos(dc);
+        sums[2] += m_sin(de);
+        sums[3] += m_cos(de);
+    }
+    return sums[2] * sums[2] + sums[3] * sums[3];
+}
+
+/* A start for the two index terms c' and e' (pm_fit_run's Note 1): the
+** circular means of the encoder-minus-true offsets (c' = true - encoder
+** on axis 1, e' = encoder - true on axis 2: pm.h's P_d(delta - e')), the
+** hour-angle offsets weighted by cos^2 of the declination (near the pole
+** they grow as sec), for the reading of the sides under which the
+** declination offsets agree best: unfolded (a fork whose declination index
+** takes its readings past 90 deg does not flip), readings beyond +-90 deg
+** folded to the sky (a German mount's two sides differ by twice the
+** declination unfolded), or readings beyond +-90 deg of the unfolded or
+** the folded mean e' folded, that mean refined once (a German mount whose
+** declination encoder reads 180 deg off reads its normal side beyond
+** +-90: folded at 0 its offsets were spread, unfolded half of them, and
+** the hour-angle mean of two halves 180 deg apart fell anywhere; an
+** outside probe's runs stopped at sigma 1.3e5" in 6 of 32).  A later
+** reading is taken only where its offsets agree better beyond rounding.
+** False where no offset is usable. */
+static bool index_start(const pm_model *m, long n, const double *enc_ha,
+                        const double *enc_dec, const double *app_ha,
+                        const double *app_dec, double *c, double *e)
+{
+    double best[4], sums[4];
+    double best_r = index_sums(m, n, enc_ha, enc_dec, app_ha, app_dec, -1, 0, best);
+    double r = index_sums(m, n, enc_ha, enc_dec, app_ha, app_dec, 1, 0, sums);
+    const double unfolded_e = m_atan2(best[2], best[3]), folded_e = m_atan2(sums[2], sums[3]);
+    if (r >= best_r) { /* (ties folded, as before) */
+        best_r = r;
+        __builtin_memcpy(best, sums, sizeof best);
+    }
+    if (m->mount != PM_MOUNT_ALTAZ) {
+        for (int j = 0; j < 2; j++) {
+            double fe = j ? folded_e : unfolded_e;
+            for (int it = 0; it < 2; it++) {
+                r = index_sums(m, n, enc_ha, enc_dec, app_ha, app_dec, 1, fe, sums);
+                if (r > best_r * (1 + 1e-9)) {
+                    best_r = r;
+                    __builtin_memcpy(best, sums, sizeof best);
+                }
+                fe = m_atan2(sums[2], sums[3]);
             }
-            const double dc = app_ha[i] - h, de = s * (d - app_dec[i]);
-            sc[fold] += w * m_sin(dc);
-            cc[fold] += w * m_cos(dc);
-            se[fold] += m_sin(de);
-            ce[fold] += m_cos(de);
         }
     }
-    const int k = se[0] * se[0] + ce[0] * ce[0] > se[1] * se[1] + ce[1] * ce[1] ? 0 : 1;
-    if (!(sc[k] * sc[k] + cc[k] * cc[k] > 0) || !(se[k] * se[k] + ce[k] * ce[k] > 0))
+    if (!(best[0] * best[0] + best[1] * best[1] > 0) || !(best_r > 0))
         return false;
-    *c = m_atan2(sc[k], cc[k]);
-    *e = m_atan2(se[k], ce[k]);
+    *c = m_atan2(best[0], best[1]);
+    *e = m_atan2(best[2], best[3]);
     return true;
 }
 

@@ -828,6 +828,66 @@ static double term_deg(const char *name)
     return tu_json_num(t, "value_arcsec") / 3600;
 }
 
+/* A copy of a column run with both encoder fields (1 and 2) moved by 180
+** deg, wrapped into (-180, 180]: both index errors half a turn more. */
+static int edit_half_turn_both(char *line, size_t size, void *arg)
+{
+    double t, d;
+    int k;
+    (void)arg;
+    if (line[0] == '#' || sscanf(line, "%lf %lf%n", &t, &d, &k) != 2)
+        return 1;
+    {
+        char head[64];
+        int m = snprintf(head, sizeof head, "%.9f %.9f", fmod(t + 360, 360) - 180,
+                         fmod(d + 360, 360) - 180);
+        ck_assert(m > 0 && (size_t)m < sizeof head && (size_t)m + strlen(line + k) < size);
+        memmove(line + m, line + k, strlen(line + k) + 1);
+        memcpy(line, head, (size_t)m);
+    }
+    return 1;
+}
+
+/* A German mount whose two encoders both read half a turn off (c' and e'
+** of 180.3 deg): its normal side reads declinations beyond +-90 and its
+** flipped side within.  The start from the offsets folded the readings
+** beyond +-90 (the wrong half) and, unfolded, averaged hour-angle offsets
+** 180 deg apart: the fit stopped in a false minimum at sigma 1.2e5-1.3e5"
+** with PM_OK in 5 of these 16 runs of the independent generator (an
+** outside probe: 6 of 32 of its own).  It now folds about the offsets' own
+** declination index (lib/fit.cpp, index_start). */
+START_TEST(test_pmfit_gem_both_encoders_half_turn)
+{
+    const char *top = getenv("PM_TOP");
+    char cmd[2048], path[400], shifted[400];
+    int seed, lat, order;
+    make_tmpdir();
+    snprintf(path, sizeof path, "%s/hb.dat", tmpdir);
+    snprintf(shifted, sizeof shifted, "%s/hb_shifted.dat", tmpdir);
+    for (seed = 1; seed <= 8; seed++)
+        for (lat = 40; lat >= -35; lat -= 75) {
+            snprintf(cmd, sizeof cmd,
+                     "/usr/bin/python3 %s/tests/ref/indep_gen.py %s --mount gem --n 100 --seed %d "
+                     "--lat %d --noise 1 --index 0.3,0.3 > /dev/null 2>&1",
+                     top ? top : ".", path, seed, lat);
+            ck_assert_int_eq(system(cmd), 0);
+            tu_edited_copy(path, shifted, edit_half_turn_both, NULL);
+            for (order = 0; order <= 1; order++) {
+                double sigma;
+                snprintf(cmd, sizeof cmd, "%s --order %d --json", shifted, order);
+                ck_assert_msg(run("%s fit %s%s", cmd, "") == 0, "%s", out);
+                sigma = tu_json_num(out, "sigma_arcsec");
+                if (sigma > 1.3)
+                    printf("check_pmfit: seed %d, lat %d, order %d: sigma %.1f\"\n", seed, lat,
+                           order, sigma);
+                ck_assert(sigma < 1.3);
+                ck_assert(fabs(fabs(term_deg("c'")) - 179.7) < 0.01);
+                ck_assert(fabs(fabs(term_deg("e'")) - 179.7) < 0.01);
+            }
+        }
+}
+END_TEST
+
 /* Encoders read 180 deg off on axis 1 (a fork synchronised 12 h wrong, an
 ** alt-az azimuth from the other side): the fit has two exact aliases of
 ** the isotropic terms (pm.h, pm_fit_run Note 3) and comes back with the one
@@ -964,6 +1024,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_pmfit_altaz_elevation_direction);
     tcase_add_test(tc, test_pmfit_explain_column_follows_temperature);
     tcase_add_test(tc, test_pmfit_index_half_turn);
+    tcase_add_test(tc, test_pmfit_gem_both_encoders_half_turn);
     tcase_set_timeout(tc, 60);
     suite_add_tcase(s, tc);
     return s;
