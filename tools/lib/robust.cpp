@@ -3,6 +3,7 @@
 #include "robust.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <cmath>
 #include <numeric>
 
@@ -138,6 +139,126 @@ bool standardised(const pm_model &m, const std::vector<Obs> &obs, const std::vec
     return true;
 }
 
+// A least-trimmed-squares solution: the model fitted to the h points of
+// smallest residual, its objective q (the sum of those h squared residuals).
+struct Lts {
+    bool ok = false;
+    pm_model model = pm_model();
+    double q = 0;
+    std::vector<int> hs; // the h points (indices into the run), sorted
+};
+
+// The h points of use with the smallest residual under m, and their sum of
+// squared residuals; false if a residual fails.
+bool smallest(const pm_model &m, const std::vector<Obs> &obs, const std::vector<int> &use,
+              size_t h, std::vector<int> &hs, double &q)
+{
+    std::vector<double> r0, r1, rho;
+    if (!all_residuals(m, obs, use, r0, r1, rho))
+        return false;
+    std::vector<size_t> ord(use.size());
+    std::iota(ord.begin(), ord.end(), 0);
+    std::stable_sort(ord.begin(), ord.end(), [&](size_t a, size_t b) { return rho[a] < rho[b]; });
+    hs.clear();
+    q = 0;
+    for (size_t j = 0; j < h; j++) {
+        hs.push_back(use[ord[j]]);
+        q += rho[ord[j]] * rho[ord[j]];
+    }
+    std::sort(hs.begin(), hs.end());
+    return true;
+}
+
+// Concentration steps (Rousseeuw & Van Driessen's C-step) from model m: fit
+// the h points of smallest residual, repeat until that set is unchanged or
+// after `steps` fits.  Not ok if a fit of a half fails.
+Lts concentrate(const std::vector<Obs> &obs, const std::vector<int> &use, size_t h,
+                const pm_model &m, int max_passes, int steps)
+{
+    Lts l;
+    l.model = m;
+    std::vector<int> hs;
+    double q;
+    for (int step = 0; step < steps; step++) {
+        if (!smallest(l.model, obs, use, h, hs, q))
+            return l;
+        if (step > 0 && hs == l.hs)
+            break;
+        FitOut g = do_fit(obs, hs, l.model, max_passes);
+        if (g.status != PM_OK)
+            return l;
+        l.model = g.model;
+        l.hs = hs;
+    }
+    l.ok = smallest(l.model, obs, use, h, hs, l.q);
+    return l;
+}
+
+// The start that a cluster of gross errors cannot bend: order-0 fits (the
+// six isotropic terms, which carry nearly all of a mount's pointing) of
+// random four-point subsets, each followed by two concentration steps at
+// order 0; the best of them by its trimmed objective, its h points fitted
+// with the full model and concentrated to the end.  A least-squares fit of
+// all points leans towards a cluster of failed solves all off the same way
+// (20% of a run in one part of the sky: clipping from it kept part of the
+// cluster and rejected 32 good points, an outside probe), while one of
+// these subsets is clean with probability (1 - f)^4 for a fraction f of
+// gross errors: 0.13 at f = 0.4, so that 60 subsets miss with probability
+// 2e-4.  The subsets come from a fixed generator seeded by the run's size:
+// the same run gives the same fit.
+Lts order0_start(const std::vector<Obs> &obs, const std::vector<int> &use, size_t h,
+                 const pm_model &start, int max_passes)
+{
+    Lts best;
+    const size_t n = use.size();
+    pm_model m0;
+    if (n < 8 || pm_model_init(&m0, start.mount, 0) != PM_OK)
+        return best;
+    m0.latitude = start.latitude;
+    if (pm_model_prepare(&m0) != PM_OK)
+        return best;
+    uint64_t state = 0x9e3779b97f4a7c15ull ^ (uint64_t)n;
+    auto next = [&]() { // splitmix64
+        uint64_t z = (state += 0x9e3779b97f4a7c15ull);
+        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+        z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+        return z ^ (z >> 31);
+    };
+    Lts b0;
+    for (int s = 0; s < 60; s++) {
+        std::vector<int> sub;
+        while (sub.size() < 4) {
+            int k = use[(size_t)(next() % n)];
+            if (std::find(sub.begin(), sub.end(), k) == sub.end())
+                sub.push_back(k);
+        }
+        FitOut g = do_fit(obs, sub, m0, max_passes);
+        if (g.status != PM_OK)
+            continue;
+        Lts l = concentrate(obs, use, h, g.model, max_passes, 2);
+        if (l.ok && (!b0.ok || l.q < b0.q))
+            b0 = l;
+    }
+    if (!b0.ok)
+        return best;
+    FitOut g = do_fit(obs, b0.hs, start, max_passes);
+    if (g.status != PM_OK)
+        return best;
+    return concentrate(obs, use, h, g.model, max_passes, 30);
+}
+
+// The threshold K' on d / s for a scale s estimated with nu degrees of
+// freedom that rejects a clean point as often as K does for the true sigma:
+// d^2 / (2 s^2) is F(2, nu), P(d > K' s) = (1 + K'^2/nu)^(-nu/2), set equal
+// to exp(-K^2/2).  K itself for nu <= 0 or large nu.
+double studentised_clip(double clip, double nu)
+{
+    if (!(nu > 0))
+        return clip;
+    const double x = clip * clip / nu; // K'^2 = nu (exp(K^2/nu) - 1)
+    return x < 1e-12 ? clip : std::sqrt(nu * std::expm1(x));
+}
+
 std::vector<int> pick(const std::vector<int> &use, const std::vector<char> &keep)
 {
     std::vector<int> k;
@@ -189,33 +310,27 @@ RobustFit robust_fit(const std::vector<Obs> &obs, const std::vector<int> &use,
     pm_model model = rf.fit.model;
     std::vector<double> r0, r1, rho, dist;
 
-    // 2. the start: concentration steps of least trimmed squares on h points
+    // 2. the start: concentration steps of least trimmed squares on h points,
+    //    from the fit of all points and from the best of order-0 fits of
+    //    random four-point subsets (docs/robust.md)
     size_t h = std::max((n + 1) / 2, (size_t)p);
     rf.lts_start = h < n;
     if (rf.lts_start) {
-        std::vector<int> prev;
-        for (int step = 0; step < 30; step++) {
-            if (!all_residuals(model, obs, use, r0, r1, rho))
-                break;
-            std::vector<size_t> ord(n);
-            std::iota(ord.begin(), ord.end(), 0);
-            std::stable_sort(ord.begin(), ord.end(),
-                             [&](size_t a, size_t b) { return rho[a] < rho[b]; });
-            std::vector<int> hs;
-            for (size_t j = 0; j < h; j++)
-                hs.push_back(use[ord[j]]);
-            std::sort(hs.begin(), hs.end());
-            if (hs == prev)
-                break;
-            FitOut g = do_fit(obs, hs, model, max_passes);
-            if (g.status != PM_OK) { // singular on this half: start from all points
-                rf.lts_start = false;
-                model = rf.fit.model;
-                break;
-            }
-            model = g.model;
-            prev = hs;
-        }
+        Lts a = concentrate(obs, use, h, rf.fit.model, max_passes, 30);
+        Lts b = order0_start(obs, use, h, start, max_passes);
+        // the subsets' start only where its half fits far better (a tenth of
+        // the objective): behind a cluster of gross errors the fit of all
+        // points leaves one of 1e-4 or less (an outside probe's runs), while
+        // a run of broad, heavy-tailed residuals has halves of either start
+        // within a factor of a few (gem-28 0.86 at L=1, cgx-l 0.40), and
+        // what it keeps is for the fit's model terms and explain to read,
+        // not gross errors to clip (docs/robust.md)
+        if (b.ok && (!a.ok || b.q < 0.1 * a.q))
+            a = b;
+        if (a.ok)
+            model = a.model;
+        else // singular on every half: start from all points
+            rf.lts_start = false;
     }
 
     // the first kept set: the scale from the best h points' median, i.e. the
@@ -238,9 +353,6 @@ RobustFit robust_fit(const std::vector<Obs> &obs, const std::vector<int> &use,
     // 3. clipping rounds until the kept set is stable
     rf.stable = false;
     bool phase2 = false;
-    // E[d^2 | d < clip sigma] / E[d^2] for d^2/sigma^2 ~ chi^2(2)
-    double e = std::exp(-clip * clip / 2);
-    double trunc = 1 - (clip * clip / 2) * e / (1 - e);
     for (rf.rounds = 1; rf.rounds <= max_rounds; rf.rounds++) {
         size_t kept = (size_t)std::count(keep.begin(), keep.end(), (char)1);
         if ((long)kept < p) {
@@ -286,20 +398,40 @@ RobustFit robust_fit(const std::vector<Obs> &obs, const std::vector<int> &use,
         // phase 2, once that set is stable: the RMS of the kept distances,
         // corrected for the truncation at clip (twice as precise: sigma of
         // the median is 0.72 sigma/sqrt(N), of the RMS 0.35 sigma/sqrt(N))
+        // The final threshold on d / sigma_robust: the scale is estimated
+        // from 2M - P degrees of freedom, so a rejected point's ratio has
+        // the tail of F(2, nu), not of chi^2(2): at nu = 38 (30 points,
+        // L = 1) K = 4.29 rejected a clean point with probability 5.5e-4,
+        // not 1e-4 (an outside probe: 7 of 9000).  (The median's rounds
+        // only find the set the RMS rounds start from.)
+        const double k_rms = studentised_clip(clip, 2.0 * (double)kept - p), k_med = clip;
+        // E[d^2 | d < c sigma] / E[d^2] for d^2/sigma^2 ~ chi^2(2), where
+        // c is the threshold or, where more points are left out than it
+        // leaves out of clean ones, the point of the Rayleigh tail that
+        // holds as many (the consistency factor of a trimmed scale, as in
+        // LTS's reweighting): otherwise a small run's scale from the points
+        // its few largest clean residuals left behind is too small and
+        // keeps them out (30 clean points at --clip 3: five rejected at a
+        // scale of 0.6 sigma, a state that holds itself)
+        double c = k_rms;
+        if (kept < n)
+            c = std::min(c, std::sqrt(-2 * std::log((double)(n - kept) / (double)n)));
+        const double e = std::exp(-c * c / 2);
+        const double trunc = 1 - (c * c / 2) * e / (1 - e);
         double s_med = median(kr) / RAYLEIGH_MEDIAN * shrink;
         double s_rms = std::sqrt(ss / (2.0 * (double)kept) / trunc) * shrink;
-        auto decide = [&](double sig) {
+        auto decide = [&](double threshold) {
             std::vector<char> v(n);
             for (size_t i = 0; i < n; i++)
-                v[i] = dist[i] <= clip * sig;
+                v[i] = dist[i] <= threshold;
             return v;
         };
         rf.sigma_robust = phase2 ? s_rms : s_med;
-        std::vector<char> nk = decide(rf.sigma_robust);
+        std::vector<char> nk = decide(phase2 ? k_rms * s_rms : k_med * s_med);
         if (nk == keep && !phase2) {
             phase2 = true;
             rf.sigma_robust = s_rms;
-            nk = decide(s_rms);
+            nk = decide(k_rms * s_rms);
         }
         if (nk == keep) {
             rf.stable = true;
