@@ -955,7 +955,8 @@ py::tuple fit_run(const RunData &d, int order, std::vector<std::string> adds, bo
         for (size_t i = 0; i < all.size(); i++)
             all[i] = (int)i;
         if (!split) {
-            fits.push_back(fit_points(run, all, start, max_iter, run.path, "joint fit, both pier sides"));
+            fits.push_back(
+                fit_points(run, all, start, max_iter, run.path, all_points_title(start)));
             if (side_terms) {
                 std::unique_ptr<pm_fit> w(new pm_fit);
                 FitOut g = do_fit(*w, run.obs, all, without_side_terms(start), 100);

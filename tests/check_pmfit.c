@@ -634,6 +634,37 @@ START_TEST(test_pmfit_explain_period_seam)
 }
 END_TEST
 
+/* The MMT run with a 144-cycle azimuth error of 2 sigma injected (phase
+** 180 deg): explain names refraction first (by its false-alarm
+** probability, which counts the periods tried), and offers the periodic
+** error, which BIC prefers by 11 (likelihood ratio 10^3.5), as "a
+** better-fitting reading"; it had said "as good a reading" (an outside
+** probe).  A reading within Delta BIC 6 is still "as good".  The fit of an
+** alt-az run is of "all points", not a "joint fit, both pier sides". */
+START_TEST(test_pmfit_explain_better_reading_altaz)
+{
+    char path[512], inj[600], args[1400];
+    const char *p;
+    if (!tu_real_run("mmt/k_and_e.dat", path, sizeof path))
+        return;
+    make_tmpdir();
+    snprintf(inj, sizeof inj, "%s/kae_p144.dat", tmpdir);
+    snprintf(args, sizeof args, "--inject ha_periodic:144=2sigma --phase 180 --into '%s' %s",
+             path, inj);
+    ck_assert_msg(run("%s simulate %s%s", args, "") == 0, "%s", out);
+    ck_assert_msg(run("%s explain %s%s", inj, "") == 0, "%s", out);
+    ck_assert_msg(strstr(out, "a better-fitting reading: ha_periodic") != NULL, "%s", out);
+    for (p = strstr(out, "as good a reading: "); p; p = strstr(p + 1, "as good a reading: ")) {
+        const char *b = strstr(p, "Delta BIC ");
+        ck_assert_ptr_nonnull(b);
+        ck_assert_msg(atof(b + strlen("Delta BIC ")) > -6, "%.200s", p);
+    }
+    ck_assert_msg(run("%s fit %s%s", path, "") == 0, "%s", out);
+    ck_assert_msg(strstr(out, "all points (alt-az mount)") != NULL &&
+                      strstr(out, "both pier sides") == NULL, "%s", out);
+}
+END_TEST
+
 /* explain composes its baseline as a gimbal only where the stars determine
 ** it between them: the first 13 points of the MMT run (22 terms, pmfit
 ** fit's undetermined warning) "composed" 0.41" out of a 0.39" sigma, and
@@ -1025,6 +1056,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_pmfit_explain_column_follows_temperature);
     tcase_add_test(tc, test_pmfit_index_half_turn);
     tcase_add_test(tc, test_pmfit_gem_both_encoders_half_turn);
+    tcase_add_test(tc, test_pmfit_explain_better_reading_altaz);
     tcase_set_timeout(tc, 60);
     suite_add_tcase(s, tc);
     return s;

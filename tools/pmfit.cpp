@@ -1686,7 +1686,7 @@ int run_main(int argc, char **argv)
     if (!o.split) {
         FitOut f = fit_points(all, o.run);
         fits.push_back(f);
-        titles.push_back("joint fit, both pier sides");
+        titles.push_back(all_points_title(start));
         if (side_terms) {
             FitOut g = do_fit(obs, kept, without_side_terms(start));
             if (g.status == PM_OK)

@@ -124,6 +124,13 @@ std::vector<std::string> model_inputs(const pmmodel_info &info);
 // narrow band of elevation -- can take hundreds of damped passes).
 const int FIT_MAX_PASSES = 2000;
 
+// The title of the fit of all points, as the report and model files give
+// it: an alt-az mount has no pier sides to fit jointly.
+inline const char *all_points_title(const pm_model &m)
+{
+    return m.mount == PM_MOUNT_ALTAZ ? "all points (alt-az mount)" : "joint fit, both pier sides";
+}
+
 // Fit `start` to the observations `use` (Gauss-Newton, at most max_passes);
 // on success the residuals are filled in.  corr, corr_i, corr_j: the most
 // correlated pair of terms (also after PM_ERR_DIVERGED).
