@@ -371,8 +371,10 @@ static int ca_op_residual(pmfz_in *in, ca_state *s)
         return pmfz_fail("residual: stale model gave %d", st);
     if (st == PM_OK && !fin)
         return pmfz_fail("residual: PM_OK for non-finite input");
-    if (ca_ready(s) && fin && ca_ctx_ok(&s->m, ctx) && st != PM_OK &&
-        (st != PM_ERR_NONFINITE || ca_plain(s, ctx, v[0], v[1])))
+    if (st == PM_OK && fabs(v[3]) > M_PI / 2 + 1e-9)
+        return pmfz_fail("residual: PM_OK for an observed dec of %.17g", v[3]);
+    if (ca_ready(s) && fin && ca_ctx_ok(&s->m, ctx) && fabs(v[3]) <= M_PI / 2 &&
+        st != PM_OK && (st != PM_ERR_NONFINITE || ca_plain(s, ctx, v[0], v[1])))
         return pmfz_fail("residual: ready model, finite input gave %d", st);
     if (st != PM_OK && (res[0] != CA_SENTINEL || res[1] != CA_SENTINEL))
         return pmfz_fail("residual: output changed on error %d", st);

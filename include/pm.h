@@ -747,7 +747,9 @@ pm_status pm_model_track(const pm_model *m, const pm_context *ctx, pm_track *t,
 **     m        const pm_model*   prepared model
 **     ctx      const pm_context* per-evaluation inputs, or NULL
 **     enc_ha, enc_dec  double    encoder position of an observation
-**     app_ha, app_dec  double    the observed apparent position
+**     app_ha, app_dec  double    the observed apparent position (app_dec
+**                                within +-pi/2: PM_ERR_ARG beyond, as
+**                                pm_fit_add)
 **  Returned:
 **     res      double[2]         residual (radians): [0] along axis 1 on
 **                                the sky (i.e. d(ha)*cos(dec)), [1] along

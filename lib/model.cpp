@@ -2420,6 +2420,8 @@ pm_status pm_model_residual(const pm_model *m, const pm_context *ctx,
     if (!finite(enc_ha) || !finite(enc_dec) || !finite(app_ha) ||
         !finite(app_dec))
         return PM_ERR_NONFINITE;
+    if (m_fabs(app_dec) > PI / 2 + 1e-9) /* (as pm_fit_add: no place on the sky) */
+        return PM_ERR_ARG;
     const Iso<double> &k = iso_of(m);
     V3<double> p = forward_vec<double>(m, k, trig_of(enc_ha, enc_dec), ctx);
     V3<double> q = unit_of(app_ha, app_dec);

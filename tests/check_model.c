@@ -647,6 +647,22 @@ START_TEST(test_pm_model_residual_nonfinite)
 }
 END_TEST
 
+/* An observed declination beyond +-pi/2 is no place on the sky: refused as
+** pm_fit_add and pm_model_invert refuse it (it had returned PM_OK with a
+** residual of 1.8 rad; an outside probe). */
+START_TEST(test_pm_model_residual_dec_out_of_range)
+{
+    static pm_model m;
+    double res[2] = {SENTINEL, SENTINEL};
+    roundtrip_model(&m, 2, 1);
+    ck_assert_int_eq(pm_model_residual(&m, NULL, 0.1, 0.2, 0.1, 2.0, res), PM_ERR_ARG);
+    ck_assert_int_eq(pm_model_residual(&m, NULL, 0.1, 0.2, 0.1, -M_PI / 2 - 1e-6, res),
+                     PM_ERR_ARG);
+    ck_assert(res[0] == SENTINEL && res[1] == SENTINEL);
+    ck_assert_int_eq(pm_model_residual(&m, NULL, 0.1, 0.2, 0.1, M_PI / 2, res), PM_OK);
+}
+END_TEST
+
 START_TEST(test_pm_model_residual_stale)
 {
     static pm_model good, stale;
@@ -1923,6 +1939,7 @@ static Suite *model_suite(void)
     tcase_add_test(tc, test_pm_model_stale_each_coef);
     tcase_add_test(tc, test_pm_model_residual_null);
     tcase_add_test(tc, test_pm_model_residual_nonfinite);
+    tcase_add_test(tc, test_pm_model_residual_dec_out_of_range);
     tcase_add_test(tc, test_pm_model_residual_stale);
     tcase_add_test(tc, test_pm_terms_eval_bad_args);
     tcase_add_test(tc, test_pm_check_config_mismatch);
