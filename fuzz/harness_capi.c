@@ -104,7 +104,7 @@ static int ca_ctx_ok(const pm_model *m, const pm_context *ctx)
             x = a == PM_AUX_TEMP ? ctx->temp_c
               : a == PM_AUX_TIME ? ctx->time_h
               : a == PM_AUX_DIR ? (double)ctx->dir : ctx->aux[a - PM_AUX_USER];
-            if (!pmfz_finite(x))
+            if (!pmfz_finite(x) || (a == PM_AUX_DIR && (ctx->dir < -1 || ctx->dir > 1)))
                 return 0;
         }
     return 1;

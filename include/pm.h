@@ -260,8 +260,11 @@ typedef struct pm_context {
     double temp_c;          /* ambient temperature (deg C) */
     double time_h;          /* time (hours, any zero point) */
     int pier;               /* +1 normal side (east), -1 beyond the pole
-                               (west), 0: from the encoder dec */
-    int dir;                /* last slew direction on axis 1: +1, -1, 0 */
+                               (west), 0: from the encoder dec (other
+                               values: by their sign) */
+    int dir;                /* last slew direction on axis 1: +1, -1, 0
+                               (another value is PM_ERR_ARG where a term
+                               reads it: not a velocity or a step count) */
     double aux[PM_MAX_AUX]; /* user inputs (PM_AUX_USER + j) */
 } pm_context;
 

@@ -877,8 +877,10 @@ inline double aux_input(const pm_context *ctx, int aux)
     }
 }
 
-/* Does the context carry what the model's AUX terms read, finite?  (For
-** pm_model and pm_model_f alike.) */
+/* Does the context carry what the model's AUX terms read, finite, and a
+** slew direction of +1, -1 or 0 where one is read (a raw velocity or step
+** count there had scaled the hysteresis term silently: dir 3, three times
+** the term; an outside probe)?  (For pm_model and pm_model_f alike.) */
 template <typename M> inline pm_status context_ok(const M *m, const pm_context *ctx)
 {
     if (!m->needs_ctx)
@@ -890,6 +892,8 @@ template <typename M> inline pm_status context_ok(const M *m, const pm_context *
             double x = aux_input(ctx, m->term[i].aux);
             if (!finite(x))
                 return PM_ERR_NONFINITE;
+            if (m->term[i].aux == PM_AUX_DIR && (ctx->dir < -1 || ctx->dir > 1))
+                return PM_ERR_ARG;
         }
     return PM_OK;
 }

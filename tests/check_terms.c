@@ -579,6 +579,54 @@ START_TEST(test_pm_model_apply_aux_nonfinite_context)
 }
 END_TEST
 
+/* The slew direction is +1, -1 or 0: another value, where a term reads it,
+** is PM_ERR_ARG from every entry (a raw velocity or step count had scaled
+** the hysteresis term silently: dir 3, three times the term; an outside
+** probe).  Where no term reads it, it is not looked at; the pier side
+** is taken by its sign. */
+START_TEST(test_pm_model_apply_dir_out_of_range)
+{
+    static pm_model m, plain;
+    static pm_model_f mf;
+    pm_term t = make_term(PM_TERM_AUX, PM_BASE_C, 0, 0, 0, PM_AUX_DIR, 0.0);
+    pm_context c;
+    double a = 7.0, b = 7.0, res[2] = {7.0, 7.0}, row0[PM_MAX_TERMS], row1[PM_MAX_TERMS];
+    double af = 7.0, bf = 7.0;
+    int j;
+    static const int bad[4] = {2, -2, 3, 1000};
+    fit_start(&m, PM_MOUNT_EQUATORIAL, 1, LAT_N);
+    ck_assert_int_eq(pm_model_add_term(&m, &t, 2.0 * ARCSEC, NULL), PM_OK);
+    ck_assert_int_eq(pm_model_f_prepare(&mf, &m), PM_OK);
+    ck_assert_int_eq(pm_fit_init(&g_fit, &m), PM_OK);
+    for (j = 0; j < 4; j++) {
+        memset(&c, 0, sizeof c);
+        c.dir = bad[j];
+        ck_assert_int_eq(pm_model_apply(&m, &c, 0.3, 0.4, &a, &b), PM_ERR_ARG);
+        ck_assert_int_eq(pm_model_invert(&m, &c, 0.3, 0.4, PM_SIDE_NORMAL, &a, &b), PM_ERR_ARG);
+        ck_assert_int_eq(pm_model_invert_near(&m, &c, 0.3, 0.4, 0.3, 0.4, &a, &b), PM_ERR_ARG);
+        ck_assert_int_eq(pm_model_residual(&m, &c, 0.3, 0.4, 0.3, 0.4, res), PM_ERR_ARG);
+        ck_assert_int_eq(pm_fit_row(&m, &c, 0.3, 0.4, 0.3, 0.4, row0, row1, res), PM_ERR_ARG);
+        ck_assert_int_eq(pm_fit_add(&g_fit, &c, 0.3, 0.4, 0.3, 0.4), PM_ERR_ARG);
+        ck_assert_int_eq(pm_model_apply_f(&mf, &c, 0.3, 0.4, &af, &bf), PM_ERR_ARG);
+    }
+    ck_assert(a == 7.0 && b == 7.0 && res[0] == 7.0 && res[1] == 7.0 && af == 7.0);
+    ck_assert_int_eq(g_fit.n_obs, 0);
+    for (j = -1; j <= 1; j++) {
+        memset(&c, 0, sizeof c);
+        c.dir = j;
+        ck_assert_int_eq(pm_model_apply(&m, &c, 0.3, 0.4, &a, &b), PM_OK);
+    }
+    /* no term reads it */
+    fit_start(&plain, PM_MOUNT_EQUATORIAL, 1, LAT_N);
+    t = make_term(PM_TERM_AUX, PM_BASE_C, 0, 0, 0, PM_AUX_TEMP, TEMP_START);
+    ck_assert_int_eq(pm_model_add_term(&plain, &t, 2.0 * ARCSEC, NULL), PM_OK);
+    memset(&c, 0, sizeof c);
+    c.dir = 3;
+    c.pier = -2;
+    ck_assert_int_eq(pm_model_apply(&plain, &c, 0.3, 0.4, &a, &b), PM_OK);
+}
+END_TEST
+
 /* ---------------------------------------------------------------------- */
 /* roundtrip: forward and inverse use the context; model files.           */
 /* ---------------------------------------------------------------------- */
@@ -1464,6 +1512,7 @@ static Suite *terms_suite(void)
     tcase_add_test(tc, test_pm_term_name_added_terms);
     tcase_add_test(tc, test_pm_model_apply_aux_null_context);
     tcase_add_test(tc, test_pm_model_apply_aux_nonfinite_context);
+    tcase_add_test(tc, test_pm_model_apply_dir_out_of_range);
     suite_add_tcase(s, tc);
 
     tc = tcase_create("roundtrip");
