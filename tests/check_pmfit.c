@@ -640,7 +640,8 @@ END_TEST
 ** error, which BIC prefers by 11 (likelihood ratio 10^3.5), as "a
 ** better-fitting reading"; it had said "as good a reading" (an outside
 ** probe).  A reading within Delta BIC 6 is still "as good".  The fit of an
-** alt-az run is of "all points", not a "joint fit, both pier sides". */
+** alt-az run is of "all points", not a "joint fit, both pier sides", and
+** its periodic effects are az_periodic and el_periodic. */
 START_TEST(test_pmfit_explain_better_reading_altaz)
 {
     char path[512], inj[600], args[1400];
@@ -653,15 +654,41 @@ START_TEST(test_pmfit_explain_better_reading_altaz)
              path, inj);
     ck_assert_msg(run("%s simulate %s%s", args, "") == 0, "%s", out);
     ck_assert_msg(run("%s explain %s%s", inj, "") == 0, "%s", out);
-    ck_assert_msg(strstr(out, "a better-fitting reading: ha_periodic") != NULL, "%s", out);
+    ck_assert_msg(strstr(out, "a better-fitting reading: az_periodic") != NULL, "%s", out);
+    /* an alt-az mount's periodic effects by its axes' names, in the text and
+    ** the closing command, which fit takes (ha_periodic had been said
+    ** beside "periodic error of the azimuth drive") */
+    ck_assert_msg(strstr(out, "ha_periodic") == NULL && strstr(out, "dec_periodic") == NULL &&
+                      strstr(out, ". az_periodic: periodic error of the azimuth drive") != NULL &&
+                      strstr(out, "--add 'az_periodic:144'") != NULL,
+                  "%s", out);
     for (p = strstr(out, "as good a reading: "); p; p = strstr(p + 1, "as good a reading: ")) {
         const char *b = strstr(p, "Delta BIC ");
         ck_assert_ptr_nonnull(b);
         ck_assert_msg(atof(b + strlen("Delta BIC ")) > -6, "%.200s", p);
     }
+    ck_assert_msg(run("%s explain %s --json%s", inj, "") == 0, "%s", out);
+    ck_assert_msg(strstr(out, "\"effect\": \"ha_periodic\", \"label\": \"az_periodic\"") != NULL,
+                  "%s", out);
     ck_assert_msg(run("%s fit %s%s", path, "") == 0, "%s", out);
     ck_assert_msg(strstr(out, "all points (alt-az mount)") != NULL &&
                       strstr(out, "both pier sides") == NULL, "%s", out);
+    /* --add takes the alt-az names there, the same terms; not on an
+    ** equatorial mount */
+    {
+        double s1, s2;
+        snprintf(args, sizeof args, "%s --add az_periodic:144:2 --add el_periodic:7 --json", path);
+        ck_assert_msg(run("%s fit %s%s", args, "") == 0, "%s", out);
+        s1 = tu_json_num(out, "sigma_arcsec");
+        snprintf(args, sizeof args, "%s --add ha_periodic:144:2 --add dec_periodic:7 --json", path);
+        ck_assert_msg(run("%s fit %s%s", args, "") == 0, "%s", out);
+        s2 = tu_json_num(out, "sigma_arcsec");
+        ck_assert(s1 == s2);
+        snprintf(args, sizeof args, "%s/examples/sim_gem.dat --add az_periodic:144",
+                 getenv("PM_TOP") ? getenv("PM_TOP") : ".");
+        ck_assert_int_ne(run("%s fit %s%s", args, ""), 0);
+        ck_assert_msg(strstr(out, "az_periodic is an alt-az mount's") != NULL, "%s", out);
+    }
 }
 END_TEST
 

@@ -124,6 +124,8 @@ void usage(FILE *f)
         "                     ha_periodic:G[:H]   periodic error of G cycles/rev on the HA\n"
         "                                         axis, harmonics 1..H (default 1)\n"
         "                     dec_periodic:G[:H]  the same on the Dec axis\n"
+        "                     az_periodic:G[:H], el_periodic:G[:H]   the same on an alt-az\n"
+        "                                         mount's azimuth and elevation axes\n"
         "                     ha_periodic_paper:G the paper's Y(G,+-G) form, for comparison\n"
         "                     refraction          cot(elevation) toward the zenith\n"
         "                     tube_flexure        cos(elevation) toward the zenith\n"
@@ -170,8 +172,9 @@ void usage(FILE *f)
         "  located variable, periodograms, sigma per step; --robust: explain the points a\n"
         "  robust fit of the baseline keeps (the rejected ones are listed); --gear G: a known\n"
         "  gear period (cycles per revolution, e.g. the worm's tooth count; ha:G or dec:G for\n"
-        "  one axis, repeatable): the periodic search looks at the given periods only, so a\n"
-        "  smaller periodic error is significant (docs/explain.md); the baseline's anisotropic\n"
+        "  one axis, az:G or el:G on an alt-az mount; repeatable): the periodic search looks\n"
+        "  at the given periods only, so a smaller periodic error is significant\n"
+        "  (docs/explain.md); the baseline's anisotropic\n"
         "  terms are read as the mount's gimbal composes them, their second-order part taken\n"
         "  out before the search where that fits better (--no-compose: to first order), and\n"
         "  read again with the terms the search found; its fits run on as many threads as the\n"
@@ -296,6 +299,26 @@ double number(const std::string &opt, const char *v, double lo, double hi)
     return x;
 }
 
+// --gear [ha:|dec:]G: the axes a gear period is for (*ha, *dec) and G's
+// text.  az: and el: name an alt-az mount's axis 1 and 2 as ha: and dec:
+// do (the text of an alt-az run speaks of az_periodic and el_periodic).
+std::string gear_axes(const std::string &v, bool *ha, bool *dec)
+{
+    static const char *const one[2] = {"ha:", "az:"}, *const two[2] = {"dec:", "el:"};
+    *ha = *dec = true;
+    for (int k = 0; k < 2; k++) {
+        if (v.rfind(one[k], 0) == 0) {
+            *dec = false;
+            return v.substr(3);
+        }
+        if (v.rfind(two[k], 0) == 0) {
+            *ha = false;
+            return v.substr(std::string(two[k]).size());
+        }
+    }
+    return v;
+}
+
 // --format NAME and --equinox E (every command that reads a run).
 void set_format(Options &o, const std::string &v)
 {
@@ -348,8 +371,9 @@ Options parse_report(Options o, int argc, char **argv)
             o.alpha = number(a, need("a probability"), 1e-12, 0.5);
         } else if (a == "--gear") {
             std::string v = need("a gear period in cycles per revolution ([ha:|dec:]G)");
-            bool ha = v.rfind("dec:", 0) != 0, dec = v.rfind("ha:", 0) != 0;
-            double g = number(a, v.substr(ha && dec ? 0 : v.find(':') + 1).c_str(), 1e-6, 1e6);
+            bool ha, dec;
+            v = gear_axes(v, &ha, &dec);
+            double g = number(a, v.c_str(), 1e-6, 1e6);
             if (ha)
                 o.gears_ha.push_back(g);
             if (dec)
@@ -463,14 +487,8 @@ bool explain_option(Options &o, const Cmd &c, Args &g)
         o.compose = false;
     } else if (a == "--gear") {
         std::string v = g.need("a gear period in cycles per revolution ([ha:|dec:]G)");
-        bool ha = true, dec = true;
-        if (v.rfind("ha:", 0) == 0) {
-            dec = false;
-            v = v.substr(3);
-        } else if (v.rfind("dec:", 0) == 0) {
-            ha = false;
-            v = v.substr(4);
-        }
+        bool ha, dec;
+        v = gear_axes(v, &ha, &dec);
         double gp = number(a, v.c_str(), 1e-6, 1e6);
         if (ha)
             o.gears_ha.push_back(gp);

@@ -36,9 +36,12 @@ std::string alternatives_json(const std::vector<Alternative> &alts)
     return j + "]";
 }
 
-std::string finding_json(const Finding &f)
+std::string finding_json(const Finding &f, int mount)
 {
-    std::string j = "{\"effect\": " + str(f.effect);
+    // (label: the effect as the text names it, az_periodic and el_periodic
+    // on an alt-az mount; effect: the name of either mount's axis 1 and 2)
+    std::string j = "{\"effect\": " + str(f.effect) + ", \"label\": " +
+                    str(mount_words(f.effect, mount));
     if (f.effect == "ha_periodic" || f.effect == "dec_periodic")
         j += ", \"cycles_per_rev\": " + num(f.cycles_per_rev) + ", \"cycles_per_rev_range\": [" +
              num(f.cycles_lo) + ", " + num(f.cycles_hi) + "], \"axis_sampled_deg\": " +
@@ -155,7 +158,7 @@ std::string explain_json(const Run &run, const Explanation &ex, int order)
              ", \"threshold\": " + num(ex.periodograms[i].threshold) + "}";
     j += "], \"findings\": [";
     for (size_t i = 0; i < ex.findings.size(); i++)
-        j += std::string(i ? ", " : "") + finding_json(ex.findings[i]);
+        j += std::string(i ? ", " : "") + finding_json(ex.findings[i], run.mount);
     j += "], \"withdrawn\": [";
     for (size_t i = 0; i < ex.withdrawn.size(); i++)
         j += std::string(i ? ", " : "") + "{\"effect\": " + str(ex.withdrawn[i].effect) +
@@ -237,8 +240,10 @@ std::string cv_cell(double x)
     return std::isfinite(x) ? fmt("%10.3f", x) : fmt("%10s", "n/a");
 }
 
-void print_findings(const Explanation &ex, double alpha)
+void print_findings(const Explanation &ex, double alpha, int mount)
 {
+    // an alt-az mount's periodic effects by its axes' names (mount_words)
+    auto W = [mount](const std::string &x) { return mount_words(x, mount); };
     std::printf("\nfindings:\n");
     if (ex.findings.empty() && ex.unmodelled.empty() && ex.blurred.empty() && ex.unfitted.empty())
         std::printf("  none: nothing significant is left out (false-alarm probability below %g "
@@ -250,14 +255,14 @@ void print_findings(const Explanation &ex, double alpha)
                     alpha);
     for (size_t i = 0; i < ex.findings.size(); i++) {
         const Finding &f = ex.findings[i];
-        std::printf("  %zu. %s: %s\n", i + 1, f.effect.c_str(), f.text.c_str());
+        std::printf("  %zu. %s: %s\n", i + 1, W(f.effect).c_str(), W(f.text).c_str());
         if (!f.with.empty())
             std::printf("     found together with %s: neither alone passed, the pair does\n",
-                        f.with.c_str());
+                        W(f.with).c_str());
         // the sizes above are the final model's, these the step's (docs/explain.md step 5)
         std::printf("     where: %s\n     step %d: false-alarm probability %.2g (10^%.1f); with "
                     "it sigma %.3f\", CV RMS %s, P = %d\n",
-                    f.where.c_str(), f.step, f.false_alarm_probability, f.log10_p,
+                    W(f.where).c_str(), f.step, f.false_alarm_probability, f.log10_p,
                     f.sigma_after_arcsec, cv_text(f.cv_rms_after_arcsec).c_str(), f.n_params_after);
         for (const Alternative &a : f.alternatives) {
             if (a.smooth)
@@ -265,40 +270,40 @@ void print_findings(const Explanation &ex, double alpha)
                             "periodic term explains, so this run cannot tell a periodic error "
                             "from a smooth distortion (Delta BIC %+.1f prefers %s for its fewer "
                             "terms); to separate them: %s\n",
-                            a.effect.c_str(), a.log10_fap, a.delta_bic, f.effect.c_str(),
-                            a.separate_by.c_str());
+                            W(a.effect).c_str(), a.log10_fap, a.delta_bic, W(f.effect).c_str(),
+                            W(a.separate_by).c_str());
             else if (a.final_model) // (a better one where the evidence is clear for it)
                 std::printf("     %s reading in the final model: %s (false-alarm 10^%.1f "
                             "there, Delta BIC %+.1f with as many terms, likelihood ratio 10^%.2f "
                             "in favour of %s; the step that found %s had the later findings "
                             "still in its residuals); to separate them: %s\n",
-                            a.delta_bic <= -6 ? "a better" : "as good a", a.effect.c_str(),
+                            a.delta_bic <= -6 ? "a better" : "as good a", W(a.effect).c_str(),
                             a.log10_fap, a.delta_bic, std::fabs(a.log10_lr),
-                            a.log10_lr >= 0 ? f.effect.c_str() : a.effect.c_str(),
-                            f.effect.c_str(), a.separate_by.c_str());
+                            a.log10_lr >= 0 ? W(f.effect).c_str() : W(a.effect).c_str(),
+                            W(f.effect).c_str(), W(a.separate_by).c_str());
             else // (the finding won by its false-alarm probability, which counts the
                  // periods and candidates tried; where BIC clearly prefers the other,
                  // "as good" overstated it: an outside probe's 10^3.53 in its favour)
                 std::printf("     %s reading: %s (false-alarm 10^%.1f, Delta BIC %+.1f%s, "
                             "likelihood ratio 10^%.2f in favour of %s); to separate them: %s\n",
                             a.delta_bic <= -6 ? "a better-fitting" : "as good a",
-                            a.effect.c_str(), a.log10_fap, a.delta_bic,
+                            W(a.effect).c_str(), a.log10_fap, a.delta_bic,
                             a.delta_bic < 0 ? ": BIC, which does not count the periods or "
                                               "candidates tried, prefers it" : "",
                             std::fabs(a.log10_lr),
-                            a.log10_lr >= 0 ? f.effect.c_str() : a.effect.c_str(),
-                            a.separate_by.c_str());
+                            a.log10_lr >= 0 ? W(f.effect).c_str() : W(a.effect).c_str(),
+                            W(a.separate_by).c_str());
         }
     }
     for (size_t i = 0; i < ex.withdrawn.size(); i++)
         std::printf("  withdrawn: %s; the findings above are those of the search without it\n",
-                    ex.withdrawn_why[i].c_str());
+                    W(ex.withdrawn_why[i]).c_str());
     for (const Unmodelled &u : ex.unmodelled)
-        std::printf("  significant, not modelled: %s\n", unmodelled_text(u).c_str());
+        std::printf("  significant, not modelled: %s\n", W(unmodelled_text(u)).c_str());
     for (const Explanation::Blurred &b : ex.blurred)
-        std::printf("  significant, not named: %s\n", blurred_text(b).c_str());
+        std::printf("  significant, not named: %s\n", W(blurred_text(b)).c_str());
     for (const Explanation::Unfitted &u : ex.unfitted)
-        std::printf("  not judged: %s\n", unfitted_text(u).c_str());
+        std::printf("  not judged: %s\n", W(unfitted_text(u)).c_str());
 }
 
 } // namespace
@@ -356,12 +361,13 @@ void print_explain_text(const Run &run, const Explanation &ex, int order, bool a
             std::printf("  %s\n", ex.physical_reading.c_str());
     }
     print_located(ex, alpha, gears_ha, gears_dec, run.mount == PM_MOUNT_ALTAZ);
-    print_findings(ex, alpha);
+    print_findings(ex, alpha, run.mount);
     std::printf("\n  %-22s %5s %10s %10s\n", "step", "P", "sigma(\")", "CV RMS(\")");
     std::printf("  %-22s %5d %10.3f %s\n", "baseline", ex.base_n_params, ex.base_sigma_arcsec,
                 cv_cell(ex.base_cv_rms_arcsec).c_str());
     for (const Finding &f : ex.findings)
-        std::printf("  %-22s %5d %10.3f %s\n", ("+ " + f.effect).c_str(), f.n_params_after,
+        std::printf("  %-22s %5d %10.3f %s\n", ("+ " + mount_words(f.effect, run.mount)).c_str(),
+                    f.n_params_after,
                     f.sigma_after_arcsec, cv_cell(f.cv_rms_after_arcsec).c_str());
     const auto nt = not_tried_why(run);
     for (size_t k = 0; k < nt.size(); k++) {
@@ -378,7 +384,7 @@ void print_explain_text(const Run &run, const Explanation &ex, int order, bool a
     }
     std::printf("\n  pmfit fit %s --order %d", shell_word(run.path).c_str(), ex.final_order);
     for (const std::string &a : ex.final_adds)
-        std::printf(" --add %s", add_word(a).c_str());
+        std::printf(" --add %s", add_word(mount_words(a, run.mount)).c_str());
     std::vector<int> bad;
     for (const Finding &f : ex.findings)
         if (f.effect == "outlier")

@@ -3,6 +3,7 @@
 #include "runfile.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -109,6 +110,26 @@ static bool axis_cut(const std::vector<double> &ang, double *cut)
 const char *axis2_dir_name(int mount)
 {
     return mount == PM_MOUNT_ALTAZ ? "el_dir" : "dec_dir";
+}
+
+std::string mount_words(const std::string &s, int mount)
+{
+    if (mount != PM_MOUNT_ALTAZ)
+        return s;
+    std::string r = s;
+    static const char *const from[2] = {"ha_periodic", "dec_periodic"};
+    static const char *const to[2] = {"az_periodic", "el_periodic"};
+    for (int k = 0; k < 2; k++) {
+        const std::string f = from[k], t = to[k];
+        for (size_t p = r.find(f); p != std::string::npos; p = r.find(f, p + t.size())) {
+            const bool word_start = p == 0 || !(std::isalnum((unsigned char)r[p - 1]) || r[p - 1] == '_');
+            const size_t e = p + f.size();
+            const bool paper = r.compare(e, 6, "_paper") == 0; // (the paper's form keeps its name)
+            if (word_start && !paper)
+                r.replace(p, f.size(), t);
+        }
+    }
+    return r;
 }
 
 void derive_directions(Run &r)
@@ -657,6 +678,14 @@ pm_model build_model(int order, const std::vector<std::string> &adds,
         pm_term t;
         std::memset(&t, 0, sizeof t);
         t.side = (signed char)a.side;
+        if (a.f[0] == "az_periodic" || a.f[0] == "el_periodic") {
+            // (an alt-az mount's names of axis 1 and 2's periodic errors)
+            if (mount != PM_MOUNT_ALTAZ)
+                throw std::runtime_error("--add " + spec + ": " + a.f[0] + " is an alt-az mount's; "
+                                         "on an equatorial mount the axes' periodic errors are "
+                                         "ha_periodic and dec_periodic");
+            a.f[0] = a.f[0] == "az_periodic" ? "ha_periodic" : "dec_periodic";
+        }
         const std::string &name = a.f[0];
         if (name == "ha_periodic" || name == "dec_periodic")
             add_periodic(b, a, t);

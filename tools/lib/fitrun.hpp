@@ -70,6 +70,12 @@ void derive_directions(Run &r);
 // The name of the derived slew direction on axis 2: "el_dir" on an alt-az
 // mount, "dec_dir" on an equatorial one.
 const char *axis2_dir_name(int mount);
+// The names of an alt-az mount's periodic effects where the text speaks of
+// its axes: "ha_periodic" and "dec_periodic" (axis 1 and 2 of either
+// mount, the names in JSON and model files) read "az_periodic" and
+// "el_periodic" in s on an alt-az mount; s unchanged on an equatorial one.
+// --add takes both names on an alt-az mount (build_model).
+std::string mount_words(const std::string &s, int mount);
 // The widest empty arc of the angles (radians) on the circle: its width
 // (2 pi for fewer than two angles), and where middle is given its middle,
 // in (-pi, pi].  (explain's sampled extent of an axis is the circle less

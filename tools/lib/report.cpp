@@ -623,14 +623,17 @@ void finding_figure(Page &p, const Data &d, const Finding &f, size_t k)
     }
     std::string bt = fmt("without it: sigma %.2f\"", before.res.sigma * RAD2AS);
     std::string at = fmt("with it: sigma %.2f\"", d.ex.final.res.sigma * RAD2AS);
-    figure(p, fmt("Finding %zu, <b>%s</b>, before and after: the residuals (arcsec; ", k + 1, h(f.effect).c_str()) +
+    figure(p, fmt("Finding %zu, <b>%s</b>, before and after: the residuals (arcsec; ", k + 1,
+                  h(mount_words(f.effect, d.run.mount)).c_str()) +
                   (f.effect == "ha_periodic" ? "axis 1 along the axis, i.e. divided by cos declination, " : "") +
                   h(axis_names(d)) + ") against " + h(xlab) + ", " +
                   (refit ? "left: the explained model refitted without this finding; right: the explained model."
                          : "left: the baseline model; right: the explained model.") +
                   " The pattern on the left that is gone on the right is what the finding explains.",
            [&](const pmplot::Out &out, std::string *err) {
-               return pmplot::xy_pair(out, fmt("Finding %zu: %s", k + 1, f.effect.c_str()), xlab, "residual (arcsec)",
+               return pmplot::xy_pair(out, fmt("Finding %zu: %s", k + 1,
+                                               mount_words(f.effect, d.run.mount).c_str()),
+                                      xlab, "residual (arcsec)",
                                       b, a, bt, at, err);
            });
 }
@@ -639,11 +642,13 @@ void finding_figure(Page &p, const Data &d, const Finding &f, size_t k)
 void explain_findings(Page &p, const Data &d)
 {
     const Explanation &ex = d.ex;
+    // an alt-az mount's periodic effects by its axes' names (mount_words)
+    auto W = [&d](const std::string &x) { return mount_words(x, d.run.mount); };
     std::vector<std::vector<std::string>> rows = {
         {"0", "baseline", "", num(ex.base_sigma_arcsec, 3), num(ex.base_cv_rms_arcsec, 3), fmt("%d", ex.base_n_params)}};
     for (size_t k = 0; k < ex.findings.size(); k++) {
         const Finding &f = ex.findings[k];
-        rows.push_back({fmt("%zu", k + 1), fmt("<a href=\"#finding%zu\">", k + 1) + h(f.effect) + "</a>",
+        rows.push_back({fmt("%zu", k + 1), fmt("<a href=\"#finding%zu\">", k + 1) + h(W(f.effect)) + "</a>",
                         fmt("%.2g", f.false_alarm_probability), num(f.sigma_after_arcsec, 3),
                         num(f.cv_rms_after_arcsec, 3), fmt("%d", f.n_params_after)});
     }
@@ -656,33 +661,34 @@ void explain_findings(Page &p, const Data &d)
         const Finding &f = ex.findings[k];
         std::string extra;
         if (!f.with.empty())
-            extra += "<li>Found together with " + h(f.with) + ": neither alone passed, the pair does.</li>";
+            extra += "<li>Found together with " + h(W(f.with)) + ": neither alone passed, the pair does.</li>";
         for (const Alternative &a : f.alternatives)
             extra += std::string(a.smooth        ? "<li>Or a smooth shape: <b>"
                                  : a.final_model ? (a.delta_bic <= -6
                                                         ? "<li>A better reading in the final model: <b>"
                                                         : "<li>As good a reading in the final model: <b>")
-                                                 : "<li>As good a reading: <b>") +
-                     h(a.effect) +
+                                                 : a.delta_bic <= -6 ? "<li>A better-fitting reading: <b>"
+                                                                    : "<li>As good a reading: <b>") +
+                     h(W(a.effect)) +
                      fmt("</b> (false-alarm 10<sup>%.1f</sup>, &Delta;BIC %+.1f%s); to separate them: ",
                          a.log10_fap, a.delta_bic,
                          a.smooth ? ": it holds all that the periodic term explains, so this run cannot "
                                     "tell a periodic error from a smooth distortion" : "") +
-                     h(a.separate_by) + "</li>";
-        p.body += fmt("<h3 id=\"finding%zu\">Finding %zu: ", k + 1, k + 1) + h(f.effect) + "</h3>\n";
-        para(p, h(f.text) + ". <i>Where:</i> " + h(f.where) + ".");
+                     h(W(a.separate_by)) + "</li>";
+        p.body += fmt("<h3 id=\"finding%zu\">Finding %zu: ", k + 1, k + 1) + h(W(f.effect)) + "</h3>\n";
+        para(p, h(W(f.text)) + ". <i>Where:</i> " + h(W(f.where)) + ".");
         if (!extra.empty())
             p.body += "<ul>" + extra + "</ul>\n";
         finding_figure(p, d, f, k);
     }
     for (const std::string &w : ex.withdrawn_why)
-        para(p, "Withdrawn: " + h(w) + "; the findings above are those of the search without it.");
+        para(p, "Withdrawn: " + h(W(w)) + "; the findings above are those of the search without it.");
     for (const Unmodelled &u : ex.unmodelled)
-        para(p, "<b>Significant, not modelled:</b> " + h(unmodelled_text(u)) + ".");
+        para(p, "<b>Significant, not modelled:</b> " + h(W(unmodelled_text(u))) + ".");
     for (const Explanation::Blurred &b : ex.blurred)
-        para(p, "<b>Significant, not named:</b> " + h(blurred_text(b)) + ".");
+        para(p, "<b>Significant, not named:</b> " + h(W(blurred_text(b))) + ".");
     for (const Explanation::Unfitted &u : ex.unfitted)
-        para(p, "<b>Not judged:</b> " + h(unfitted_text(u)) + ".");
+        para(p, "<b>Not judged:</b> " + h(W(unfitted_text(u))) + ".");
 }
 
 void section_explain(Page &p, const Data &d)
@@ -712,7 +718,7 @@ void section_explain(Page &p, const Data &d)
     explain_findings(p, d);
     std::string cmd = fmt("pmfit fit %s --order %d", shell_word(d.run.path).c_str(), ex.final_order);
     for (const std::string &a : ex.final_adds)
-        cmd += " --add " + add_word(a);
+        cmd += " --add " + add_word(mount_words(a, d.run.mount));
     para(p, "The explained model: <code>" + h(cmd) + "</code>");
     figure(p, "Residuals on the sky (arcsec, scale arrow in the legend) of the baseline (left) and of the "
               "explained model (right), on the same axes and arrow scale: " + h(d.xlabel()) + " and " +
