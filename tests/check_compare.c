@@ -115,6 +115,15 @@ START_TEST(test_compare_simulated_nights)
         ck_assert(fabs(tu_json_num(out, "c_arcsec") - 12) <=
                   3 * hypot(tu_json_num(out, "c_error_arcsec"), old_c_err));
         ck_assert_ptr_nonnull(strstr(out, "re-zero the index terms"));
+        /* the re-zeroed model's own RMS on the run (the report's table had
+        ** left its cell empty): below the old model's as it is, the index
+        ** change taken out */
+        {
+            const char *r = strstr(out, "\"rezero\": {");
+            ck_assert_ptr_nonnull(r);
+            ck_assert_double_lt(tu_json_num(r, "rms_arcsec"), tu_json_num(out, "rms_as_is_arcsec"));
+            ck_assert_double_gt(tu_json_num(r, "rms_arcsec"), 0);
+        }
 
         compare(olds[k], "n4.dat");
         printf("check_compare: %s vs d*Y(1,0) + 15\": %s\n", olds[k], strstr(out, "\"advice\""));

@@ -25,6 +25,8 @@ struct Comparison {
     int n_terms = 0;
     bool old_has_errors = false;   // OLD was a run (its errors count), not a model file
     double rms_as_is = 0;          // per axis, the new run under the old model, no refit
+    double rms_rezero = NAN;       // per axis, under the old model re-zeroed on it (NaN: the
+                                   // re-zero failed)
     double sigma_refit = 0;        // unbiased sigma of the refit
     std::vector<TermChange> moved; // |z| >= 3, largest first
     int n_stable = 0;              // terms that did not move (|z| < 3)

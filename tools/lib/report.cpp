@@ -807,7 +807,9 @@ void section_compare(Page &p, const Data &d)
     std::vector<std::vector<std::string>> rows = {
         {"the old model as it is", num(c.rms_as_is, 3), num(c.cv_as_is, 3)},
         {fmt("the old model re-zeroed (c&prime; %+.2f &plusmn; %.2f&Prime;, e&prime; %+.2f &plusmn; %.2f&Prime;)",
-             c.rezero_c, c.rezero_c_err, c.rezero_e, c.rezero_e_err), "", num(c.cv_rezero, 3)},
+             c.rezero_c, c.rezero_c_err, c.rezero_e, c.rezero_e_err),
+         std::isfinite(c.rms_rezero) ? num(c.rms_rezero, 3) : std::string("&mdash;"),
+         num(c.cv_rezero, 3)},
         {"refitted to this run", num(c.sigma_refit, 3), num(c.cv_refit, 3)}};
     table(p, "The pointing error on this run (per axis): residual RMS (for the refit: its unbiased &sigma;) and the "
              "5-fold cross-validated RMS, which says how each would point at new stars.",
