@@ -397,7 +397,7 @@ RobustFit robust_fit(const std::vector<Obs> &obs, const std::vector<int> &use,
         // phase 1: the median (robust while gross errors may still be kept);
         // phase 2, once that set is stable: the RMS of the kept distances,
         // corrected for the truncation at clip (twice as precise: sigma of
-        // the median is 0.72 sigma/sqrt(N), of the RMS 0.35 sigma/sqrt(N))
+        // the median is 0.72 sigma/sqrt(N), of the RMS 0.35 sigma/sqrt(N)).
         // The final threshold on d / sigma_robust: the scale is estimated
         // from 2M - P degrees of freedom, so a rejected point's ratio has
         // the tail of F(2, nu), not of chi^2(2): at nu = 38 (30 points,
@@ -405,19 +405,9 @@ RobustFit robust_fit(const std::vector<Obs> &obs, const std::vector<int> &use,
         // not 1e-4 (an outside probe: 7 of 9000).  (The median's rounds
         // only find the set the RMS rounds start from.)
         const double k_rms = studentised_clip(clip, 2.0 * (double)kept - p), k_med = clip;
-        // E[d^2 | d < c sigma] / E[d^2] for d^2/sigma^2 ~ chi^2(2), where
-        // c is the threshold or, where more points are left out than it
-        // leaves out of clean ones, the point of the Rayleigh tail that
-        // holds as many (the consistency factor of a trimmed scale, as in
-        // LTS's reweighting): otherwise a small run's scale from the points
-        // its few largest clean residuals left behind is too small and
-        // keeps them out (30 clean points at --clip 3: five rejected at a
-        // scale of 0.6 sigma, a state that holds itself)
-        double c = k_rms;
-        if (kept < n)
-            c = std::min(c, std::sqrt(-2 * std::log((double)(n - kept) / (double)n)));
-        const double e = std::exp(-c * c / 2);
-        const double trunc = 1 - (c * c / 2) * e / (1 - e);
+        // E[d^2 | d < K sigma] / E[d^2] for d^2/sigma^2 ~ chi^2(2)
+        const double e = std::exp(-k_rms * k_rms / 2);
+        const double trunc = 1 - (k_rms * k_rms / 2) * e / (1 - e);
         double s_med = median(kr) / RAYLEIGH_MEDIAN * shrink;
         double s_rms = std::sqrt(ss / (2.0 * (double)kept) / trunc) * shrink;
         auto decide = [&](double threshold) {
