@@ -1087,7 +1087,14 @@ pm_status pm_fit_solve(pm_fit *fit, pm_model *out, pm_fit_result *res);
 **     for a model beyond the six isotropic terms, from the six of the
 **     better order-0 fit from these two starts, and returns the fit of
 **     least chi^2, a later start only where it is lower beyond rounding
-**     (the workspace as that fit left it).
+**     (the workspace as that fit left it).  A cold start (the six
+**     isotropic terms all 0) that takes no start from the offsets runs
+**     the order-0 fit from zero as well, and where the model's fit ends
+**     above that fit's chi^2 (which it holds, so at its least-squares fit
+**     it is no larger: a false minimum) it runs again from its six (an
+**     outside probe's German runs beyond the pole with index offsets under
+**     PM_FIT_INDEX_START stopped at order 1 at 8,142" with PM_OK, 2.77" at
+**     order 0).  A refit from a model does not pay for it.
 **     Gauss-Newton from zero converges for index errors of a few degrees;
 **     an unsynchronised encoder's tens stopped in a local minimum that
 **     PM_OK reported (an alt-az azimuth zero 60 deg off: sigma 14" for 1"

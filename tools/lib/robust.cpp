@@ -194,11 +194,34 @@ Lts concentrate(const std::vector<Obs> &obs, const std::vector<int> &use, size_t
     return l;
 }
 
+// The scale of the first kept set: from the best hh points' median, i.e.
+// the quantile q = (hh/2 + 1/2)/N of |r| over all (Rayleigh: sigma
+// sqrt(-2 ln(1-q))), for the hh points' fit of p terms.
+double first_scale(std::vector<double> rho, size_t hh, int p)
+{
+    std::sort(rho.begin(), rho.end());
+    const size_t j = hh / 2;
+    const double q = ((double)j + 0.5) / (double)rho.size();
+    return rho[j] / std::sqrt(-2 * std::log(1 - q)) * shrinkage(hh, p);
+}
+
+// Does m leave a point of use beyond clip times the first scale of its h
+// best?  (True where a residual fails.)
+bool beyond_first_threshold(const pm_model &m, const std::vector<Obs> &obs,
+                            const std::vector<int> &use, size_t h, int p, double clip)
+{
+    std::vector<double> r0, r1, rho;
+    if (!all_residuals(m, obs, use, r0, r1, rho))
+        return true;
+    const double lim = clip * first_scale(rho, h, p);
+    return std::any_of(rho.begin(), rho.end(), [lim](double x) { return x > lim; });
+}
+
 // The start that a cluster of gross errors cannot bend: order-0 fits (the
 // six isotropic terms, which carry nearly all of a mount's pointing) of
-// random four-point subsets, each followed by two concentration steps at
-// order 0; the best of them by its trimmed objective, its h points fitted
-// with the full model and concentrated to the end.  A least-squares fit of
+// random four-point subsets, the ten of least trimmed objective followed by
+// two concentration steps at order 0; the best of them, its h points
+// fitted with the full model and concentrated to the end.  A least-squares fit of
 // all points leans towards a cluster of failed solves all off the same way
 // (20% of a run in one part of the sky: clipping from it kept part of the
 // cluster and rejected 32 good points, an outside probe), while one of
@@ -224,18 +247,27 @@ Lts order0_start(const std::vector<Obs> &obs, const std::vector<int> &use, size_
         z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
         return z ^ (z >> 31);
     };
-    Lts b0;
+    // each subset's fit judged by its trimmed objective; the best ten of
+    // them concentrated two steps (Rousseeuw & Van Driessen's selection)
+    std::vector<std::pair<double, pm_model>> cand;
     for (int s = 0; s < 60; s++) {
-        std::vector<int> sub;
+        std::vector<int> sub, hs;
         while (sub.size() < 4) {
             int k = use[(size_t)(next() % n)];
             if (std::find(sub.begin(), sub.end(), k) == sub.end())
                 sub.push_back(k);
         }
         FitOut g = do_fit(obs, sub, m0, max_passes);
-        if (g.status != PM_OK)
-            continue;
-        Lts l = concentrate(obs, use, h, g.model, max_passes, 2);
+        double q;
+        if (g.status == PM_OK && smallest(g.model, obs, use, h, hs, q))
+            cand.emplace_back(q, g.model);
+    }
+    std::stable_sort(cand.begin(), cand.end(),
+                     [](const std::pair<double, pm_model> &x,
+                        const std::pair<double, pm_model> &y) { return x.first < y.first; });
+    Lts b0;
+    for (size_t k = 0; k < cand.size() && k < 10; k++) {
+        Lts l = concentrate(obs, use, h, cand[k].second, max_passes, 2);
         if (l.ok && (!b0.ok || l.q < b0.q))
             b0 = l;
     }
@@ -317,35 +349,36 @@ RobustFit robust_fit(const std::vector<Obs> &obs, const std::vector<int> &use,
     rf.lts_start = h < n;
     if (rf.lts_start) {
         Lts a = concentrate(obs, use, h, rf.fit.model, max_passes, 30);
-        Lts b = order0_start(obs, use, h, start, max_passes);
-        // the subsets' start only where its half fits far better (a tenth of
-        // the objective): behind a cluster of gross errors the fit of all
-        // points leaves one of 1e-4 or less (an outside probe's runs), while
-        // a run of broad, heavy-tailed residuals has halves of either start
-        // within a factor of a few (gem-28 0.86 at L=1, cgx-l 0.40), and
-        // what it keeps is for the fit's model terms and explain to read,
-        // not gross errors to clip (docs/robust.md)
-        if (b.ok && (!a.ok || b.q < 0.1 * a.q))
-            a = b;
+        // the subsets' start where the first leaves a point beyond the
+        // threshold (a run it leaves none in has nothing to clip, and the
+        // subsets cost more than the rest of the robust fit: 60 fits and
+        // their concentration steps), and taken only where its half fits
+        // far better (a tenth of the objective): behind a cluster of gross
+        // errors the fit of all points leaves one of 1e-4 or less (an
+        // outside probe's runs), while a run of broad, heavy-tailed
+        // residuals has halves of either start within a factor of a few
+        // (gem-28 0.86 at L=1, cgx-l 0.40), and what it keeps is for the
+        // fit's model terms and explain to read, not gross errors to clip
+        // (docs/robust.md)
+        if (!a.ok || beyond_first_threshold(a.model, obs, use, h, p, clip)) {
+            Lts b = order0_start(obs, use, h, start, max_passes);
+            if (b.ok && (!a.ok || b.q < 0.1 * a.q))
+                a = b;
+        }
         if (a.ok)
             model = a.model;
         else // singular on every half: start from all points
             rf.lts_start = false;
     }
 
-    // the first kept set: the scale from the best h points' median, i.e. the
-    // quantile q = (h/2 + 1/2)/N of |r| over all (Rayleigh: sigma sqrt(-2 ln(1-q)))
+    // the first kept set: within the first threshold (first_scale)
     if (!all_residuals(model, obs, use, r0, r1, rho)) {
         rf.fit.status = PM_ERR_NONFINITE;
         return rf;
     }
     std::vector<char> keep(n, 1);
     {
-        std::vector<double> s(rho);
-        std::sort(s.begin(), s.end());
-        size_t hh = rf.lts_start ? h : n, j = hh / 2;
-        double q = ((double)j + 0.5) / (double)n;
-        double sig = s[j] / std::sqrt(-2 * std::log(1 - q)) * shrinkage(hh, p);
+        const double sig = first_scale(rho, rf.lts_start ? h : n, p);
         for (size_t i = 0; i < n; i++)
             keep[i] = rho[i] <= clip * sig;
     }
