@@ -688,6 +688,42 @@ START_TEST(test_pmfit_explain_better_reading_altaz)
                  getenv("PM_TOP") ? getenv("PM_TOP") : ".");
         ck_assert_int_ne(run("%s fit %s%s", args, ""), 0);
         ck_assert_msg(strstr(out, "az_periodic is an alt-az mount's") != NULL, "%s", out);
+        snprintf(args, sizeof args, "%s/examples/sim_gem.dat --gear az:144",
+                 getenv("PM_TOP") ? getenv("PM_TOP") : ".");
+        ck_assert_int_ne(run("%s explain %s%s", args, ""), 0);
+        ck_assert_msg(strstr(out, "--gear az:G and el:G name an alt-az mount's axes") != NULL, "%s",
+                      out);
+    }
+    /* the plots (file names, titles) and the report's captions in its axes'
+    ** words too (an outside probe: "Finding 1, ha_periodic", "divided by cos
+    ** declination" on an alt-az run) */
+    {
+        char dir[600], page[700], *text;
+        snprintf(dir, sizeof dir, "%s/kae_plots", tmpdir);
+        snprintf(args, sizeof args, "%s --plots %s", inj, dir);
+        ck_assert_msg(run("%s explain %s%s", args, "") == 0, "%s", out);
+        snprintf(page, sizeof page, "%s/finding2_az_periodic.svg", dir);
+        text = tu_slurp(page);
+        ck_assert_msg(text != NULL, "no %s", page);
+        ck_assert(strstr(text, "Finding 2, az_periodic") != NULL);
+        free(text);
+        snprintf(page, sizeof page, "%s/periodogram_az.svg", dir);
+        text = tu_slurp(page);
+        ck_assert_msg(text != NULL, "no %s", page);
+        free(text);
+        snprintf(page, sizeof page, "%s/steps.svg", dir);
+        text = tu_slurp(page);
+        ck_assert_ptr_nonnull(text);
+        ck_assert(strstr(text, "ha_periodic") == NULL && strstr(text, "az_periodic") != NULL);
+        free(text);
+        snprintf(page, sizeof page, "%s/kae.html", tmpdir);
+        snprintf(args, sizeof args, "%s -o %s", inj, page);
+        ck_assert_msg(run("%s report %s%s", args, "") == 0, "%s", out);
+        text = tu_slurp(page);
+        ck_assert_ptr_nonnull(text);
+        ck_assert(strstr(text, "axis 1 along azimuth (divided by cos elevation") != NULL &&
+                  strstr(text, "cos declination") == NULL && strstr(text, "ha_periodic") == NULL);
+        free(text);
     }
 }
 END_TEST

@@ -8,7 +8,7 @@
 //                 [--robust [--clip K]]
 //   pmfit eval MODEL RUN [--json] [--residuals FILE] [--no-refraction] [--skip-bad]
 //   pmfit report RUN -o PAGE.html [--order L] [--add EFFECT ...] [--compare OLD] [--next K]
-//                 [--alpha P] [--gear [ha:|dec:]G ...] [--quiet | --progress]
+//                 [--alpha P] [--gear [ha:|dec:|az:|el:]G ...] [--quiet | --progress]
 //   pmfit simulate OUT [--n N] [--seed S] [--lat DEG] [--mount equatorial|altaz]
 //                 [--fork] [--el-limit DEG] [--noise ARCSEC] [--order L]
 //                 [--term NAME=ARCSEC ...] [--random-aniso ARCSEC]
@@ -69,6 +69,7 @@ struct Options {
     std::string plots;             // explain: --plots DIR
     double alpha = 0.01;           // explain: --alpha
     std::vector<double> gears_ha, gears_dec; // explain: --gear [ha:|dec:]G
+    bool gears_altaz_names = false;          // az:G or el:G given (an alt-az mount's)
     bool compose = true;           // explain: the baseline composed as a gimbal (--no-compose: not)
     bool robust = false;           // fit, explain: --robust (docs/robust.md)
     double clip = ROBUST_DEFAULT_CLIP; // --clip K
@@ -160,7 +161,7 @@ void usage(FILE *f)
         "                   probability 1e-4)\n"
         "\n"
         "usage: pmfit explain RUN [--order L] [--add EFFECT ...] [--json] [--plots DIR]\n"
-        "                     [--alpha P] [--gear [ha:|dec:]G ...] [--no-refraction]\n"
+        "                     [--alpha P] [--gear [ha:|dec:|az:|el:]G ...] [--no-refraction]\n"
         "                     [--skip-bad] [--robust [--clip K]] [--no-compose]\n"
         "\n"
         "  fits the baseline model (order L, default 1, plus --add terms), locates where the\n"
@@ -226,7 +227,7 @@ void usage(FILE *f)
         "\n"
         "usage: pmfit report RUN -o PAGE.html [--order L] [--add EFFECT ...] [--compare OLD]\n"
         "                    [--next K] [--min-el DEG] [--horizon FILE] [--alpha P]\n"
-        "                    [--gear [ha:|dec:]G ...] [--no-refraction] [--skip-bad]\n"
+        "                    [--gear [ha:|dec:|az:|el:]G ...] [--no-refraction] [--skip-bad]\n"
         "                    [--format NAME] [--equinox J2000|JNow]\n"
         "                    [--quiet | --progress]\n"
         "\n"
@@ -302,21 +303,31 @@ double number(const std::string &opt, const char *v, double lo, double hi)
 // --gear [ha:|dec:]G: the axes a gear period is for (*ha, *dec) and G's
 // text.  az: and el: name an alt-az mount's axis 1 and 2 as ha: and dec:
 // do (the text of an alt-az run speaks of az_periodic and el_periodic).
-std::string gear_axes(const std::string &v, bool *ha, bool *dec)
+std::string gear_axes(const std::string &v, bool *ha, bool *dec, bool *altaz_name)
 {
     static const char *const one[2] = {"ha:", "az:"}, *const two[2] = {"dec:", "el:"};
     *ha = *dec = true;
     for (int k = 0; k < 2; k++) {
         if (v.rfind(one[k], 0) == 0) {
             *dec = false;
+            *altaz_name = *altaz_name || k == 1;
             return v.substr(3);
         }
         if (v.rfind(two[k], 0) == 0) {
             *ha = false;
+            *altaz_name = *altaz_name || k == 1;
             return v.substr(std::string(two[k]).size());
         }
     }
     return v;
+}
+
+// az:G and el:G name an alt-az mount's axes: an error on an equatorial run.
+void check_gear_names(const Options &o, const Run &run)
+{
+    if (o.gears_altaz_names && run.mount != PM_MOUNT_ALTAZ)
+        die("--gear az:G and el:G name an alt-az mount's axes; " + run.path +
+            " is of an equatorial mount: ha:G or dec:G");
 }
 
 // --format NAME and --equinox E (every command that reads a run).
@@ -372,7 +383,7 @@ Options parse_report(Options o, int argc, char **argv)
         } else if (a == "--gear") {
             std::string v = need("a gear period in cycles per revolution ([ha:|dec:]G)");
             bool ha, dec;
-            v = gear_axes(v, &ha, &dec);
+            v = gear_axes(v, &ha, &dec, &o.gears_altaz_names);
             double g = number(a, v.c_str(), 1e-6, 1e6);
             if (ha)
                 o.gears_ha.push_back(g);
@@ -488,7 +499,7 @@ bool explain_option(Options &o, const Cmd &c, Args &g)
     } else if (a == "--gear") {
         std::string v = g.need("a gear period in cycles per revolution ([ha:|dec:]G)");
         bool ha, dec;
-        v = gear_axes(v, &ha, &dec);
+        v = gear_axes(v, &ha, &dec, &o.gears_altaz_names);
         double gp = number(a, v.c_str(), 1e-6, 1e6);
         if (ha)
             o.gears_ha.push_back(gp);
@@ -1262,14 +1273,16 @@ void write_explain_plots(const std::string &dir, const Run &run, const Explanati
                                       : (altaz ? "elevation" : "declination"));
         char lab[64];
         std::snprintf(lab, sizeof lab, "false-alarm 1%% over %zu periods", pg.g.size());
-        check(pmplot::periodogram(dir + "/periodogram_" + pg.axis + ".svg", t,
+        // (on an alt-az mount periodogram_az.svg and _el.svg)
+        const std::string axis = !altaz ? pg.axis : pg.axis == "ha" ? "az" : "el";
+        check(pmplot::periodogram(dir + "/periodogram_" + axis + ".svg", t,
                                   "chi^2 reduction / sigma^2", pg.g, pg.power, pg.threshold, lab,
                                   pg.peak_g, true, &err));
     }
     std::vector<std::string> labels = {"baseline"};
     std::vector<double> sig = {ex.base_sigma_arcsec}, cv = {ex.base_cv_rms_arcsec};
     for (const Finding &f : ex.findings) {
-        labels.push_back("+ " + f.effect);
+        labels.push_back("+ " + mount_words(f.effect, run.mount));
         sig.push_back(f.sigma_after_arcsec);
         cv.push_back(f.cv_rms_after_arcsec);
     }
@@ -1293,8 +1306,10 @@ void write_explain_plots(const std::string &dir, const Run &run, const Explanati
             s2.x.push_back(x);
             s2.y.push_back(y1);
         }
-        std::snprintf(t, sizeof t, "Finding %zu, %s: baseline residuals", k + 1, f.effect.c_str());
-        check(pmplot::xy(dir + "/finding" + std::to_string(k + 1) + "_" + f.effect + ".svg", t, xlab,
+        // (an alt-az mount's periodic effects by its axes' names: mount_words)
+        const std::string name = mount_words(f.effect, run.mount);
+        std::snprintf(t, sizeof t, "Finding %zu, %s: baseline residuals", k + 1, name.c_str());
+        check(pmplot::xy(dir + "/finding" + std::to_string(k + 1) + "_" + name + ".svg", t, xlab,
                          "residual (arcsec)", {s1, s2}, &err));
     }
 }
@@ -1316,6 +1331,7 @@ void print_robust_explained(const RobustFit &rf, const Run &full, const Run &run
 // pmfit explain: report, JSON, plots.
 int cmd_explain(const Options &o, const Run &full)
 {
+    check_gear_names(o, full);
     ExplainOptions eo;
     eo.order = o.order;
     eo.adds = o.adds;
@@ -1538,6 +1554,7 @@ void check_distinct(const std::vector<std::pair<std::string, std::string>> &outs
 // the closing 'wrote'); --progress: a line per stage always; --quiet: none.
 int cmd_report(const Options &o, const Run &run, int argc, char **argv)
 {
+    check_gear_names(o, run);
     ReportOptions ro;
     ro.order = o.order;
     ro.adds = o.adds;

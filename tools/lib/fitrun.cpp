@@ -520,7 +520,8 @@ static void add_periodic(ModelBuilder &b, const AddSpec &a, pm_term t)
 {
     const std::string &name = a.f[0];
     if (a.f.size() < 2 || a.f.size() > 3)
-        throw std::runtime_error("--add " + a.spec + ": expected " + name + ":G[:H]");
+        throw std::runtime_error("--add " + a.spec + ": expected " +
+                                 a.body.substr(0, a.body.find(':')) + ":G[:H]"); // (the user's name)
     char *end;
     double G = std::strtod(a.f[1].c_str(), &end);
     if (*end || !(G > 0 && G <= 100000))

@@ -625,8 +625,15 @@ void finding_figure(Page &p, const Data &d, const Finding &f, size_t k)
     std::string at = fmt("with it: sigma %.2f\"", d.ex.final.res.sigma * RAD2AS);
     figure(p, fmt("Finding %zu, <b>%s</b>, before and after: the residuals (arcsec; ", k + 1,
                   h(mount_words(f.effect, d.run.mount)).c_str()) +
-                  (f.effect == "ha_periodic" ? "axis 1 along the axis, i.e. divided by cos declination, " : "") +
-                  h(axis_names(d)) + ") against " + h(xlab) + ", " +
+                  // (a periodic error of axis 1 is read along the axis: the sky offset
+                  // divided by cos of the second axis; axis_names gives the sky's)
+                  h(f.effect == "ha_periodic"
+                        ? std::string(d.altaz ? "axis 1 along azimuth (divided by cos elevation, i.e. "
+                                                "along the axis), axis 2 along elevation"
+                                              : "axis 1 along hour angle (divided by cos declination, "
+                                                "i.e. along the axis), axis 2 along declination")
+                        : axis_names(d)) +
+                  ") against " + h(xlab) + ", " +
                   (refit ? "left: the explained model refitted without this finding; right: the explained model."
                          : "left: the baseline model; right: the explained model.") +
                   " The pattern on the left that is gone on the right is what the finding explains.",
