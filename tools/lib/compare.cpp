@@ -495,7 +495,8 @@ std::string comparison_json(const Comparison &c)
     j += "], \"n_stable\": " + std::to_string(c.n_stable) + ", \"rezero\": {\"c_arcsec\": " +
          num(c.rezero_c) + ", \"c_error_arcsec\": " + num(c.rezero_c_err) + ", \"e_arcsec\": " +
          num(c.rezero_e) + ", \"e_error_arcsec\": " + num(c.rezero_e_err) +
-         ", \"rms_arcsec\": " + num(c.rms_rezero) + "}, \"cv_rms_arcsec\": {\"as_is\": " + num(c.cv_as_is) + ", \"rezero\": " +
+         ", \"rms_arcsec\": " + num(c.rms_rezero) + "}, \"cv_rms_arcsec\": {\"as_is\": " +
+         num(c.cv_as_is) + ", \"rezero\": " +
          num(c.cv_rezero) + ", \"refit\": " + num(c.cv_refit) +
          "}, \"old_covariance\": \"" + c.old_cov_kind + "\", \"joint_log10_p\": " +
          num(c.joint_log10p) + ", \"rest_log10_p\": " +
@@ -540,7 +541,8 @@ void print_comparison(const Comparison &c, const std::string &old_name, const st
                         ? ": no one term beyond 3 sigma, but together they are; terms this "
                           "sky confounds changed as one"
                         : "");
-    std::printf("\n  re-zero (only c' and e' refitted): c' %+.2f\" +- %.2f\", e' %+.2f\" +- %.2f\"%s\n",
+    std::printf("\n  re-zero (only c' and e' refitted): c' %+.2f\" +- %.2f\", e' %+.2f\" +- "
+                "%.2f\"%s\n",
                 c.rezero_c, c.rezero_c_err, c.rezero_e, c.rezero_e_err,
                 std::isfinite(c.rms_rezero) ? fmt(", RMS per axis %.3f\"", c.rms_rezero).c_str()
                                             : "");

@@ -122,7 +122,8 @@ std::string mount_words(const std::string &s, int mount)
     for (int k = 0; k < 2; k++) {
         const std::string f = from[k], t = to[k];
         for (size_t p = r.find(f); p != std::string::npos; p = r.find(f, p + t.size())) {
-            const bool word_start = p == 0 || !(std::isalnum((unsigned char)r[p - 1]) || r[p - 1] == '_');
+            const bool word_start =
+                p == 0 || !(std::isalnum((unsigned char)r[p - 1]) || r[p - 1] == '_');
             const size_t e = p + f.size();
             const bool paper = r.compare(e, 6, "_paper") == 0; // (the paper's form keeps its name)
             if (word_start && !paper)
@@ -520,8 +521,8 @@ static void add_periodic(ModelBuilder &b, const AddSpec &a, pm_term t)
 {
     const std::string &name = a.f[0];
     if (a.f.size() < 2 || a.f.size() > 3)
-        throw std::runtime_error("--add " + a.spec + ": expected " +
-                                 a.body.substr(0, a.body.find(':')) + ":G[:H]"); // (the user's name)
+        throw std::runtime_error("--add " + a.spec + ": expected " + // (the user's name)
+                                 a.body.substr(0, a.body.find(':')) + ":G[:H]");
     char *end;
     double G = std::strtod(a.f[1].c_str(), &end);
     if (*end || !(G > 0 && G <= 100000))
