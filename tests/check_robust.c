@@ -429,14 +429,14 @@ END_TEST
 /* Small runs: the robust scale comes from 2N - P degrees of freedom (18
 ** for 12 points at L = 0, 38 for 30 at L = 1), and the threshold K on
 ** d / sigma_robust rejected a clean point as often as F(2, nu)'s tail says,
-** not as the docs promise (K = 4.29: 1e-4; at nu = 18 it is 2.5e-3): an
+** not as the docs promise (K = 4.29: 1e-4; at nu = 18 it is 1.8e-3): an
 ** outside probe counted 12 of 18,000 clean points of 30-point runs at
 ** L = 1.  The final threshold is now studentised (docs/robust.md, step 4).
 ** 200 runs of 30 points at L = 1, German and alt-az, expected 0.6
 ** rejections at 1e-4 each; the bound is the Poisson 99.9% quantile.  Not
 ** met, and printed only (docs/robust.md, "What it cannot do"): 12-point runs
 ** at L = 0 (9 of 3600 where 0.36 are expected; 31 before) and a lower K
-** (--clip 3.5: about twice the nominal 2.2e-3; five times before). */
+** (--clip 3.5: about twice the nominal 2.2e-3; 3.3 times before). */
 START_TEST(test_robust_small_runs_false_rate)
 {
     static const config small[4] = {
