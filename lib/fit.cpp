@@ -705,6 +705,33 @@ static pm_status run_from(pm_fit *fit, pm_model *m, const pm_context *ctx, long 
     return PM_ERR_DIVERGED;
 }
 
+/* The order-0 fit (the six isotropic terms alone) of the observations from
+** the six of start, in the scratch model *s: its six into out, at their
+** alias with d and i within 90 deg (an order-0 fit's two are the same fit;
+** the order-L fit from either is not, and rounding had chosen between
+** them: an outside probe's fits from the other came back with i -180 deg
+** and a worse chi^2), its statistics into *r.  The seeds of pm_fit_run's
+** starts (in the caller's scratch model and result: the stack of one run). */
+static pm_status order0_fit(pm_fit *fit, const pm_model *model, const double *start,
+                            const pm_context *ctx, long n, const double *enc_ha,
+                            const double *enc_dec, const double *app_ha, const double *app_dec,
+                            int max_iter, pm_model *s, double *out, pm_fit_result *r)
+{
+    pm_status st = pm_model_init(s, model->mount, 0);
+    if (st != PM_OK)
+        return st;
+    s->latitude = model->latitude;
+    for (int i = 0; i < 6; i++)
+        s->coef[i] = start[i];
+    if ((st = pm_model_prepare(s)) != PM_OK ||
+        (st = run_from(fit, s, ctx, n, enc_ha, enc_dec, app_ha, app_dec, max_iter, r)) != PM_OK)
+        return st;
+    for (int i = 0; i < 6; i++)
+        out[i] = s->coef[i];
+    canonical_alias(out);
+    return PM_OK;
+}
+
 /* *s: the caller's model with the six isotropic terms of start k (k = 0:
 ** the caller's own), prepared. */
 static pm_status start_model(const pm_model *model, const double (*iso)[6], int k,
@@ -756,22 +783,13 @@ pm_status pm_fit_run(pm_fit *fit, pm_model *model, const pm_context *ctx,
     const int n_index = n_start;
     double iso_chi2 = 0;
     for (int k = 0; k < n_index && n_index > 1 && model->n_terms > 6; k++) {
-        if (pm_model_init(&s, model->mount, 0) != PM_OK)
-            break;
-        s.latitude = model->latitude;
-        for (int i = 0; i < 6; i++)
-            s.coef[i] = iso[k][i];
-        if (pm_model_prepare(&s) != PM_OK ||
-            run_from(fit, &s, ctx, n, enc_ha, enc_dec, app_ha, app_dec, max_iter, &r) != PM_OK ||
+        double six[6];
+        if (order0_fit(fit, model, iso[k], ctx, n, enc_ha, enc_dec, app_ha, app_dec, max_iter,
+                       &s, six, &r) != PM_OK ||
             (n_start > n_index && !(r.chi2 < iso_chi2)))
             continue;
         for (int i = 0; i < 6; i++)
-            iso[n_index][i] = s.coef[i];
-        /* (an order-0 fit: its alias with d and i within 90 deg is the same
-        ** fit; the order-L fit from either is not, and rounding had chosen
-        ** between them: an outside probe's fits from the other came back
-        ** with i -180 deg and a worse chi^2) */
-        canonical_alias(iso[n_index]);
+            iso[n_index][i] = six[i];
         iso_chi2 = r.chi2;
         n_start = n_index + 1;
     }
@@ -788,16 +806,10 @@ pm_status pm_fit_run(pm_fit *fit, pm_model *model, const pm_context *ctx,
     for (int i = 0; i < 6; i++)
         n_cold += iso[0][i] == 0;
     if (n_index == 1 && model->n_terms > 6 && n_cold == 6 &&
-        pm_model_init(&s, model->mount, 0) == PM_OK) {
-        s.latitude = model->latitude;
-        if (pm_model_prepare(&s) == PM_OK &&
-            run_from(fit, &s, ctx, n, enc_ha, enc_dec, app_ha, app_dec, max_iter, &r) == PM_OK) {
-            for (int i = 0; i < 6; i++)
-                iso[n_start][i] = s.coef[i];
-            canonical_alias(iso[n_start]);
-            chi2_0 = r.chi2;
-            seed0 = true;
-        }
+        order0_fit(fit, model, iso[0], ctx, n, enc_ha, enc_dec, app_ha, app_dec, max_iter, &s,
+                   iso[n_start], &r) == PM_OK) {
+        chi2_0 = r.chi2;
+        seed0 = true;
     }
     pm_status first = PM_ERR_DIVERGED;
     double best_chi2 = 0;
