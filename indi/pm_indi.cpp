@@ -26,17 +26,22 @@ double wrap_pi(double a)
     return a;
 }
 
-/* Index offsets: c' the circular mean of app1 - enc1, e' the mean of
-** enc2 - app2 (pm: apparent = (enc1 + c', enc2 - e') for a model of the
-** index terms alone, exactly). */
+/* Index offsets: c' the circular mean of app1 - enc1, weighted by
+** cos^2 of the star's axis-2 angle, e' the mean of enc2 - app2 (pm:
+** apparent = (enc1 + c', enc2 - e') for a model of the index terms alone,
+** exactly).  The weight: an axis-1 offset of the sky's error x reads
+** x / cos(axis 2), so a sync near the pole (the zenith) carries its
+** pointing error, and any polar (tilt) error, magnified by sec; unweighted,
+** one such sync beside one at Dec 20 moved every GOTO by up to 11 deg (an
+** outside probe; pm_fit_run's own start from the offsets weights so). */
 void offsets(long n, const double *e1, const double *e2, const double *a1, const double *a2, double *c,
              double *e)
 {
     double s = 0, co = 0, d = 0;
     for (long i = 0; i < n; i++) {
-        double t = a1[i] - e1[i];
-        s += std::sin(t);
-        co += std::cos(t);
+        const double t = a1[i] - e1[i], w = std::cos(a2[i]) * std::cos(a2[i]);
+        s += w * std::sin(t);
+        co += w * std::cos(t);
         d += e2[i] - a2[i];
     }
     *c = (s == 0 && co == 0) ? 0.0 : std::atan2(s, co);
@@ -61,6 +66,55 @@ pm_status start_model(pm_model *m, int mount, int order, const pm_model *src, do
         m->coef[ie] = e;
     }
     return pm_model_prepare(m);
+}
+
+/* The most correlated pair of the fit's terms (after a solve): the signed
+** correlation, their names into pair; 0 where none is available. */
+double worst_corr(const pm_fit *fit, const pm_fit_result *fr, const pm_model *m, char *pair, size_t len)
+{
+    double best = 0;
+    int bi = -1, bj = -1;
+    for (int i = 0; i < fr->n_par; i++)
+        for (int j = 0; j < i; j++) {
+            double cov, corr;
+            if (pm_fit_covariance(fit, fr, i, j, &cov, &corr) == PM_OK && std::fabs(corr) > std::fabs(best)) {
+                best = corr;
+                bi = i;
+                bj = j;
+            }
+        }
+    pair[0] = 0;
+    if (bi >= 0) {
+        char a[28], b[28]; /* (pm term names are short: "e'*Y(2,-2)") */
+        pm_term_name(m, bj, a, sizeof a);
+        pm_term_name(m, bi, b, sizeof b);
+        std::snprintf(pair, len, "%s and %s", a, b);
+    }
+    return best;
+}
+
+/* The RMS over the sky of the fit's own pointing error per unit residual
+** sigma (pm_fit_pointing_sigma at sigma 1; Note 2 of pm_indi_fit): every
+** axis-1 angle, axis 2 from the lowest sync point's to 90 deg, weighted by
+** area.  HUGE_VAL where it cannot be had. */
+double sky_gain(const pm_fit *fit, const pm_fit_result *fr, const pm_model *m, long n, const double *e2)
+{
+    pm_fit_result unit = *fr;
+    unit.sigma = 1.0;
+    double lo = kPi / 2, sum = 0, area = 0;
+    for (long i = 0; i < n; i++)
+        lo = std::min(lo, e2[i]);
+    for (int j = 0; j < 12; j++) {
+        const double y = lo + (kPi / 2 - lo) * (j + 0.5) / 12, w = std::cos(y);
+        for (int i = 0; i < 24; i++) {
+            double sg, cov[3];
+            if (pm_fit_pointing_sigma(fit, &unit, m, nullptr, (i - 11.5) * kPi / 12, y, &sg, cov) != PM_OK)
+                return HUGE_VAL;
+            sum += w * sg * sg;
+            area += w;
+        }
+    }
+    return area > 0 ? std::sqrt(sum / area) : HUGE_VAL;
 }
 
 /* Leave-one-out rms per axis (Note 1 of pm_indi_fit). */
@@ -167,6 +221,8 @@ pm_status pm_indi_fit(int mount, long n, const double *enc1, const double *enc2,
     long worst[PM_INDI_MAX_ORDER + 1] = {-1, -1, -1};
     double worst_loo[PM_INDI_MAX_ORDER + 1] = {0};
     int top = -1;
+    double corr[PM_INDI_MAX_ORDER + 1] = {0}, gain[PM_INDI_MAX_ORDER + 1] = {0};
+    char pair[PM_INDI_MAX_ORDER + 1][sizeof r.corr_pair] = {{0}};
     r.worst = -1;
     for (int L = 0; L <= r.chosen_order; L++) {
         pm_model &m = fitted[L];
@@ -177,6 +233,7 @@ pm_status pm_indi_fit(int mount, long n, const double *enc1, const double *enc2,
             st = pm_fit_run(fit, &m, nullptr, n, enc1, enc2, app1, app2, kMaxIter, &fr);
         if (st != PM_OK) {
             r.fallbacks = r.chosen_order - L + 1;
+            r.failed = (int)st;
             r.bad_term[0] = 0;
             if (st == PM_ERR_SINGULAR && fit->bad_term >= 0 && fit->bad_term < m.n_terms)
                 pm_term_name(&m, fit->bad_term, r.bad_term, sizeof r.bad_term);
@@ -184,6 +241,8 @@ pm_status pm_indi_fit(int mount, long n, const double *enc1, const double *enc2,
                 std::snprintf(r.bad_term, sizeof r.bad_term, "%s", pm_status_text(st));
             break;
         }
+        corr[L] = worst_corr(fit, &fr, &m, pair[L], sizeof pair[L]);
+        gain[L] = sky_gain(fit, &fr, &m, n, enc2);
         r.cv[L] = loo_rms(fit, &fr, &m, n, enc1, enc2, app1, app2, &worst[L], &worst_loo[L]);
         sig[L] = fr.sigma;
         npar[L] = fr.n_par;
@@ -199,6 +258,9 @@ pm_status pm_indi_fit(int mount, long n, const double *enc1, const double *enc2,
             r.n_par = npar[L];
             r.worst = worst[L];
             r.worst_loo = worst_loo[L];
+            r.corr = corr[L];
+            r.gain = gain[L];
+            std::memcpy(r.corr_pair, pair[L], sizeof r.corr_pair);
         }
     *out = best;
     *res = r;
@@ -232,12 +294,18 @@ void pm_indi_describe(const pm_indi_result *r, long n, long skipped, char *buf, 
                           "points over %.0f deg)%s",
                           n, r->spread * 180.0 / kPi, PM_SH_TERMS(0), PM_INDI_SPREAD_L0 * 180.0 / kPi,
                           extra);
-        else /* enough of both: the order 0 fit itself failed (extra says why) */
+        else if (r->failed == PM_ERR_SINGULAR) /* the order 0 fit itself failed (extra says why) */
             std::snprintf(buf, len,
                           "%ld sync point(s) over %.1f deg: index offsets only, the order 0 fit "
                           "failed: these points do not determine it (all on one declination or "
                           "hour-angle circle, or one altitude? add sync points spread over both "
                           "axes)%s",
+                          n, r->spread * 180.0 / kPi, extra);
+        else /* (a 3 x 2 grid whose fit did not converge had been told it was all on one circle) */
+            std::snprintf(buf, len,
+                          "%ld sync point(s) over %.1f deg: index offsets only, the order 0 fit "
+                          "failed: these points hardly determine it (add sync points spread over "
+                          "more of the sky)%s",
                           n, r->spread * 180.0 / kPi, extra);
         break;
     default: {
@@ -265,6 +333,14 @@ void pm_indi_describe(const pm_indi_result *r, long n, long skipped, char *buf, 
                 r->cv[r->order] < 1e6) {
             const double all2 = 2.0 * (double)n * r->cv[r->order] * r->cv[r->order];
             others = std::sqrt(std::max(0.0, all2 - r->worst_loo * r->worst_loo) / (double)(n - 1));
+        }
+        if (r->gain > PM_INDI_GAIN_WARN) {
+            size_t k = std::strlen(buf);
+            std::snprintf(buf + k, len - k,
+                          "; these points do not determine the model between them: an error of 1 "
+                          "arcsec at them moves GOTOs elsewhere by %.1f arcsec (RMS over the sky above "
+                          "the lowest one; %s correlated %.4f): add sync points over more of the sky",
+                          r->gain, r->corr_pair, r->corr);
         }
         if (others >= 0 && r->worst_loo > PM_INDI_WORST_RATIO * others &&
                 r->worst_loo * arcsec > 10.0) {

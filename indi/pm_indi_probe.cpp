@@ -239,7 +239,14 @@ int main(int argc, char **argv)
                   (int)!p->TransformCelestialToTelescope(5, 91, 0, tdv) +
                   (int)!p->TransformCelestialToTelescope(5, 10, NAN, tdv) +
                   (int)!p->TransformTelescopeToCelestial(TelescopeDirectionVector(0, 0, 0), r1, r2) +
-                  (int)!p->TransformTelescopeToCelestial(TelescopeDirectionVector(NAN, 0, 1), r1, r2);
+                  (int)!p->TransformTelescopeToCelestial(TelescopeDirectionVector(NAN, 0, 1), r1, r2) +
+                  (int)!p->TransformCelestialToTelescope(1e300, 10, 0, tdv);
+    /* a vector whose length overflows is still a direction: (1e300, 1e300,
+    ** 0) read as (1, 0, 0) before */
+    double u1 = 0, u2 = 0, b1 = 1, b2 = 1;
+    int big_ok = (int)(p->TransformTelescopeToCelestial(TelescopeDirectionVector(0.6, 0.6, 0.1), u1, u2) &&
+                       p->TransformTelescopeToCelestial(TelescopeDirectionVector(6e299, 6e299, 1e299), b1, b2) &&
+                       std::fabs(u1 - b1) < 1e-12 && std::fabs(u2 - b2) < 1e-12);
     /* The known mount's axis-2 encoder reads 0.25 deg high (O2), so within
     ** about that of the north pole (eq) or the zenith (altaz) it reads
     ** beyond 90 deg, which a direction vector cannot carry: refused.  A
@@ -249,9 +256,9 @@ int main(int argc, char **argv)
                                                               0, tdv);
     int near_ok = (int)p->TransformCelestialToTelescope(altaz ? zra : 7.5, altaz ? LAT - 1.5 : 88.5, 0, tdv);
     fflush(stdout);
-    printf("\nprobe: %s targets %d failed %d worst_goto_arcsec %.3e worst_back_arcsec %.3e bad_refused %d/5 "
-           "near_refused %d near_ok %d\n",
-           argv[2], q, fails, worst_goto, worst_back, refused, near_refused, near_ok);
+    printf("\nprobe: %s targets %d failed %d worst_goto_arcsec %.3e worst_back_arcsec %.3e bad_refused %d/6 "
+           "near_refused %d near_ok %d big_ok %d\n",
+           argv[2], q, fails, worst_goto, worst_back, refused, near_refused, near_ok, big_ok);
     destroy(p);
     dlclose(h);
     return 0;

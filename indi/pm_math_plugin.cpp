@@ -31,6 +31,7 @@
 #include "pm.h"
 #include "pm_indi.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
@@ -158,12 +159,29 @@ bool PmMathPlugin::site(double *lat, double *lon)
     return true;
 }
 
+/* v / |v|, false where v is not finite or shorter than 1e-6.  Scaled
+** first: the length of (1e300, 1e300, 0) overflows, and x / inf had read
+** it as (1, 0, 0) (an outside probe). */
+static bool unit_vector(const TelescopeDirectionVector &v, TelescopeDirectionVector *u)
+{
+    if (!finite3(v))
+        return false;
+    const double big = std::max(std::fabs(v.x), std::max(std::fabs(v.y), std::fabs(v.z)));
+    if (!(big > 0))
+        return false;
+    const double sx = v.x / big, sy = v.y / big, sz = v.z / big;
+    const double ln = std::sqrt(sx * sx + sy * sy + sz * sz); /* 1 .. sqrt 3 */
+    if (!(ln * big > 1e-6))
+        return false;
+    *u = TelescopeDirectionVector(sx / ln, sy / ln, sz / ln);
+    return true;
+}
+
 bool PmMathPlugin::mount_axes(const TelescopeDirectionVector &v, double lst, double *a1, double *a2)
 {
-    double len = v.Length();
-    if (!finite3(v) || !(len > 1e-6))
+    TelescopeDirectionVector u;
+    if (!unit_vector(v, &u))
         return false;
-    TelescopeDirectionVector u(v.x / len, v.y / len, v.z / len);
     double az, pol;
     if (altaz()) {
         /* TelescopeDirectionVectorFromAltitudeAzimuth: clockwise azimuth */
@@ -284,8 +302,11 @@ bool PmMathPlugin::Initialise(InMemoryDatabase *db)
 bool PmMathPlugin::TransformCelestialToTelescope(const double RightAscension, const double Declination,
                                                  double JulianOffset, TelescopeDirectionVector &out)
 {
-    if (!std::isfinite(RightAscension) || !std::isfinite(Declination) || std::fabs(Declination) > 90.0 ||
-            !std::isfinite(JulianOffset)) {
+    /* (an RA beyond 2^31 h is no hour angle a caller meant: fmod reduces
+    ** 1e300 exactly, to a direction nobody gave; pmfit's readers refuse
+    ** such angles alike) */
+    if (!std::isfinite(RightAscension) || std::fabs(RightAscension) > 2147483648.0 ||
+            !std::isfinite(Declination) || std::fabs(Declination) > 90.0 || !std::isfinite(JulianOffset)) {
         note("TransformCelestialToTelescope: bad target (RA %g h, Dec %g deg, offset %g d)", RightAscension,
              Declination, JulianOffset);
         return false;
@@ -334,9 +355,10 @@ bool PmMathPlugin::TransformTelescopeToCelestial(const TelescopeDirectionVector 
 {
     double lat = 0, lon = 0;
     if (!site(&lat, &lon)) {
-        if (!altaz() && kind_ == PM_INDI_NONE && finite3(v) && v.Length() > 1e-6) {
+        TelescopeDirectionVector u;
+        if (!altaz() && kind_ == PM_INDI_NONE && unit_vector(v, &u)) {
             INDI::IEquatorialCoordinates rd;
-            EquatorialCoordinatesFromTelescopeDirectionVector(v, rd);
+            EquatorialCoordinatesFromTelescopeDirectionVector(u, rd);
             RightAscension = rd.rightascension;
             Declination = rd.declination;
             return true;
