@@ -575,9 +575,42 @@ START_TEST(test_pmfit_explain_says_what_it_cannot_try)
     ck_assert_msg(strstr(out, "\"not_tried\": [{\"effect\": \"refraction\", \"why\": \"the run "
                               "gives no latitude\"}, {\"effect\": \"tube_flexure\"") != NULL,
                   "%.3000s", out);
+    /* without temperature and time columns: temperature and time_drift
+    ** (the MMT run's JSON had said nothing was left untried) */
+    snprintf(path, sizeof path, "%s/notime.dat", tmpdir);
+    snprintf(cmd, sizeof cmd,
+             "awk '/^# latitude/ {print} /^[^#]/ {print $1, $2, $3, $4}' %s/examples/sim_gem.dat > %s",
+             top ? top : ".", path);
+    ck_assert_int_eq(system(cmd), 0);
+    ck_assert_msg(run("%s explain %s --json%s", path, "") == 0, "%s", out);
+    ck_assert_msg(strstr(out, "\"not_tried\": [{\"effect\": \"temperature\", \"why\": \"the run gives no "
+                              "temperatures\"}, {\"effect\": \"time_drift\", \"why\": \"the run gives "
+                              "no times\"}]") != NULL,
+                  "%.3000s", out);
+    ck_assert_msg(run("%s explain %s%s", path, "") == 0, "%s", out);
+    ck_assert_msg(strstr(out, "not tried: temperature: the run gives no temperatures") != NULL,
+                  "%s", out);
     snprintf(path, sizeof path, "%s/examples/sim_gem.dat", top ? top : ".");
     ck_assert_msg(run("%s explain %s --json%s", path, "") == 0, "%s", out);
     ck_assert_msg(strstr(out, "\"not_tried\": []") != NULL, "%.3000s", out);
+}
+END_TEST
+
+/* An error that rounds to 0.00 in the value's unit is given in the next
+** unit down: a 3' polar error measured to 0.01" read "3.00' +- 0.00'" (an
+** outside probe). */
+START_TEST(test_pmfit_explain_small_error_shown)
+{
+    char path[300];
+    make_tmpdir();
+    snprintf(path, sizeof path, "%s/lown.dat", tmpdir);
+    ck_assert_int_eq(run("%s simulate %s --n 200 --seed 4 --noise 0.05 --term a=180 --term b=20%s",
+                         path, ""),
+                     0);
+    ck_assert_msg(run("%s explain %s --order 0%s", path, "") == 0, "%s", out);
+    ck_assert_msg(strstr(out, "polar axis 3.00' +- 0.01\" east of the pole") != NULL &&
+                      strstr(out, "+- 0.00'") == NULL,
+                  "%s", out);
 }
 END_TEST
 
@@ -1122,6 +1155,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_pmfit_eval_missing_input_and_long_comment);
     tcase_add_test(tc, test_pmfit_columns_by_name);
     tcase_add_test(tc, test_pmfit_explain_says_what_it_cannot_try);
+    tcase_add_test(tc, test_pmfit_explain_small_error_shown);
     tcase_add_test(tc, test_pmfit_printed_commands_quote);
     tcase_add_test(tc, test_pmfit_explain_period_seam);
     tcase_add_test(tc, test_pmfit_explain_no_composition_undetermined);

@@ -463,6 +463,10 @@ bool both_sides(const Run &run, const std::vector<int> &use)
     return e && w;
 }
 
+} // namespace
+
+namespace xdetail {
+
 // Does input `which` (0 temp, 1 time, 2 dir) vary, and is it known everywhere?
 bool input_usable(const Run &run, const std::vector<int> &use, int which)
 {
@@ -481,6 +485,10 @@ bool input_usable(const Run &run, const std::vector<int> &use, int which)
         return false;
     return hi - lo > (which == 0 ? 0.2 : which == 1 ? 0.05 : 1);
 }
+
+} // namespace xdetail
+
+namespace {
 
 // The chi^2 excess of a group of residuals (components: 1 axis 1, 2 axis 2,
 // 3 both), with the fit's sigma: Wilson-Hilferty tail.

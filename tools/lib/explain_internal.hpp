@@ -87,6 +87,8 @@ bool has(const std::vector<std::string> &v, const std::string &s);
 // observations `use`: "no value at line N (...)", "the same at every
 // point"; empty where it can (physical_candidates, not_tried_why).
 std::string column_unusable(const Run &run, const std::vector<int> &use, size_t j);
+// Does input `which` (0 temp, 1 time, 2 dir) vary, and is it known everywhere?
+bool input_usable(const Run &run, const std::vector<int> &use, int which);
 // Angular size (radians) of model b minus model a at each observation.
 std::vector<double> model_difference(const Run &run, const std::vector<int> &use,
                                      const pm_model &a, const pm_model &b);

@@ -108,13 +108,23 @@ Interpretation item(const char *what, double v, double e, const char *unit, cons
 
 // An angle and its error (radians) as text: arcminutes from 1', else
 // arcseconds (0.01' would hide a well-measured 0.7").
+// An error that would print as 0.00 in the value's unit goes down a unit,
+// or to two significant figures: "3.00' +- 0.00'" had hidden a 0.15" error
+// (an outside probe).
 std::string angle_text(double v, double e)
 {
-    char b[80];
-    if (std::fabs(v) * RAD2AS >= 60)
-        std::snprintf(b, sizeof b, "%.2f' +- %.2f'", v * RAD2AS / 60, e * RAD2AS / 60);
+    char b[80], err[40];
+    const bool arcmin = std::fabs(v) * RAD2AS >= 60;
+    if (arcmin && e * RAD2AS / 60 >= 0.005)
+        std::snprintf(err, sizeof err, "%.2f'", e * RAD2AS / 60);
+    else if (e * RAD2AS >= 0.005 || !(e > 0))
+        std::snprintf(err, sizeof err, "%.2f\"", e * RAD2AS);
     else
-        std::snprintf(b, sizeof b, "%.2f\" +- %.2f\"", v * RAD2AS, e * RAD2AS);
+        std::snprintf(err, sizeof err, "%.2g\"", e * RAD2AS);
+    if (arcmin)
+        std::snprintf(b, sizeof b, "%.2f' +- %s", v * RAD2AS / 60, err);
+    else
+        std::snprintf(b, sizeof b, "%.2f\" +- %s", v * RAD2AS, err);
     return b;
 }
 

@@ -106,11 +106,30 @@ std::vector<std::pair<std::string, std::string>> not_tried_why(const Run &run)
         out.push_back({"refraction", "the run gives no latitude"});
         out.push_back({"tube_flexure", "the run gives no latitude"});
     }
-    // the run's own columns that cannot be candidates (an outside probe: a
-    // column's effect was not looked for, and nothing said so)
     std::vector<int> all(run.obs.size());
     for (size_t i = 0; i < all.size(); i++)
         all[i] = (int)i;
+    // temperature and time (physical_candidates' input_usable), said where
+    // the run cannot give them (an outside probe: the MMT run's JSON listed
+    // nothing not tried, and it has neither)
+    static const char *const input[2][3] = {{"temperature", "temperature", "0.2 deg C"},
+                                            {"time_drift", "time", "3 minutes"}};
+    for (int w = 0; w < 2; w++) {
+        if (xdetail::input_usable(run, all, w))
+            continue;
+        size_t known = 0;
+        for (const Obs &o : run.obs)
+            known += std::isfinite(w == 0 ? o.ctx.temp_c : o.ctx.time_h);
+        const std::string what = input[w][1];
+        out.push_back({input[w][0], known == 0 ? "the run gives no " + what + "s"
+                                    : known < run.obs.size()
+                                        ? "the run gives the " + what + " of only " +
+                                              std::to_string(known) + " of its " +
+                                              std::to_string(run.obs.size()) + " points"
+                                        : "its " + what + "s span less than " + input[w][2]});
+    }
+    // the run's own columns that cannot be candidates (an outside probe: a
+    // column's effect was not looked for, and nothing said so)
     for (size_t j = 0; j < run.aux_names.size(); j++) {
         const std::string &name = run.aux_names[j];
         if (name == axis2_dir_name(run.mount) && run.dec_dir_derived)
