@@ -596,6 +596,53 @@ START_TEST(test_pmfit_explain_says_what_it_cannot_try)
 }
 END_TEST
 
+/* An alt-az controller that writes its azimuth as a count past a turn (a
+** cable wrap's 90..450 deg here), without a direction column: the slew
+** direction is the count's, however far the move; the short way round had
+** read every move over 180 deg backwards, the backlash at half its size and
+** false gear periods beside it (an outside probe).  The run is made here,
+** by a gimbal of index errors and a backlash alone, not pmfit simulate. */
+START_TEST(test_pmfit_altaz_counted_azimuth_direction)
+{
+    char path[300];
+    FILE *f;
+    unsigned long long x = 12345;
+    double raw = 200, prev = 200, h_fit = 0, h_err = 1;
+    const double h = 4.0 / 3600, ia = 300.0 / 3600, ie = -120.0 / 3600, noise = 1.0 / 3600;
+    long long_moves = 0;
+    make_tmpdir();
+    snprintf(path, sizeof path, "%s/counted.dat", tmpdir);
+    f = fopen(path, "w");
+    ck_assert_ptr_nonnull(f);
+    fprintf(f, "# mount: altaz\n# latitude: 32\n# tau delta T D\n");
+    for (int i = 0; i < 150; i++) {
+        double u[4];
+        for (int k = 0; k < 4; k++) { /* LCG, uniform in (0, 1) */
+            x = x * 6364136223846793005ULL + 1442695040888963407ULL;
+            u[k] = ((double)(x >> 11) + 0.5) / 9007199254740992.0;
+        }
+        raw = 90 + 360 * u[0];
+        const double el = 20 + 60 * u[1];
+        const int dir = i == 0 ? 0 : (raw > prev ? 1 : -1);
+        long_moves += fabs(raw - prev) > 180;
+        prev = raw;
+        /* noise on the sky: +-noise (uniform, sqrt 3 times the RMS) */
+        const double ns = noise * sqrt(3.0) * (2 * u[2] - 1), nd = noise * sqrt(3.0) * (2 * u[3] - 1);
+        double az = fmod(raw + ia + h * dir + ns / cos(el * 3.14159265358979323846 / 180), 360.0);
+        fprintf(f, "%.7f %.7f %.7f %.7f\n", raw, el, az, el - ie + nd);
+    }
+    fclose(f);
+    ck_assert(long_moves > 30);
+    ck_assert_msg(run("%s fit %s --order 0 --add hysteresis --json%s", path, "") == 0, "%s", out);
+    const char *p = strstr(out, "\"name\": \"c'*dir\"");
+    ck_assert_msg(p && sscanf(strstr(p, "\"value_arcsec\""), "\"value_arcsec\": %lf, \"error_arcsec\": %lf",
+                              &h_fit, &h_err) == 2,
+                  "%s", out);
+    ck_assert_msg(fabs(h_fit - 4.0) < 4 * h_err && h_err < 0.3, "c'*dir %.3f +- %.3f (4 injected)",
+                  h_fit, h_err);
+}
+END_TEST
+
 /* An error that rounds to 0.00 in the value's unit is given in the next
 ** unit down: a 3' polar error measured to 0.01" read "3.00' +- 0.00'" (an
 ** outside probe). */
@@ -1156,6 +1203,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_pmfit_columns_by_name);
     tcase_add_test(tc, test_pmfit_explain_says_what_it_cannot_try);
     tcase_add_test(tc, test_pmfit_explain_small_error_shown);
+    tcase_add_test(tc, test_pmfit_altaz_counted_azimuth_direction);
     tcase_add_test(tc, test_pmfit_printed_commands_quote);
     tcase_add_test(tc, test_pmfit_explain_period_seam);
     tcase_add_test(tc, test_pmfit_explain_no_composition_undetermined);

@@ -40,6 +40,7 @@ Run run_from_pmrun(const pmrun *run, const std::string &path)
         const pmrun_obs *p = pmrun_get(run, i);
         Obs ob{p->enc_ha, p->enc_dec, p->app_ha, p->app_dec, p->pier, p->line, pm_context()};
         std::memset(&ob.ctx, 0, sizeof ob.ctx);
+        ob.raw1 = p->enc_raw[0];
         ob.ctx.temp_c = p->temp_c;
         ob.ctx.time_h = p->time_h;
         ob.ctx.pier = p->pier;
@@ -133,6 +134,26 @@ std::string mount_words(const std::string &s, int mount)
     return r;
 }
 
+// True where the file wrote axis 1 as a count that runs on past a turn
+// (every value finite, and not all within one of the two ranges a modular
+// writer uses, [0, 360) and (-180, 180] deg: an alt-az controller's cable
+// wrap, e.g. -270..270 or 90..450 deg).  The count then says which way the
+// axis went between two points, however far; an outside probe's runs with
+// the azimuth written 90..450 deg had their backlash read at half its size
+// from the short way round, and false gear periods beside it.
+static bool raw_counted(const std::vector<Obs> &obs)
+{
+    const double eps = 1e-9 * PI / 180, turn = 2 * PI;
+    bool in_0_360 = true, in_pm180 = true;
+    for (const Obs &ob : obs) {
+        if (!std::isfinite(ob.raw1))
+            return false;
+        in_0_360 = in_0_360 && ob.raw1 >= -eps && ob.raw1 < turn - eps;
+        in_pm180 = in_pm180 && ob.raw1 > -PI + eps && ob.raw1 <= PI + eps;
+    }
+    return !obs.empty() && !in_0_360 && !in_pm180;
+}
+
 void derive_directions(Run &r)
 {
     std::vector<double> e1, e2;
@@ -150,10 +171,20 @@ void derive_directions(Run &r)
     bool have_dir = false;
     for (const Obs &ob : r.obs)
         have_dir = have_dir || ob.ctx.dir != 0;
+    const bool counted = r.mount == PM_MOUNT_ALTAZ && raw_counted(r.obs);
     if (!have_dir) {
         r.dir_derived = true;
-        for (size_t i = 1; i < r.obs.size(); i++)
-            r.obs[i].ctx.dir = move_sign(r.obs[i - 1].eh, r.obs[i].eh, cut1, ok1);
+        // (the count's sense against the encoder angle's: a reader may
+        // count the file's azimuth from the south, or the other way round)
+        double sense = 0;
+        for (size_t i = 1; counted && i < r.obs.size(); i++)
+            sense += std::remainder(r.obs[i].eh - r.obs[i - 1].eh, 2 * PI) *
+                     std::remainder(r.obs[i].raw1 - r.obs[i - 1].raw1, 2 * PI);
+        for (size_t i = 1; i < r.obs.size(); i++) {
+            const double d = (r.obs[i].raw1 - r.obs[i - 1].raw1) * (sense < 0 ? -1 : 1);
+            r.obs[i].ctx.dir = counted ? (d > 0 ? 1 : (d < 0 ? -1 : 0))
+                                       : move_sign(r.obs[i - 1].eh, r.obs[i].eh, cut1, ok1);
+        }
     }
     // The slew direction on axis 2, likewise from the sequence, as the input
     // "dec_dir" ("el_dir" on an alt-az mount; backlash of the declination or

@@ -10,6 +10,7 @@
 #include "modelfile.h"
 #include "runfile.h"
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,9 @@ struct Obs {
     double eh, ed, ah, ad;
     int pier, line;
     pm_context ctx; // inputs of the physical terms
+    // axis 1 as the file wrote it (radians; pmrun_obs.enc_raw[0]): a cable
+    // wrap's turn; NaN where the observation did not come from a file
+    double raw1 = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct FitOut {
