@@ -596,23 +596,21 @@ START_TEST(test_pmfit_explain_says_what_it_cannot_try)
 }
 END_TEST
 
-/* An alt-az controller that writes its azimuth as a count past a turn (a
-** cable wrap's 90..450 deg here), without a direction column: the slew
-** direction is the count's, however far the move; the short way round had
-** read every move over 180 deg backwards, the backlash at half its size and
-** false gear periods beside it (an outside probe).  The run is made here,
-** by a gimbal of index errors and a backlash alone, not pmfit simulate. */
-START_TEST(test_pmfit_altaz_counted_azimuth_direction)
+/* An alt-az run as a cable-wrapped controller writes it: the azimuth as a
+** count from lo to lo + span degrees (not reduced), no direction column;
+** index errors, a backlash h (arcsec, half of it per unit of the slew
+** direction on azimuth) and an offset w (arcsec, on the azimuth index) on
+** the turn beyond a count of 360 deg; 1" of noise.  A gimbal of its own
+** (not pmfit simulate).  Returns the number of moves over 180 deg. */
+static long write_counted_altaz(const char *path, unsigned long long seed, double lo, double span,
+                                double h_as, double w_as)
 {
-    char path[300];
-    FILE *f;
-    unsigned long long x = 12345;
-    double raw = 200, prev = 200, h_fit = 0, h_err = 1;
-    const double h = 4.0 / 3600, ia = 300.0 / 3600, ie = -120.0 / 3600, noise = 1.0 / 3600;
+    FILE *f = fopen(path, "w");
+    const double h = h_as / 3600, w = w_as / 3600, ia = 300.0 / 3600, ie = -120.0 / 3600;
+    const double noise = 1.0 / 3600, deg = 3.14159265358979323846 / 180;
+    double prev = lo + 0.5 * span;
+    unsigned long long x = seed;
     long long_moves = 0;
-    make_tmpdir();
-    snprintf(path, sizeof path, "%s/counted.dat", tmpdir);
-    f = fopen(path, "w");
     ck_assert_ptr_nonnull(f);
     fprintf(f, "# mount: altaz\n# latitude: 32\n# tau delta T D\n");
     for (int i = 0; i < 150; i++) {
@@ -621,18 +619,31 @@ START_TEST(test_pmfit_altaz_counted_azimuth_direction)
             x = x * 6364136223846793005ULL + 1442695040888963407ULL;
             u[k] = ((double)(x >> 11) + 0.5) / 9007199254740992.0;
         }
-        raw = 90 + 360 * u[0];
-        const double el = 20 + 60 * u[1];
+        const double raw = lo + span * u[0], el = 20 + 60 * u[1];
         const int dir = i == 0 ? 0 : (raw > prev ? 1 : -1);
         long_moves += fabs(raw - prev) > 180;
         prev = raw;
-        /* noise on the sky: +-noise (uniform, sqrt 3 times the RMS) */
+        /* noise on the sky: uniform, sqrt 3 times the RMS */
         const double ns = noise * sqrt(3.0) * (2 * u[2] - 1), nd = noise * sqrt(3.0) * (2 * u[3] - 1);
-        double az = fmod(raw + ia + h * dir + ns / cos(el * 3.14159265358979323846 / 180), 360.0);
+        const double az = fmod(raw + ia + h * dir + (raw >= 360 ? w : 0) + ns / cos(el * deg), 360.0);
         fprintf(f, "%.7f %.7f %.7f %.7f\n", raw, el, az, el - ie + nd);
     }
     fclose(f);
-    ck_assert(long_moves > 30);
+    return long_moves;
+}
+
+/* An alt-az controller that writes its azimuth as a count past a turn (a
+** cable wrap's 90..450 deg here), without a direction column: the slew
+** direction is the count's, however far the move; the short way round had
+** read every move over 180 deg backwards, the backlash at half its size and
+** false gear periods beside it (an outside probe). */
+START_TEST(test_pmfit_altaz_counted_azimuth_direction)
+{
+    char path[300];
+    double h_fit = 0, h_err = 1;
+    make_tmpdir();
+    snprintf(path, sizeof path, "%s/counted.dat", tmpdir);
+    ck_assert(write_counted_altaz(path, 12345, 90, 360, 4, 0) > 30);
     ck_assert_msg(run("%s fit %s --order 0 --add hysteresis --json%s", path, "") == 0, "%s", out);
     const char *p = strstr(out, "\"name\": \"c'*dir\"");
     ck_assert_msg(p && sscanf(strstr(p, "\"value_arcsec\""), "\"value_arcsec\": %lf, \"error_arcsec\": %lf",
@@ -640,6 +651,34 @@ START_TEST(test_pmfit_altaz_counted_azimuth_direction)
                   "%s", out);
     ck_assert_msg(fabs(h_fit - 4.0) < 4 * h_err && h_err < 0.3, "c'*dir %.3f +- %.3f (4 injected)",
                   h_fit, h_err);
+}
+END_TEST
+
+/* A cable wrap's second turn: where the azimuth count spans more than a
+** turn (0..540 deg), explain tries the input az_turn (0, or 1 past 360)
+** and names an offset there as cable_wrap (an outside probe's 10" and 30"
+** had been called bad points, or false gears); on the same sky without it,
+** not. */
+START_TEST(test_pmfit_explain_cable_wrap)
+{
+    char path[300];
+    double v = 0, e = 1;
+    make_tmpdir();
+    snprintf(path, sizeof path, "%s/wrap.dat", tmpdir);
+    write_counted_altaz(path, 777, 0, 540, 0, 10);
+    ck_assert_msg(run("%s explain %s --json%s", path, "") == 0, "%s", out);
+    const char *p = strstr(out, "\"effect\": \"cable_wrap\"");
+    ck_assert_msg(p != NULL, "%s", out);
+    p = strstr(p, "\"name\": \"c'*aux1\", \"column\": \"az_turn\"");
+    ck_assert_msg(p && sscanf(strstr(p, "\"value_arcsec\""), "\"value_arcsec\": %lf, \"error_arcsec\": %lf",
+                              &v, &e) == 2,
+                  "%s", out);
+    ck_assert_msg(fabs(v - 10.0) < 4 * e && e < 1, "c'*az_turn %.3f +- %.3f (10 injected)", v, e);
+    ck_assert_msg(run("%s explain %s%s", path, "") == 0, "%s", out);
+    ck_assert_msg(strstr(out, "--add 'aux:az_turn'") != NULL, "%s", out);
+    write_counted_altaz(path, 777, 0, 540, 0, 0);
+    ck_assert_msg(run("%s explain %s --json%s", path, "") == 0, "%s", out);
+    ck_assert_msg(strstr(out, "\"effect\": \"cable_wrap\"") == NULL, "%s", out);
 }
 END_TEST
 
@@ -1204,6 +1243,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_pmfit_explain_says_what_it_cannot_try);
     tcase_add_test(tc, test_pmfit_explain_small_error_shown);
     tcase_add_test(tc, test_pmfit_altaz_counted_azimuth_direction);
+    tcase_add_test(tc, test_pmfit_explain_cable_wrap);
     tcase_add_test(tc, test_pmfit_printed_commands_quote);
     tcase_add_test(tc, test_pmfit_explain_period_seam);
     tcase_add_test(tc, test_pmfit_explain_no_composition_undetermined);

@@ -1806,6 +1806,9 @@ int run_main(int argc, char **argv)
                                         run.dec_dir_derived
                                     ? " (the sign of the axis-2 move from the previous "
                                       "position, derived)"
+                                : std::string(info.input[j]) == "az_turn" && run.turn_derived
+                                    ? " (the turn of the file's azimuth count past 360 deg "
+                                      "multiples, less the run's least: 0 or 1, derived)"
                                     : "");
         // a write that fails now still lets the report below be printed
         if (!o.save.empty() &&

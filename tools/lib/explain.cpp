@@ -858,6 +858,11 @@ void physical_candidates(const Run &run, const State &st, std::vector<Candidate>
         h.push_back("aux:" + dir2 + ":e'");
     if (!h.empty())
         add_candidate(cands, st, "hysteresis", h);
+    // an alt-az cable wrap's second turn (the derived "az_turn")
+    for (size_t j = 0; j < run.aux_names.size() && j < (size_t)PM_MAX_AUX; j++)
+        if (run.turn_derived && run.aux_names[j] == "az_turn" &&
+            column_unusable(run, st.use, j).empty())
+            add_candidate(cands, st, "cable_wrap", {"aux:az_turn"});
     // the run's own columns (a tube temperature, a focus position, TPOINT's
     // auxiliary readings): each a cause the run recorded, on c' and e' as
     // `--add aux:NAME` fits it.  Not the axes' own positions (gpoint's axis
@@ -867,7 +872,7 @@ void physical_candidates(const Run &run, const State &st, std::vector<Candidate>
         const std::string &name = run.aux_names[j];
         static const char *const position[] = {"axra", "axdec", "axaz", "axalt",
                                                "angularPosRA", "angularPosDEC"};
-        if (name == dir2 ||
+        if (name == dir2 || (name == "az_turn" && run.turn_derived) ||
             std::any_of(std::begin(position), std::end(position),
                         [&](const char *p) { return name == p; }) ||
             !column_unusable(run, st.use, j).empty())

@@ -366,6 +366,10 @@ const char *family_words(const Run &run, const std::string &e, double sign)
     if (e == "time_drift")
         return "the pointing drifts through the night (arcsec per hour): settling, slipping "
                "encoders or a clock error";
+    if (e == "cable_wrap")
+        return "the pointing differs on the cable wrap's next turn (the file's azimuth count "
+               "past the next multiple of 360 deg): the cables' drag, or an offset that depends "
+               "on the wrap, on the azimuth and elevation index (arcsec on the next turn)";
     if (e.rfind("aux:", 0) == 0)
         return az ? "the pointing follows the run's own column (arcsec per unit of it, about its "
                     "mean), on the azimuth and elevation index: a cause the run recorded (a "

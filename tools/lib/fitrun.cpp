@@ -209,6 +209,33 @@ void derive_directions(Run &r)
             r.aux_values.push_back(col);
         }
     }
+    // The turn of an alt-az cable wrap, as the input "az_turn": where the
+    // file counts its azimuth past a turn (raw_counted) and the run's span
+    // of it is more than a turn, the count's own turn (floor(count / 360
+    // deg)) less the least one's, so 0 and 1 (the pointing may differ on
+    // the next turn: the cables' drag, a wrap-dependent offset; an outside
+    // probe's 30" on the turn beyond 360 deg was called bad points or false
+    // gears).  When a context slot is free and the run has no such column.
+    double lo = HUGE_VAL, hi = -HUGE_VAL;
+    for (const Obs &ob : r.obs) {
+        lo = std::min(lo, ob.raw1);
+        hi = std::max(hi, ob.raw1);
+    }
+    if (counted && hi - lo > 2 * PI &&
+        std::find(r.aux_names.begin(), r.aux_names.end(), "az_turn") == r.aux_names.end() &&
+        (int)r.aux_names.size() < PM_MAX_AUX) {
+        const int j = (int)r.aux_names.size();
+        r.aux_names.push_back("az_turn");
+        r.turn_derived = true;
+        for (Obs &ob : r.obs)
+            ob.ctx.aux[j] = std::floor(ob.raw1 / (2 * PI)) - std::floor(lo / (2 * PI));
+        if (r.aux_values.size() == (size_t)j) {
+            std::vector<double> col;
+            for (const Obs &ob : r.obs)
+                col.push_back(ob.ctx.aux[j]);
+            r.aux_values.push_back(col);
+        }
+    }
 }
 
 std::string term_name(const pm_model &m, int i)
@@ -754,7 +781,8 @@ Run run_for_model(const Run &run, const pm_model &m, const std::vector<std::stri
             c += (c.empty() ? "" : ", ") + n +
                  (n == axis2_dir_name(run.mount) && run.dec_dir_derived
                       ? " (derived from the sequence)"
-                      : "");
+                  : n == "az_turn" && run.turn_derived ? " (derived from the azimuth count)"
+                                                       : "");
         return c.empty() ? std::string("none") : c;
     };
     for (size_t j = 0; j < (size_t)PM_MAX_AUX; j++) {

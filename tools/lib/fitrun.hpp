@@ -51,6 +51,7 @@ struct Run {
     std::vector<std::string> notes; // reader warnings, skipped records
     bool dir_derived = false;       // slew directions from the sequence
     bool dec_dir_derived = false;   // the input "dec_dir" too (derive_directions)
+    bool turn_derived = false;      // the input "az_turn" (derive_directions)
     // every auxiliary column as read, [column][observation] (the contexts
     // hold the first PM_MAX_AUX): run_for_model takes a model's input from
     // beyond them by its name.  Only for the run as read (a run whose obs
