@@ -651,6 +651,7 @@ std::shared_ptr<RunData> read_run(const std::string &path, bool refraction, bool
     std::unique_ptr<pmrun, void (*)(pmrun *)> guard(raw, pmrun_free);
     auto r = std::make_shared<RunData>();
     r->run = run_from_pmrun(raw, path);
+    equinox_hint(r->run, raw, path, ro);
     r->format = pmrun_format(raw);
     pmrun_get_site(raw, &r->site);
     for (int i = 0; i < pmrun_n_skipped(raw); i++) {

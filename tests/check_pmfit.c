@@ -682,6 +682,29 @@ START_TEST(test_pmfit_explain_cable_wrap)
 }
 END_TEST
 
+/* An RTS2 file of J2000 true places read as they are (the default): a note
+** says they fit far better as J2000 (an outside probe's run had come out
+** with sigma 90.7" and a, b, c' hundreds of arcseconds off, and nothing
+** said); not where the places are of date, nor with --equinox given. */
+START_TEST(test_pmfit_rts2_equinox_hint)
+{
+    char path[600];
+    const char *top = getenv("PM_TOP");
+    snprintf(path, sizeof path, "%s/tests/data/rts2_gpoint_j2000.dat", top ? top : ".");
+    ck_assert_msg(run("%s fit %s --order 0%s", path, "") == 0, "%s", out);
+    ck_assert_msg(strstr(out, "its true places fit far better as J2000 places") != NULL &&
+                      strstr(out, "read it with --equinox J2000") != NULL,
+                  "%s", out);
+    ck_assert_msg(run("%s fit %s --order 0 --equinox J2000%s", path, "") == 0, "%s", out);
+    ck_assert_msg(strstr(out, "fit far better") == NULL, "%s", out);
+    ck_assert_msg(run("%s fit %s --order 0 --equinox JNow%s", path, "") == 0, "%s", out);
+    ck_assert_msg(strstr(out, "fit far better") == NULL, "%s", out);
+    snprintf(path, sizeof path, "%s/tests/data/rts2_gpoint.dat", top ? top : ".");
+    ck_assert_msg(run("%s fit %s --order 0%s", path, "") == 0, "%s", out);
+    ck_assert_msg(strstr(out, "fit far better") == NULL, "%s", out);
+}
+END_TEST
+
 /* An error that rounds to 0.00 in the value's unit is given in the next
 ** unit down: a 3' polar error measured to 0.01" read "3.00' +- 0.00'" (an
 ** outside probe). */
@@ -1244,6 +1267,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_pmfit_explain_small_error_shown);
     tcase_add_test(tc, test_pmfit_altaz_counted_azimuth_direction);
     tcase_add_test(tc, test_pmfit_explain_cable_wrap);
+    tcase_add_test(tc, test_pmfit_rts2_equinox_hint);
     tcase_add_test(tc, test_pmfit_printed_commands_quote);
     tcase_add_test(tc, test_pmfit_explain_period_seam);
     tcase_add_test(tc, test_pmfit_explain_no_composition_undetermined);

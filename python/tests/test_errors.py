@@ -451,3 +451,13 @@ def test_inputs_the_c_calls_would_misread(tmp_path):
     with pytest.raises(pm.ArgumentError, match="lst and utc both given"):
         pm.plan(latitude=0.8, lst=3, utc="2026-01-01T00:00", lon=5,
                 catalogue=os.path.join(TOP, "examples", "bright_stars.txt"))
+
+
+def test_rts2_j2000_places_read_as_of_date_noted():
+    # An RTS2 file of J2000 true places read as they are (the default): the
+    # run's warnings say they fit far better as J2000 (an outside probe's run
+    # came out 90.7" with nothing said); not with the equinox given.
+    path = os.path.join(TOP, "tests", "data", "rts2_gpoint_j2000.dat")
+    notes = [w for w in pm.read_run(path).warnings if "fit far better as J2000" in w]
+    assert len(notes) == 1 and 'equinox="J2000"' in notes[0], notes
+    assert not [w for w in pm.read_run(path, equinox="J2000").warnings if "far better" in w]

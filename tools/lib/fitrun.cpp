@@ -25,7 +25,55 @@ Run load_run(const std::string &path, bool refraction, bool skip_bad, int format
     if (pmrun_read(path.c_str(), &ro, &run, err, sizeof err) != 0)
         throw std::runtime_error(err);
     std::unique_ptr<pmrun, void (*)(pmrun *)> guard(run, pmrun_free);
-    return run_from_pmrun(run, path);
+    Run r = run_from_pmrun(run, path);
+    equinox_hint(r, run, path, ro);
+    return r;
+}
+
+// An RTS2 file read with its true places as they are (the default) whose
+// places fit far better reduced from J2000: a note that says so.  Image
+// astrometry gives J2000, and read as of date an outside probe's run came
+// out with sigma 90.7" and a, b, c' hundreds of arcseconds off, without a
+// word (6.2" and every term within 0.3" read with --equinox J2000).  Both
+// readings are fitted at order 0; the note where J2000's sigma is below a
+// third of the other's and 5" less.
+void equinox_hint(Run &r, const pmrun *raw, const std::string &path, const pmrun_options &ro)
+{
+    if (pmrun_format(raw) != PMRUN_FORMAT_RTS2 || ro.equinox != PMRUN_EQUINOX_FILE ||
+        !std::isfinite(r.latitude) || r.obs.size() < 6)
+        return;
+    pmrun_options o2 = ro;
+    o2.equinox = PMRUN_EQUINOX_J2000;
+    o2.skip_bad = 1;
+    pmrun *other = nullptr;
+    char err[1024];
+    if (pmrun_read(path.c_str(), &o2, &other, err, sizeof err) != 0)
+        return;
+    std::unique_ptr<pmrun, void (*)(pmrun *)> guard(other, pmrun_free);
+    Run j = run_from_pmrun(other, path);
+    double sigma[2];
+    const Run *runs[2] = {&r, &j};
+    for (int k = 0; k < 2; k++) {
+        std::vector<int> use(runs[k]->obs.size());
+        for (size_t i = 0; i < use.size(); i++)
+            use[i] = (int)i;
+        const pm_model m = build_model(0, {}, runs[k]->obs, runs[k]->mount, runs[k]->latitude,
+                                       runs[k]->aux_names);
+        FitOut f = do_fit(runs[k]->obs, use, m, FIT_MAX_PASSES);
+        if (f.status != PM_OK)
+            return;
+        sigma[k] = f.res.sigma * RAD2AS;
+    }
+    if (sigma[1] < sigma[0] / 3 && sigma[0] - sigma[1] > 5) {
+        char b[400];
+        std::snprintf(b, sizeof b,
+                      "%s: its true places fit far better as J2000 places (order 0 sigma %.3g\" "
+                      "reduced from J2000, %.3g\" as they are, which is how it was read): image "
+                      "astrometry gives J2000; read it with --equinox J2000 (in Python, "
+                      "read_run(..., equinox=\"J2000\"))",
+                      path.c_str(), sigma[1], sigma[0]);
+        r.notes.push_back(b);
+    }
 }
 
 Run run_from_pmrun(const pmrun *run, const std::string &path)

@@ -65,6 +65,10 @@ struct Run {
 // a PMRUN_EQUINOX_* id (0: as the file says) (tools/lib/runfile.h).
 Run load_run(const std::string &path, bool refraction, bool skip_bad, int format = -1,
              int equinox = 0);
+// A note in r.notes where an RTS2 file read with its true places as they
+// are (ro.equinox PMRUN_EQUINOX_FILE) fits far better with them reduced
+// from J2000 (both fitted at order 0); raw is the run as read.
+void equinox_hint(Run &r, const pmrun *raw, const std::string &path, const pmrun_options &ro);
 // The same from a run already read (pmrun_read), named path in messages.
 Run run_from_pmrun(const pmrun *run, const std::string &path);
 // What load_run derives from the sequence of the observations: the slew
