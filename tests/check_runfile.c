@@ -581,6 +581,25 @@ START_TEST(test_pmrun_read_directory)
 }
 END_TEST
 
+/* A decimal comma (a European locale's writing) is named as such, with
+** the number as it should read, in a four-column file and in a ';' CSV
+** (an outside probe's CSV was told "not an angle"). */
+START_TEST(test_pmrun_read_decimal_comma)
+{
+    static const char four[] = "# latitude: 40\n10.0 20.0 10.1 20.1\n10,5 20 10.6 20.1\n";
+    static const char csv[] = "# longitude: 19.0\n# latitude: 47.0\n# equinox: JNow\n"
+                              "MountRA;MountDec;SolvedRA;SolvedDec;PierSide;Time\n"
+                              "10,1650125;20,5;10,166;20,51;pierEast;2024-03-01T20:00:00Z\n";
+    char tmp[64];
+    temp_file(tmp, sizeof tmp, four, sizeof four - 1);
+    tu_read_fails(tmp, NULL, PMRUN_ERR_FORMAT, 3, "'10,5': a decimal comma? expected a decimal point ('10.5')");
+    unlink(tmp);
+    temp_file(tmp, sizeof tmp, csv, sizeof csv - 1);
+    tu_read_fails(tmp, NULL, PMRUN_ERR_FORMAT, 5, "a decimal comma? expected a decimal point ('10.1650125')");
+    unlink(tmp);
+}
+END_TEST
+
 START_TEST(test_pmrun_read_too_many_records)
 {
     static const char rec[] = "0 0 0 0\n";
@@ -1474,6 +1493,7 @@ static Suite *runfile_suite(void)
     tcase_add_test(tc, test_pmrun_read_missing_file);
     tcase_add_test(tc, test_pmrun_read_directory);
     tcase_add_test(tc, test_pmrun_read_too_many_records);
+    tcase_add_test(tc, test_pmrun_read_decimal_comma);
     tcase_add_test(tc, test_pmrun_read_out_of_memory);
     tcase_add_test(tc, test_pmrun_read_error_truncated);
     tcase_add_test(tc, test_pmrun_read_empty_file);

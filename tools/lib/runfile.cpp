@@ -242,6 +242,18 @@ bool is_number(const std::string &tok)
     return parse_number(tok, v, why);
 }
 
+bool decimal_comma(const std::string &s, std::string &why)
+{
+    const size_t k = !s.empty() && (s[0] == '+' || s[0] == '-') ? 1 : 0, comma = s.find(',');
+    bool digits = comma != std::string::npos && comma > k && comma + 1 < s.size();
+    for (size_t q = k; digits && q < s.size(); q++)
+        digits = q == comma || (s[q] >= '0' && s[q] <= '9');
+    if (digits)
+        why = "a decimal comma? expected a decimal point ('" + s.substr(0, comma) + "." +
+              s.substr(comma + 1) + "'); write the numbers with '.'";
+    return digits;
+}
+
 bool parse_number(const std::string &tok, double &v, std::string &why)
 {
     std::string l = lower(tok);
@@ -251,7 +263,8 @@ bool parse_number(const std::string &tok, double &v, std::string &why)
         return false;
     }
     if (!number_syntax(tok)) {
-        why = "not a number, expected a decimal number";
+        if (!decimal_comma(tok, why))
+            why = "not a number, expected a decimal number";
         return false;
     }
     const char *b = tok.data();

@@ -106,6 +106,9 @@ std::string excerpt(const std::string &s, size_t max = 40);
 // Strict decimal number: [+-]digits[.digits][e[+-]digits].  No NaN, Inf,
 // hex or trailing garbage.  On failure `why` says what was wrong.
 bool parse_number(const std::string &tok, double &v, std::string &why);
+// A token of digits with one decimal comma ('10,165', a European locale's
+// writing): true, with why saying so.
+bool decimal_comma(const std::string &s, std::string &why);
 // An angle in a file (degrees or hours) may be written in any turn, but not
 // beyond +-kMaxAngle = 2^31: fmod reduces 1e300 exactly, to a direction the
 // file never gave (an outside probe's run read it silently).  Below 2^31 a

@@ -70,6 +70,8 @@ bool parse_sexagesimal(const std::string &text, double &value, std::string &why)
         why = "NaN/Inf is not accepted, expected a finite angle";
         return false;
     }
+    if (decimal_comma(s, why))
+        return false;
     size_t i = 0;
     bool neg = false;
     if (s[i] == '+' || s[i] == '-') neg = s[i++] == '-';
