@@ -705,6 +705,43 @@ START_TEST(test_pmfit_rts2_equinox_hint)
 }
 END_TEST
 
+/* A German mount's run whose records beyond the pole are written folded to
+** the sky, without a pier column: every record reads as one side, and the
+** fit and explain say that the residuals change at the meridian as the two
+** sides do (an outside probe's run: sigma 55", "19 points ... failed plate
+** solves?", explain named higher_order).  Not for the run as simulated,
+** with its pier column. */
+START_TEST(test_pmfit_folded_records_without_pier)
+{
+    char src[300], path[300], cmd[1400];
+    make_tmpdir();
+    snprintf(src, sizeof src, "%s/fold_src.dat", tmpdir);
+    snprintf(path, sizeof path, "%s/folded.dat", tmpdir);
+    ck_assert_int_eq(run("%s simulate %s --n 80 --seed 5 --noise 2 --term i=60 --term \"e'=-40\" "
+                         "--term d=20%s",
+                         src, ""),
+                     0);
+    snprintf(cmd, sizeof cmd,
+             "awk '/^# tau/ {print \"# tau delta T D temp time dir\"; next} /^#/ {print; next} "
+             "{t = $1; d = $2; if ($5 == \"W\") {t += 180; if (t > 180) t -= 360; d = 180 - d} "
+             "print t, d, $3, $4, $6, $7, $8}' %s > %s",
+             src, path);
+    ck_assert_int_eq(system(cmd), 0);
+    ck_assert_msg(run("%s fit %s%s", path, "") == 0, "%s", out);
+    ck_assert_msg(strstr(out, "warning: every record reads as one pier side, and the residuals "
+                              "change at the meridian") != NULL &&
+                      strstr(out, "failed plate solves") == NULL,
+                  "%s", out);
+    ck_assert_msg(run("%s explain %s --json%s", path, "") == 0, "%s", out);
+    ck_assert_msg(strstr(out, "\"folded_pier\": \"every record reads as one pier side") != NULL,
+                  "%.2000s", out);
+    ck_assert_msg(run("%s fit %s%s", src, "") == 0, "%s", out);
+    ck_assert_msg(strstr(out, "every record reads as one pier side") == NULL, "%s", out);
+    ck_assert_msg(run("%s explain %s --json%s", src, "") == 0, "%s", out);
+    ck_assert_msg(strstr(out, "\"folded_pier\": null") != NULL, "%.2000s", out);
+}
+END_TEST
+
 /* An error that rounds to 0.00 in the value's unit is given in the next
 ** unit down: a 3' polar error measured to 0.01" read "3.00' +- 0.00'" (an
 ** outside probe). */
@@ -1268,6 +1305,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_pmfit_altaz_counted_azimuth_direction);
     tcase_add_test(tc, test_pmfit_explain_cable_wrap);
     tcase_add_test(tc, test_pmfit_rts2_equinox_hint);
+    tcase_add_test(tc, test_pmfit_folded_records_without_pier);
     tcase_add_test(tc, test_pmfit_printed_commands_quote);
     tcase_add_test(tc, test_pmfit_explain_period_seam);
     tcase_add_test(tc, test_pmfit_explain_no_composition_undetermined);

@@ -1871,7 +1871,13 @@ int run_main(int argc, char **argv)
             std::printf("\n%s\n", error_map_text(run, maps[k]).c_str());
             if (!undetermined[k].empty())
                 std::printf("\n  warning: %s.\n", undetermined[k].c_str());
-            if (o.robust)
+            // (records folded to the sky: the robust hint's "failed plate
+            // solves" would be the wrong cause, 19 of 40 points)
+            const std::string folded =
+                fits.size() == 1 && !o.robust ? folded_pier_hint(run, o.order, o.adds) : "";
+            if (!folded.empty())
+                std::printf("\n  warning: %s.\n", folded.c_str());
+            else if (o.robust)
                 print_robust(robs[k], obs, o.run);
             else
                 print_robust_hint(fits[k], obs, o.run);

@@ -1754,6 +1754,7 @@ Explanation explain_pass(const Run &run, const ExplainOptions &opt)
     ex.periodograms.push_back(periodogram(run, st.cur.f, 1, opt, s2));
     ex.interpretation = interpret(run, st.cur.f);
     ex.physical_reading = physical_reading(run, ex, opt);
+    ex.folded_pier = folded_pier_hint(run, opt.order, opt.adds);
     while ((int)ex.findings.size() < opt.max_findings && step(run, st, opt, ex)) {
     }
     prune(run, st, opt, ex);

@@ -134,6 +134,7 @@ struct Explanation {
     std::vector<std::string> withdrawn_why;
     std::vector<Interpretation> interpretation; // the physical reading of the baseline
     std::string physical_reading;        // order 0 + one term predicts as well as order 1
+    std::string folded_pier;             // folded_pier_hint (fitrun.hpp): sides not in the file
     FitOut baseline, final;              // the two fits (residuals for plots)
     std::vector<int> kept;               // observations used by the final fit
     std::vector<std::string> final_adds;

@@ -165,6 +165,7 @@ std::string explain_json(const Run &run, const Explanation &ex, int order)
                     str(run.mount == PM_MOUNT_ALTAZ ? "altaz" : "equatorial") +
                     ", \"interpretation\": " + interpretation_json(ex) + ", \"physical_reading\": " +
                     (ex.physical_reading.empty() ? "null" : str(ex.physical_reading)) +
+                    ", \"folded_pier\": " + (ex.folded_pier.empty() ? "null" : str(ex.folded_pier)) +
                     ", \"located\": [";
     for (size_t i = 0; i < ex.located.size() && i < 8; i++)
         j += std::string(i ? ", " : "") + "{\"what\": " + str(ex.located[i].what) + ", \"value\": " +
@@ -380,6 +381,8 @@ void print_explain_text(const Run &run, const Explanation &ex, int order, bool a
         if (!ex.physical_reading.empty())
             std::printf("  %s\n", ex.physical_reading.c_str());
     }
+    if (!ex.folded_pier.empty())
+        std::printf("\n  warning: %s\n", ex.folded_pier.c_str());
     print_located(ex, alpha, gears_ha, gears_dec, run.mount == PM_MOUNT_ALTAZ);
     print_findings(ex, alpha, run.mount);
     std::printf("\n  %-22s %5s %10s %10s\n", "step", "P", "sigma(\")", "CV RMS(\")");

@@ -65,6 +65,10 @@ struct Run {
 // a PMRUN_EQUINOX_* id (0: as the file says) (tools/lib/runfile.h).
 Run load_run(const std::string &path, bool refraction, bool skip_bad, int format = -1,
              int equinox = 0);
+// Where an equatorial run's records are all one pier side but its residuals
+// change at the meridian as a German mount's sides do (records folded to the
+// sky, no pier column): the text that says so (fit order, adds); else "".
+std::string folded_pier_hint(const Run &run, int order, const std::vector<std::string> &adds);
 // A note in r.notes where an RTS2 file read with its true places as they
 // are (ro.equinox PMRUN_EQUINOX_FILE) fits far better with them reduced
 // from J2000 (both fitted at order 0); raw is the run as read.

@@ -721,6 +721,8 @@ void section_explain(Page &p, const Data &d)
             p.body += "<li>" + h(ex.physical_reading) + "</li>\n";
         p.body += "</ul>\n";
     }
+    if (!ex.folded_pier.empty())
+        para(p, "<strong>Warning:</strong> " + h(ex.folded_pier) + ".");
     p.body += "<h3>Findings</h3>\n";
     explain_findings(p, d);
     std::string cmd = fmt("pmfit fit %s --order %d", shell_word(d.run.path).c_str(), ex.final_order);
