@@ -1401,9 +1401,10 @@ State baseline(const Run &run, const ExplainOptions &opt)
         why = "term " + term_name(f.model, f.bad_term) + " cannot be determined from these observations";
     else if (f.status == PM_ERR_DIVERGED)
         why = "the fit did not converge" +
-              (st.order > 0 ? std::string(" (--order ") + std::to_string(st.order - 1) +
-                                  " fits fewer terms)"
-                            : std::string());
+              (f.corr_i >= 0 ? fit_failure_detail(f, FIT_MAX_PASSES, "--order")
+               : st.order > 0 ? std::string(" (--order ") + std::to_string(st.order - 1) +
+                                    " fits fewer terms)"
+                              : std::string());
     throw std::runtime_error(run.path + ": the baseline fit failed: " + why +
                              "; try pmfit fit for details");
 }
