@@ -175,13 +175,15 @@ def _as_float(name, value, what="numbers"):
         raise ArgumentError("%s: expected %s (%s)" % (name, what, e)) from None
 
 
-def _as_int(name, value, allowed=None):
+def _as_int(name, value, allowed=None, allowed_words=None):
     f = _as_float(name, value, "integers")
     if f.size and not (_np.isfinite(f).all() and (f == _np.round(f)).all()):
         raise ArgumentError("%s: expected integers" % name)
     a = f.astype(_np.int64)
     if allowed is not None and a.size and not _np.isin(a, allowed).all():
-        raise ArgumentError("%s: expected values in %s" % (name, list(allowed)))
+        bad = a.reshape(-1)[~_np.isin(a.reshape(-1), allowed)][0]
+        raise ArgumentError("%s: expected %s, got %d" % (
+            name, allowed_words or "values in %s" % list(allowed), bad))
     return a.astype(_np.intc)
 
 
@@ -371,7 +373,14 @@ class Model(_pm.Model):
         _pm.Model.coefficients.__set__(self, c)
 
     def copy(self):
+        """An independent copy (also ``copy.copy`` and ``copy.deepcopy``)."""
         return Model._wrap(self)
+
+    def __copy__(self):
+        return self.copy()
+
+    def __deepcopy__(self, memo):
+        return self.copy()
 
     def __repr__(self):
         return "<pm.Model %s, order %d, %d terms>" % (self.mount, self.order, self.n_terms)
@@ -464,7 +473,8 @@ class Model(_pm.Model):
             for n, a in (("start_ha", pos[2]), ("start_dec", pos[3])):
                 if (_np.abs(a) > START_MAX).any():
                     raise ArgumentError("%s: |angle| beyond %g rad (PM_START_MAX)" % (n, START_MAX))
-        s = _as_int("side", side, (0, 1))
+        s = _as_int("side", side, (0, 1),
+                    "0 / 'normal' or 1 / 'flipped' (per point or for all)")
         try:
             s = _np.ascontiguousarray(_np.broadcast_to(s, shape)).reshape(-1)
         except ValueError:
@@ -557,7 +567,9 @@ class Run:
         Messages call observation i (0-based) "line i+1"."""
         m = _mount_id(mount)
         named = [("enc_ha", enc_ha), ("enc_dec", enc_dec), ("app_ha", app_ha), ("app_dec", app_dec)]
-        arrays = [(n, _np.atleast_1d(_as_float(n, v))) for n, v in named]
+        given = [(n, _as_float(n, v)) for n, v in named]
+        shapes = {n: a.shape for n, a in given}
+        arrays = [(n, _np.atleast_1d(a)) for n, a in given]
         for n, a in arrays:
             if a.ndim != 1:
                 raise ArgumentError("%s: expected a 1-D array, got shape %s" % (n, a.shape))
@@ -592,7 +604,12 @@ class Run:
                     raise _first_bad("aux[%r]" % k, _np.where(_np.isnan(a), 0.0, a))
                 names.append(k)
                 extra.append(("aux[%r]" % k, a))
-        for n, a in arrays[1:] + extra:
+        for n, a in arrays[1:]:  # (one per observation, not broadcast: a probe's 0-d
+            if a.shape != arrays[0][1].shape:  # enc_dec was called shape (1,))
+                raise ArgumentError("%s: shape %s, expected %s like enc_ha (the four positions "
+                                    "are one per observation, not broadcast)" % (
+                                        n, shapes[n], arrays[0][1].shape))
+        for n, a in extra:
             if a.ndim > 1 or (a.ndim == 1 and a.shape != arrays[0][1].shape):
                 raise ArgumentError("%s: shape %s, expected %s like enc_ha" % (
                     n, a.shape, arrays[0][1].shape))

@@ -461,3 +461,22 @@ def test_rts2_j2000_places_read_as_of_date_noted():
     notes = [w for w in pm.read_run(path).warnings if "fit far better as J2000" in w]
     assert len(notes) == 1 and 'equinox="J2000"' in notes[0], notes
     assert not [w for w in pm.read_run(path, equinox="J2000").warnings if "far better" in w]
+
+
+def test_model_copy_and_deepcopy_are_independent():
+    import copy
+    m = pm.Model(order=0)
+    for c in (copy.copy(m), copy.deepcopy(m), m.copy()):
+        v = c.coefficients.copy()
+        v[2] += 1e-5
+        c.coefficients = v
+        assert m.coefficients[2] == 0 and c.coefficients[2] == 1e-5
+
+
+def test_invert_side_message_and_fit_shapes_named():
+    m = pm.Model(order=0)
+    with pytest.raises(pm.ArgumentError, match=r"side: expected 0 / 'normal' or 1 / 'flipped'"):
+        m.invert(0.1, 0.2, side=2)
+    h = np.linspace(-1, 1, 20)
+    with pytest.raises(pm.ArgumentError, match=r"enc_dec: shape \(\), expected \(20,\) like enc_ha"):
+        pm.fit(h, 0.3, h, h * 0 + 0.3)
