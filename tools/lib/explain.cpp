@@ -1320,16 +1320,26 @@ std::vector<Alternative> alternatives(const Run &run, const State &st, const Can
     double s2 = c.fit.chi2 / (double)(2 * c.fit.N - c.fit.P);
     double ln2n = std::log((double)(2 * c.fit.N));
     for (const Candidate &a : cands) {
-        if (&a == &c || a.effect == "outlier" || !a.fit.ok || a.fit.P <= st.cur.P ||
-            !(a.log_fap < std::log(opt.alpha)))
+        if (&a == &c || a.effect == "outlier" || !a.fit.ok || a.fit.P <= st.cur.P)
             continue;
         double dchi = (a.fit.chi2 - c.fit.chi2) / s2;
         double dbic = dchi + (a.fit.P - c.fit.P) * ln2n;
         double log10_lr = dchi / 2 / LN10;
         // Delta BIC charges the extra parameters; for two readings of as
-        // many parameters it is 2 ln(likelihood ratio): below 6 = LR below 20
+        // many parameters it is 2 ln(likelihood ratio): below 6 = LR below
+        // 20.  So close a reading is offered where its own false-alarm
+        // probability (trials counted) is within ten times alpha, not only
+        // below it: a finding that only just passes (0.0084) beside a rival
+        // 2.05 in chi^2 behind it that only just misses (0.010) had been
+        // named without it (an outside probe's low-sky flexure read as
+        // refraction).  (A periodic search's best of many periods is close
+        // in chi^2 by chance: its trials keep it out.)  A smooth
+        // alternative must pass alpha.
+        const bool close = dbic < opt.close_delta_bic;
+        if (!(a.log_fap < std::log(close ? 10 * opt.alpha : opt.alpha)))
+            continue;
         double cycles = 0;
-        bool smooth = !(dbic < opt.close_delta_bic) && smooth_alternative(run, st, c, a, opt, &cycles);
+        bool smooth = !close && smooth_alternative(run, st, c, a, opt, &cycles);
         if (!(dbic < opt.close_delta_bic) && !smooth)
             continue;
         Alternative al;
