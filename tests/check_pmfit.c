@@ -665,6 +665,40 @@ START_TEST(test_pmfit_altaz_counted_azimuth_direction)
                   "%s", out);
     ck_assert_msg(fabs(h_fit - 4.0) < 4 * h_err && h_err < 0.3, "c'*dir %.3f +- %.3f (4 injected)",
                   h_fit, h_err);
+    /* A file in 0..360 deg with one record written 360.000000 (359.9999997
+    ** to six decimals), or -180 in -180..180 (atan2), is not a count: read
+    ** as its sister file with 0 (or 180) there (one such record had turned
+    ** every move across the cut the long way round; an outside probe). */
+    {
+        static const char *const ends[2][2] = {{"0.0000000", "360.0000000"},
+                                               {"180.0000000", "-180.0000000"}};
+        for (int k = 0; k < 2; k++) {
+            double v[2];
+            write_counted_altaz(path, 999, k ? -180 : 0, 360, 4, 0);
+            for (int e = 0; e < 2; e++) {
+                char cmd[1600];
+                /* the first record's encoder azimuth at the range's end, its
+                ** star's azimuth moved with it (their difference kept) */
+                snprintf(cmd, sizeof cmd,
+                         "awk 'BEGIN {done = 0} /^#/ {print; next} !done {o = $3 - $1; "
+                         "o -= 360 * int(o / 360 + (o < 0 ? -0.5 : 0.5)); $3 = sprintf(\"%%.7f\", "
+                         "%s + o); $1 = \"%s\"; done = 1} {print}' %.300s > %.300s.end && "
+                         "mv %.300s.end %.300s",
+                         ends[k][e], ends[k][e], path, path, path, path);
+                ck_assert_int_eq(system(cmd), 0);
+                ck_assert_msg(run("%s fit %s --order 0 --add hysteresis --json%s", path, "") == 0,
+                              "%s", out);
+                p = strstr(out, "\"name\": \"c'*dir\"");
+                ck_assert_msg(p && sscanf(strstr(p, "\"value_arcsec\""), "\"value_arcsec\": %lf",
+                                          &v[e]) == 1,
+                              "%s", out);
+            }
+            /* (this gimbal never crosses the file's cut, which a 0..360
+            ** file cannot show: both read the short way round, alike) */
+            ck_assert_msg(v[0] == v[1], "%s: c'*dir %.4f, %s: %.4f", ends[k][0], v[0], ends[k][1],
+                          v[1]);
+        }
+    }
 }
 END_TEST
 

@@ -246,20 +246,24 @@ std::string mount_words(const std::string &s, int mount)
 
 // True where the file wrote axis 1 as a count that runs on past a turn
 // (every value finite, and not all within one of the two ranges a modular
-// writer uses, [0, 360) and (-180, 180] deg: an alt-az controller's cable
-// wrap, e.g. -270..270 or 90..450 deg).  The count then says which way the
-// axis went between two points, however far; an outside probe's runs with
-// the azimuth written 90..450 deg had their backlash read at half its size
-// from the short way round, and false gear periods beside it.
+// writer uses, 0..360 and -180..180 deg, both ends and a micro-degree
+// beyond them included: atan2 gives -180 as well as 180, and 359.9999997
+// printed to six decimals is 360.000000, and one such record had read a
+// whole run as a count, every move across the cut the long way round; an
+// outside probe): an alt-az controller's cable wrap, e.g. -270..270 or
+// 90..450 deg.  The count then says which way the axis went between two
+// points, however far; an outside probe's runs with the azimuth written
+// 90..450 deg had their backlash read at half its size from the short way
+// round, and false gear periods beside it.
 static bool raw_counted(const std::vector<Obs> &obs)
 {
-    const double eps = 1e-9 * PI / 180, turn = 2 * PI;
+    const double eps = 1e-6 * PI / 180, turn = 2 * PI;
     bool in_0_360 = true, in_pm180 = true;
     for (const Obs &ob : obs) {
         if (!std::isfinite(ob.raw1))
             return false;
-        in_0_360 = in_0_360 && ob.raw1 >= -eps && ob.raw1 < turn - eps;
-        in_pm180 = in_pm180 && ob.raw1 > -PI + eps && ob.raw1 <= PI + eps;
+        in_0_360 = in_0_360 && ob.raw1 >= -eps && ob.raw1 <= turn + eps;
+        in_pm180 = in_pm180 && ob.raw1 >= -PI - eps && ob.raw1 <= PI + eps;
     }
     return !obs.empty() && !in_0_360 && !in_pm180;
 }
