@@ -1808,7 +1808,7 @@ int run_main(int argc, char **argv)
                                       "position, derived)"
                                 : std::string(info.input[j]) == "az_turn" && run.turn_derived
                                     ? " (the turn of the file's azimuth count past 360 deg "
-                                      "multiples, less the run's least: 0 or 1, derived)"
+                                      "multiples, less the run's least: 0, 1 or 2, derived)"
                                     : "");
         // a write that fails now still lets the report below be printed
         if (!o.save.empty() &&

@@ -324,18 +324,20 @@ void derive_directions(Run &r)
         }
     }
     // The turn of an alt-az cable wrap, as the input "az_turn": where the
-    // file counts its azimuth past a turn (raw_counted) and the run's span
-    // of it is more than a turn, the count's own turn (floor(count / 360
-    // deg)) less the least one's, so 0 and 1 (the pointing may differ on
-    // the next turn: the cables' drag, a wrap-dependent offset; an outside
-    // probe's 30" on the turn beyond 360 deg was called bad points or false
-    // gears).  When a context slot is free and the run has no such column.
+    // file counts its azimuth past a turn (raw_counted) and the run's count
+    // crosses a multiple of 360 deg, the count's own turn (floor(count / 360
+    // deg)) less the least one's: 0 and 1, or 2 where the count crosses two
+    // (the pointing may differ on the next turn: the cables' drag, a
+    // wrap-dependent offset; an outside probe's 30" on the turn beyond 360
+    // deg was called bad points or false gears, over -270..270 deg and over
+    // 90..450, where each azimuth has one count and the turn is a step at
+    // north).  When a context slot is free and the run has no such column.
     double lo = HUGE_VAL, hi = -HUGE_VAL;
     for (const Obs &ob : r.obs) {
         lo = std::min(lo, ob.raw1);
         hi = std::max(hi, ob.raw1);
     }
-    if (counted && hi - lo > 2 * PI &&
+    if (counted && std::floor(hi / (2 * PI)) != std::floor(lo / (2 * PI)) &&
         std::find(r.aux_names.begin(), r.aux_names.end(), "az_turn") == r.aux_names.end() &&
         (int)r.aux_names.size() < PM_MAX_AUX) {
         const int j = (int)r.aux_names.size();
