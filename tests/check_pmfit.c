@@ -727,6 +727,16 @@ START_TEST(test_pmfit_explain_cable_wrap)
     write_counted_altaz(path, 777, 0, 540, 0, 0);
     ck_assert_msg(run("%s explain %s --json%s", path, "") == 0, "%s", out);
     ck_assert_msg(strstr(out, "\"effect\": \"cable_wrap\"") == NULL, "%s", out);
+    /* a count over 90..450 deg, each azimuth once: the turn is a step at
+    ** north (it had not been tried there, and 30" were read as gears) */
+    write_counted_altaz(path, 778, 90, 360, 0, 30);
+    ck_assert_msg(run("%s explain %s --json%s", path, "") == 0, "%s", out);
+    p = strstr(out, "\"effect\": \"cable_wrap\"");
+    ck_assert_msg(p && (p = strstr(p, "\"name\": \"c'*aux1\", \"column\": \"az_turn\"")) &&
+                      sscanf(strstr(p, "\"value_arcsec\""),
+                             "\"value_arcsec\": %lf, \"error_arcsec\": %lf", &v, &e) == 2,
+                  "%s", out);
+    ck_assert_msg(fabs(v - 30.0) < 4 * e && e < 1.5, "c'*az_turn %.3f +- %.3f (30 injected)", v, e);
 }
 END_TEST
 
