@@ -97,8 +97,12 @@ std::string folded_pier_hint(const Run &run, int order, const std::vector<std::s
 // astrometry gives J2000, and read as of date an outside probe's run came
 // out with sigma 90.7" and a, b, c' hundreds of arcseconds off, without a
 // word (6.2" and every term within 0.3" read with --equinox J2000).  Both
-// readings are fitted at order 0; the note where J2000's sigma is below a
-// third of the other's and 5" less.
+// readings are fitted at order 0, the one as read with a refraction term
+// (the J2000 reduction adds refraction: over a short run of places of date
+// order 0 holds the precession, and the comparison had rewarded the
+// refraction, not the equinox; an outside probe's JNow runs of 6-15
+// minutes got the note 10 times in 10); the note where J2000's sigma is
+// below a third of the other's and 5" less.
 void equinox_hint(Run &r, const pmrun *raw, const std::string &path, const pmrun_options &ro)
 {
     if (pmrun_format(raw) != PMRUN_FORMAT_RTS2 || ro.equinox != PMRUN_EQUINOX_FILE ||
@@ -119,8 +123,9 @@ void equinox_hint(Run &r, const pmrun *raw, const std::string &path, const pmrun
         std::vector<int> use(runs[k]->obs.size());
         for (size_t i = 0; i < use.size(); i++)
             use[i] = (int)i;
-        const pm_model m = build_model(0, {}, runs[k]->obs, runs[k]->mount, runs[k]->latitude,
-                                       runs[k]->aux_names);
+        const pm_model m =
+            build_model(0, k == 0 ? std::vector<std::string>{"refraction"} : std::vector<std::string>{},
+                        runs[k]->obs, runs[k]->mount, runs[k]->latitude, runs[k]->aux_names);
         FitOut f = do_fit(runs[k]->obs, use, m, FIT_MAX_PASSES);
         if (f.status != PM_OK)
             return;
@@ -130,7 +135,8 @@ void equinox_hint(Run &r, const pmrun *raw, const std::string &path, const pmrun
         char b[400];
         std::snprintf(b, sizeof b,
                       "%s: its true places fit far better as J2000 places (order 0 sigma %.3g\" "
-                      "reduced from J2000, %.3g\" as they are, which is how it was read): image "
+                      "reduced from J2000, %.3g\" as they are with a refraction term; they were "
+                      "read as they are): image "
                       "astrometry gives J2000; read it with --equinox J2000 (in Python, "
                       "read_run(..., equinox=\"J2000\"))",
                       path.c_str(), sigma[1], sigma[0]);
