@@ -823,6 +823,14 @@ START_TEST(test_pmfit_folded_records_without_pier)
     ck_assert_msg(strstr(out, "every record reads as one pier side") == NULL, "%s", out);
     ck_assert_msg(run("%s explain %s --json%s", src, "") == 0, "%s", out);
     ck_assert_msg(strstr(out, "\"folded_pier\": null") != NULL, "%.2000s", out);
+    /* Nor a German mount that never flips, its hour-angle index stepping
+    ** 10" at the meridian as the balance reverses (an outside probe's
+    ** gimbal, tests/ref/equ_gen_v.py: 4 runs of 8 had been told their
+    ** records were folded) */
+    snprintf(src, sizeof src, "%s/tests/data/gem_oneside_balstep.dat",
+             getenv("PM_TOP") ? getenv("PM_TOP") : ".");
+    ck_assert_msg(run("%s fit %s%s", src, "") == 0, "%.2000s", out);
+    ck_assert_msg(strstr(out, "every record reads as one pier side") == NULL, "%.2000s", out);
 }
 END_TEST
 

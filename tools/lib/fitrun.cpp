@@ -39,7 +39,8 @@ Run load_run(const std::string &path, bool refraction, bool skip_bad, int format
 // mount tracks past it before it flips), both sides hold 5 or more, and on
 // those records the model of the fit with e'@W and i@W read by the encoder
 // hour angle's sign (west where it is positive) fits far better (F-test p <
-// 1e-6, sigma below 2/3), the text that says so; else empty.
+// 1e-6, sigma below 2/3) and better than a step of c' there (below), the
+// text that says so; else empty.
 std::string folded_pier_hint(const Run &run, int order, const std::vector<std::string> &adds)
 {
     if (run.mount != PM_MOUNT_EQUATORIAL)
@@ -60,15 +61,18 @@ std::string folded_pier_hint(const Run &run, int order, const std::vector<std::s
     Run by_ha = run;
     for (Obs &o : by_ha.obs)
         o.pier = o.ctx.pier = std::remainder(o.eh, 2 * PI) < 0 ? 1 : -1;
-    std::vector<std::string> sided = adds;
+    std::vector<std::string> sided = adds, stepped = adds;
     sided.push_back("e'@W");
     sided.push_back("i@W");
-    FitOut f[2];
+    stepped.push_back("c'@W");
+    FitOut f[3];
     try {
         f[0] = do_fit(run.obs, use,
                       build_model(order, adds, run.obs, run.mount, run.latitude, run.aux_names));
         f[1] = do_fit(by_ha.obs, use,
                       build_model(order, sided, by_ha.obs, run.mount, run.latitude, run.aux_names));
+        f[2] = do_fit(by_ha.obs, use, build_model(order, stepped, by_ha.obs, run.mount,
+                                                  run.latitude, run.aux_names));
     } catch (const std::exception &) {
         return "";
     }
@@ -77,6 +81,15 @@ std::string folded_pier_hint(const Run &run, int order, const std::vector<std::s
     const FTest t = f_test(f[0].res.chi2, f[0].res.n_par, f[1].res.chi2, f[1].res.n_par,
                            (long)use.size(), "");
     if (!(t.done && t.p < 1e-6 && f[1].res.sigma < f[0].res.sigma * 2 / 3))
+        return "";
+    // Not where a step of the hour-angle index at the meridian does as well
+    // (BIC, its one term against two): a German mount that never flips, its
+    // worm changing flank as the balance reverses there, had been told its
+    // records were folded (an outside probe's 10" step: 4 runs of 8).
+    const double s2 = f[1].res.sigma * f[1].res.sigma,
+                 ln2n = std::log(2.0 * (double)use.size());
+    if (f[2].status == PM_OK &&
+        !(f[1].res.chi2 < f[2].res.chi2 - s2 * ln2n * (f[1].res.n_par - f[2].res.n_par)))
         return "";
     char b[700];
     std::snprintf(b, sizeof b,
