@@ -198,7 +198,8 @@ std::string error_map_text(const Run &run, const ErrorMap &e)
     char b[600];
     std::snprintf(b, sizeof b,
                   "  predicted pointing error of this model (1 sigma per axis, from the fit's "
-                  "covariance):\n    over the sky above %s %.0f deg (the lowest star): RMS %.3g\", "
+                  "covariance; not what the model leaves out, which sigma holds with the "
+                  "noise):\n    over the sky above %s %.0f deg (the lowest star): RMS %.3g\", "
                   "max %.3g\" at %s %.0f deg, %s %.0f deg; at the stars %.3g\"",
                   e.elevation ? "elevation" : "declination", e.limit_deg, e.mean_arcsec,
                   e.max_arcsec, altaz ? "azimuth" : "HA", e.max_x_deg,
