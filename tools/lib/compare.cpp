@@ -256,26 +256,27 @@ std::string advice_of(const Comparison &c)
                                        "cross-validated %.3g\" as is, refitted %s",
                           c.n_terms, p_text(c.joint_log10p).c_str(), single.c_str(), c.cv_as_is,
                           refit_s.c_str());
-        } else if (refit_cv && c.cv_refit >= c.cv_as_is && !(1.05 * c.cv_rezero < c.cv_as_is)) {
-            // The terms moved, yet this night's own refit predicts it no
-            // better than the model as is: no refit advised (an outside
-            // probe's alt-az pair of 20-star nights, nothing changed: "refit"
-            // at cross-validated 8.49" refitted against 1.49" as is, the
-            // refit 3 times worse than the old model against its truth).
-            std::snprintf(b, sizeof b, "keep the model: its terms %s (joint test, %s), yet this "
-                                       "night's own refit predicts it no better (cross-validated "
-                                       "%.3g\" refitted, %.3g\" as is, %.3g\" re-zeroed): take "
-                                       "more stars before refitting",
-                          moved, p_text(c.joint_log10p).c_str(), c.cv_refit, c.cv_as_is,
-                          c.cv_rezero);
         } else if (refit_cv && c.cv_refit >= c.cv_as_is) {
-            std::snprintf(b, sizeof b, "re-zero the index terms (c' %+.2f\", e' %+.2f\"): that "
-                                       "predicts this night best (cross-validated %.3g\" "
-                                       "re-zeroed, %.3g\" as is); the terms %s (joint test, "
-                                       "%s), but this night's own refit predicts it worse "
-                                       "(%.3g\")",
-                          c.rezero_c, c.rezero_e, c.cv_rezero, c.cv_as_is, moved,
-                          p_text(c.joint_log10p).c_str(), c.cv_refit);
+            // The terms moved, yet this night's own refit cross-validates no
+            // better than the model as is: undecided, and said so.  An
+            // outside probe's unchanged alt-az mount (20 stars a night) got
+            // "refit" at 8.49" refitted against 1.49" as is, the refit 3
+            // times worse against its truth; a second probe's real changes
+            // on 20-star nights, told "keep the model" for that, were 3-8
+            // times better refitted: 20 stars for 22 terms cannot decide it.
+            const std::string meanwhile =
+                1.05 * c.cv_rezero < c.cv_as_is
+                    ? fmt("; meanwhile a re-zero of the index terms (c' %+.2f\", e' %+.2f\") "
+                          "predicts it best",
+                          c.rezero_c, c.rezero_e)
+                    : std::string();
+            std::snprintf(b, sizeof b, "undecided: the terms %s (joint test, %s), yet this "
+                                       "night's own refit cross-validates no better (%.3g\" "
+                                       "refitted, %.3g\" as is, %.3g\" re-zeroed): %ld stars "
+                                       "for %d terms do not determine a refit; take more stars "
+                                       "and compare again%s",
+                          moved, p_text(c.joint_log10p).c_str(), c.cv_refit, c.cv_as_is,
+                          c.cv_rezero, c.n_obs, c.n_terms, meanwhile.c_str());
         } else if (c.rest_log10p >= alpha_log10 && !rezero_far_worse) {
             std::snprintf(b, sizeof b, "re-zero the index terms (c' %+.2f\", e' %+.2f\"): the "
                                        "terms %s together (joint test, %s), but beyond the "
