@@ -702,6 +702,59 @@ START_TEST(test_pmfit_altaz_counted_azimuth_direction)
 }
 END_TEST
 
+/* A file in 0..360 deg of a mount that never turns through north (its
+** directions are the count's; the generator's mount so): explain finds the
+** slew directions fit far better read so, says it, explains so, and its
+** closing command carries --azimuth-count, which fit takes (the short way
+** round had read the backlash at a third and stacked false gears on it; an
+** outside probe's 6 of 6).  Reading options repeat in the closing command
+** (--equinox J2000 had been dropped from it). */
+START_TEST(test_pmfit_explain_azimuth_count_reading)
+{
+    char path[300];
+    double h_fit = 0, h_err = 1;
+    make_tmpdir();
+    snprintf(path, sizeof path, "%s/count360.dat", tmpdir);
+    ck_assert(write_counted_altaz(path, 4242, 0, 360, 4, 0) > 30);
+    ck_assert_msg(run("%s explain %s%s", path, "") == 0, "%.2000s", out);
+    ck_assert_msg(strstr(out, "fit far better with the file's azimuth read as the mount's count") &&
+                      strstr(out, "--add 'hysteresis'") && strstr(out, " --azimuth-count   #") &&
+                      !strstr(out, "az_periodic"),
+                  "%.3000s", out);
+    ck_assert_msg(run("%s fit %s --order 0 --add hysteresis --azimuth-count --json%s", path, "") ==
+                      0,
+                  "%.2000s", out);
+    const char *p = strstr(out, "\"name\": \"c'*dir\"");
+    ck_assert_msg(p && (p = strstr(p, "\"value_arcsec\"")) &&
+                      sscanf(p, "\"value_arcsec\": %lf, \"error_arcsec\": %lf", &h_fit, &h_err) == 2,
+                  "%.2000s", out);
+    ck_assert_msg(fabs(h_fit - 4.0) < 4 * h_err && h_err < 0.3, "c'*dir %.3f +- %.3f (4 injected)",
+                  h_fit, h_err);
+    /* a mount that does take the short way (pmfit simulate's) is not read so */
+    snprintf(path, sizeof path, "%s/short.dat", tmpdir);
+    ck_assert_int_eq(run("%s simulate %s --mount altaz --n 150 --seed 3 --effect hysteresis=3%s",
+                         path, ""),
+                     0);
+    {
+        char cmd[1600];
+        snprintf(cmd, sizeof cmd,
+                 "awk '/^# tau/ {print \"# tau delta T D temp time\"; next} /^#/ {print; next} "
+                 "{a = $1; t = $3; if (a < 0) a += 360; if (t < 0) t += 360; "
+                 "print a, $2, t, $4, $5, $6}' %.300s > %.300s.n && mv %.300s.n %.300s",
+                 path, path, path, path);
+        ck_assert_int_eq(system(cmd), 0);
+    }
+    ck_assert_msg(run("%s explain %s%s", path, "") == 0, "%.2000s", out);
+    ck_assert_msg(!strstr(out, "azimuth-count") && strstr(out, "1. hysteresis"), "%.3000s", out);
+    /* the reading options in the closing command */
+    snprintf(path, sizeof path, "%s/tests/data/rts2_gpoint_j2000.dat",
+             getenv("PM_TOP") ? getenv("PM_TOP") : ".");
+    ck_assert_msg(run("%s explain %s --order 0 --equinox J2000 --no-refraction%s", path, "") == 0,
+                  "%.2000s", out);
+    ck_assert_msg(strstr(out, " --no-refraction --equinox J2000   # fits") != NULL, "%.3000s", out);
+}
+END_TEST
+
 /* A cable wrap's second turn: where the azimuth count spans more than a
 ** turn (0..540 deg), explain tries the input az_turn (0, or 1 past 360)
 ** and names an offset there as cable_wrap (an outside probe's 10" and 30"
@@ -1396,6 +1449,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_pmfit_explain_small_error_shown);
     tcase_add_test(tc, test_pmfit_altaz_counted_azimuth_direction);
     tcase_add_test(tc, test_pmfit_explain_cable_wrap);
+    tcase_add_test(tc, test_pmfit_explain_azimuth_count_reading);
     tcase_add_test(tc, test_pmfit_rts2_equinox_hint);
     tcase_add_test(tc, test_pmfit_folded_records_without_pier);
     tcase_add_test(tc, test_pmfit_explain_close_rival_above_alpha);

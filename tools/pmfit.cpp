@@ -102,6 +102,7 @@ struct Options {
     bool progress = false;           // report: a line per stage on stderr, always
     int format = PMRUN_FORMAT_AUTO;  // --format NAME (docs/formats.md)
     int equinox = PMRUN_EQUINOX_FILE; // --equinox J2000|JNow
+    bool az_count = false;            // --azimuth-count
     std::string tpoint_terms;        // fit --tpoint-terms FILE
     bool order_given = false;        // --order on the command line
 };
@@ -113,7 +114,7 @@ void usage(FILE *f)
         "                     [--residuals FILE] [--save MODEL] [--emit-c HEADER]\n"
         "                     [--error-map F] [--tpoint-terms FILE] [--no-refraction]\n"
         "                     [--skip-bad] [--robust [--clip K]] [--format NAME]\n"
-        "                     [--equinox J2000|JNow]\n"
+        "                     [--equinox J2000|JNow] [--azimuth-count]\n"
         "\n"
         "  RUN              pointing run: four-column, named-column, TPOINT, RTS2 gpoint,\n"
         "                   MountWizzard4 JSON, CSV log or MMT log (docs/formats.md)\n"
@@ -154,6 +155,10 @@ void usage(FILE *f)
         "  --equinox E      J2000 or JNow: the equinox of a CSV log's or an RTS2 file's\n"
         "                   RA/Dec places, over what the file says (docs/formats.md);\n"
         "                   an error for formats it does not apply to (TPOINT, columns, MMT)\n"
+        "  --azimuth-count  an alt-az file's azimuth is the mount's count, even within\n"
+        "                   0..360 deg: the slew direction is its change (the mount never\n"
+        "                   turns through the file's seam; explain offers it where it fits\n"
+        "                   far better; docs/explain.md)\n"
         "  --robust         ignore gross outliers (failed plate solves): clip points whose\n"
         "                   residual on the sky exceeds K robust sigmas, refit, repeat until\n"
         "                   stable; the report lists them by line (docs/robust.md)\n"
@@ -228,7 +233,7 @@ void usage(FILE *f)
         "usage: pmfit report RUN -o PAGE.html [--order L] [--add EFFECT ...] [--compare OLD]\n"
         "                    [--next K] [--min-el DEG] [--horizon FILE] [--alpha P]\n"
         "                    [--gear [ha:|dec:|az:|el:]G ...] [--no-refraction] [--skip-bad]\n"
-        "                    [--format NAME] [--equinox J2000|JNow]\n"
+        "                    [--format NAME] [--equinox J2000|JNow] [--azimuth-count]\n"
         "                    [--quiet | --progress]\n"
         "\n"
         "  one self-contained HTML page (inline SVG, no script, no network): the fit and its\n"
@@ -397,6 +402,8 @@ Options parse_report(Options o, int argc, char **argv)
             set_format(o, need("a format name"));
         } else if (a == "--equinox") {
             set_equinox(o, need("J2000 or JNow"));
+        } else if (a == "--azimuth-count") {
+            o.az_count = true;
         } else if (a == "--quiet" || a == "-q") {
             o.quiet = true;
         } else if (a == "--progress") {
@@ -620,6 +627,8 @@ bool run_option(Options &o, const Cmd &c, Args &g)
         set_format(o, g.need("a format name"));
     } else if (a == "--equinox") {
         set_equinox(o, g.need("J2000 or JNow"));
+    } else if (a == "--azimuth-count") {
+        o.az_count = true;
     } else if (a == "--no-refraction") {
         o.refraction = false;
     } else if (a == "--skip-bad") {
@@ -1663,11 +1672,30 @@ int run_main(int argc, char **argv)
 
     Run run;
     try {
-        run = load_run(o.run, o.refraction, o.skip_bad, o.format, o.equinox);
+        run = load_run(o.run, o.refraction, o.skip_bad, o.format, o.equinox, o.az_count);
+        // explain and report: an alt-az run whose slew directions fit far
+        // better read from the azimuth as the mount's count is explained so
+        // (count_reading_hint), and says so
+        if ((o.cmd == "explain" || o.cmd == "report") && !o.az_count) {
+            const std::string hint = count_reading_hint(run, o.order, o.adds);
+            if (!hint.empty()) {
+                run = load_run(o.run, o.refraction, o.skip_bad, o.format, o.equinox, true);
+                run.notes.push_back(o.run + ": " + hint + " (read so here)");
+            }
+        }
     } catch (const std::exception &x) {
         // (report says so of every failure; its run's had lacked it)
         die(std::string(x.what()) + (o.cmd == "report" ? " (no page written)" : ""), 1);
     }
+    run.read_options = std::string(o.refraction ? "" : " --no-refraction") +
+                       (o.skip_bad ? " --skip-bad" : "") +
+                       (o.format != PMRUN_FORMAT_AUTO
+                            ? std::string(" --format ") + pmrun_format_name(o.format)
+                            : "") +
+                       (o.equinox == PMRUN_EQUINOX_J2000  ? " --equinox J2000"
+                        : o.equinox == PMRUN_EQUINOX_JNOW ? " --equinox JNow"
+                                                          : "") +
+                       (run.az_count ? " --azimuth-count" : "");
     for (const std::string &n : run.notes)
         std::fprintf(stderr, "pmfit: note: %s\n", n.c_str());
     std::vector<Obs> &obs = run.obs;

@@ -408,6 +408,7 @@ void print_explain_text(const Run &run, const Explanation &ex, int order, bool a
     std::printf("\n  pmfit fit %s --order %d", shell_word(run.path).c_str(), ex.final_order);
     for (const std::string &a : ex.final_adds)
         std::printf(" --add %s", add_word(mount_words(a, run.mount)).c_str());
+    std::printf("%s", run.read_options.c_str()); /* (as it was read: --equinox, ...) */
     std::vector<int> bad;
     for (const Finding &f : ex.findings)
         if (f.effect == "outlier")

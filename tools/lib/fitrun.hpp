@@ -52,6 +52,10 @@ struct Run {
     bool dir_derived = false;       // slew directions from the sequence
     bool dec_dir_derived = false;   // the input "dec_dir" too (derive_directions)
     bool turn_derived = false;      // the input "az_turn" (derive_directions)
+    bool az_count = false;          // axis 1 read as the mount's count (load_run)
+    // the reading options a command that refits the run repeats
+    // (" --equinox J2000 --no-refraction ..."; explain's closing command)
+    std::string read_options;
     // every auxiliary column as read, [column][observation] (the contexts
     // hold the first PM_MAX_AUX): run_for_model takes a model's input from
     // beyond them by its name.  Only for the run as read (a run whose obs
@@ -63,8 +67,11 @@ struct Run {
 // axis 1 is the sign of the encoder's change from the previous observation.
 // format: a PMRUN_FORMAT_* id or -1 (PMRUN_FORMAT_AUTO, detect); equinox:
 // a PMRUN_EQUINOX_* id (0: as the file says) (tools/lib/runfile.h).
+// az_count: an alt-az file's azimuth is the mount's count, read so even
+// within 0..360 deg (the mount never turns through the file's seam;
+// pmfit --azimuth-count; derive_directions).
 Run load_run(const std::string &path, bool refraction, bool skip_bad, int format = -1,
-             int equinox = 0);
+             int equinox = 0, bool az_count = false);
 // Where an equatorial run's records are all one pier side but its residuals
 // change at the meridian as a German mount's sides do (records folded to the
 // sky, no pier column): the text that says so (fit order, adds); else "".
@@ -74,12 +81,19 @@ std::string folded_pier_hint(const Run &run, int order, const std::vector<std::s
 // from J2000 (both fitted at order 0); raw is the run as read.
 void equinox_hint(Run &r, const pmrun *raw, const std::string &path, const pmrun_options &ro);
 // The same from a run already read (pmrun_read), named path in messages.
-Run run_from_pmrun(const pmrun *run, const std::string &path);
+Run run_from_pmrun(const pmrun *run, const std::string &path, bool az_count = false);
 // What load_run derives from the sequence of the observations: the slew
 // direction on axis 1 where no observation has one, and the input "dec_dir"
 // ("el_dir" on an alt-az mount: axis2_dir_name) where the run has no such
 // column and a context slot is free.
-void derive_directions(Run &r);
+// az_count: axis 1 of an alt-az run as written is the mount's count (the
+// slew direction its change), whatever its range (load_run).
+void derive_directions(Run &r, bool az_count = false);
+// Where an alt-az run's slew directions were taken the short way round
+// but the file's azimuth read as the mount's count (never through the
+// file's 0/360 seam) gives other ones, and with a backlash term they fit
+// far better so (order, adds as the fit's): the text that says so; else "".
+std::string count_reading_hint(const Run &run, int order, const std::vector<std::string> &adds);
 // The name of the derived slew direction on axis 2: "el_dir" on an alt-az
 // mount, "dec_dir" on an equatorial one.
 const char *axis2_dir_name(int mount);

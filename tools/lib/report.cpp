@@ -728,6 +728,7 @@ void section_explain(Page &p, const Data &d)
     std::string cmd = fmt("pmfit fit %s --order %d", shell_word(d.run.path).c_str(), ex.final_order);
     for (const std::string &a : ex.final_adds)
         cmd += " --add " + add_word(mount_words(a, d.run.mount));
+    cmd += d.run.read_options; /* (as it was read: --equinox, ...) */
     para(p, "The explained model: <code>" + h(cmd) + "</code>");
     figure(p, "Residuals on the sky (arcsec, scale arrow in the legend) of the baseline (left) and of the "
               "explained model (right), on the same axes and arrow scale: " + h(d.xlabel()) + " and " +
