@@ -619,7 +619,8 @@ struct RunData {
 };
 
 std::shared_ptr<RunData> read_run(const std::string &path, bool refraction, bool skip_bad,
-                                  const std::string &format, const std::string &equinox)
+                                  const std::string &format, const std::string &equinox,
+                                  bool azimuth_count = false)
 {
     pmrun_options ro;
     pmrun_options_default(&ro);
@@ -650,7 +651,7 @@ std::shared_ptr<RunData> read_run(const std::string &path, bool refraction, bool
     }
     std::unique_ptr<pmrun, void (*)(pmrun *)> guard(raw, pmrun_free);
     auto r = std::make_shared<RunData>();
-    r->run = run_from_pmrun(raw, path);
+    r->run = run_from_pmrun(raw, path, azimuth_count);
     equinox_hint(r->run, raw, path, ro);
     r->format = pmrun_format(raw);
     pmrun_get_site(raw, &r->site);
@@ -1369,7 +1370,8 @@ PYBIND11_MODULE(_pm, mod)
     py::class_<RunData, std::shared_ptr<RunData>>(mod, "RunData")
         .def("columns", &run_columns)
         .def("info", &run_info);
-    mod.def("read_run", &read_run);
+    mod.def("read_run", &read_run, py::arg("path"), py::arg("refraction"), py::arg("skip_bad"),
+            py::arg("format"), py::arg("equinox"), py::arg("azimuth_count") = false);
     mod.def("run_from_arrays", &run_from_arrays);
 
     py::class_<Fit>(mod, "Fit")

@@ -649,7 +649,8 @@ class Run:
         return explain(self, **kw)
 
 
-def read_run(path, refraction=True, skip_bad=False, format="auto", equinox=None):
+def read_run(path, refraction=True, skip_bad=False, format="auto", equinox=None,
+             azimuth_count=False):
     """Read a pointing run file: four-column, named-column, TPOINT, RTS2
     gpoint, MountWizzard4 JSON, N.I.N.A./ASCOM CSV or MMT log
     (docs/formats.md), detected from its content.
@@ -661,9 +662,11 @@ def read_run(path, refraction=True, skip_bad=False, format="auto", equinox=None)
     ``refraction``: apply refraction in the TPOINT equatorial reduction
     (pmfit's default; False is --no-refraction).  ``skip_bad``: skip
     malformed records, each listed in ``run.skipped`` (--skip-bad); otherwise
-    the first one raises FormatError("path:LINE: ...")."""
+    the first one raises FormatError("path:LINE: ...").  ``azimuth_count``:
+    an alt-az file's azimuth is the mount's count even within 0..360 deg, the
+    slew direction its change (pmfit --azimuth-count)."""
     return Run(_pm.read_run(_path(path), bool(refraction), bool(skip_bad), str(format),
-                            "" if equinox is None else str(equinox)))
+                            "" if equinox is None else str(equinox), bool(azimuth_count)))
 
 
 def _run(run):

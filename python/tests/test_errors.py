@@ -480,3 +480,16 @@ def test_invert_side_message_and_fit_shapes_named():
     h = np.linspace(-1, 1, 20)
     with pytest.raises(pm.ArgumentError, match=r"enc_dec: shape \(\), expected \(20,\) like enc_ha"):
         pm.fit(h, 0.3, h, h * 0 + 0.3)
+
+
+def test_read_run_azimuth_count(tmp_path):
+    # azimuth_count: an alt-az file in 0..360 deg read as the mount's count:
+    # the slew direction is the change of the written azimuth, however far
+    # (350 -> 10 is a move of -340, not +20)
+    p = tmp_path / "count.dat"
+    p.write_text("# mount: altaz\n# latitude: 40\n# tau delta T D\n"
+                 "350 40 350.01 40\n10 41 10.01 41\n200 42 200.01 42\n340 43 340.01 43\n")
+    short = pm.read_run(str(p))
+    count = pm.read_run(str(p), azimuth_count=True)
+    assert list(short.dir[1:]) == [1, -1, 1]
+    assert list(count.dir[1:]) == [-1, 1, 1]
