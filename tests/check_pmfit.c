@@ -602,6 +602,17 @@ END_TEST
 ** direction on azimuth) and an offset w (arcsec, on the azimuth index) on
 ** the turn beyond a count of 360 deg; 1" of noise.  A gimbal of its own
 ** (not pmfit simulate).  Returns the number of moves over 180 deg. */
+/* A coefficient of pmfit's JSON: the value and error (arcsec) of the first
+** coefficient named by key (e.g. "\"name\": \"c'*dir\"") after the first
+** occurrence of `after` (NULL: anywhere in out).  0 where there is none. */
+static int json_coef(const char *after, const char *key, double *v, double *e)
+{
+    const char *p = after ? strstr(out, after) : out;
+    p = p ? strstr(p, key) : NULL;
+    p = p ? strstr(p, "\"value_arcsec\"") : NULL;
+    return p && sscanf(p, "\"value_arcsec\": %lf, \"error_arcsec\": %lf", v, e) == 2;
+}
+
 static long write_altaz_run(const char *path, unsigned long long seed, double lo, double span,
                             double h_as, double w_as, double el_lo, double el_hi, double flex_as,
                             double noise_as, int n);
@@ -659,10 +670,7 @@ START_TEST(test_pmfit_altaz_counted_azimuth_direction)
     snprintf(path, sizeof path, "%s/counted.dat", tmpdir);
     ck_assert(write_counted_altaz(path, 12345, 90, 360, 4, 0) > 30);
     ck_assert_msg(run("%s fit %s --order 0 --add hysteresis --json%s", path, "") == 0, "%.2000s", out);
-    const char *p = strstr(out, "\"name\": \"c'*dir\"");
-    ck_assert_msg(p && sscanf(strstr(p, "\"value_arcsec\""), "\"value_arcsec\": %lf, \"error_arcsec\": %lf",
-                              &h_fit, &h_err) == 2,
-                  "%.2000s", out);
+    ck_assert_msg(json_coef(NULL, "\"name\": \"c'*dir\"", &h_fit, &h_err), "%.2000s", out);
     ck_assert_msg(fabs(h_fit - 4.0) < 4 * h_err && h_err < 0.3, "c'*dir %.3f +- %.3f (4 injected)",
                   h_fit, h_err);
     /* A file in 0..360 deg with one record written 360.000000 (359.9999997
@@ -688,10 +696,9 @@ START_TEST(test_pmfit_altaz_counted_azimuth_direction)
                 ck_assert_int_eq(system(cmd), 0);
                 ck_assert_msg(run("%s fit %s --order 0 --add hysteresis --json%s", path, "") == 0,
                               "%.2000s", out);
-                p = strstr(out, "\"name\": \"c'*dir\"");
-                ck_assert_msg(p && sscanf(strstr(p, "\"value_arcsec\""), "\"value_arcsec\": %lf",
-                                          &v[e]) == 1,
-                              "%.2000s", out);
+                double err;
+                ck_assert_msg(json_coef(NULL, "\"name\": \"c'*dir\"", &v[e], &err), "%.2000s",
+                              out);
             }
             /* (this gimbal never crosses the file's cut, which a 0..360
             ** file cannot show: both read the short way round, alike) */
@@ -724,10 +731,7 @@ START_TEST(test_pmfit_explain_azimuth_count_reading)
     ck_assert_msg(run("%s fit %s --order 0 --add hysteresis --azimuth-count --json%s", path, "") ==
                       0,
                   "%.2000s", out);
-    const char *p = strstr(out, "\"name\": \"c'*dir\"");
-    ck_assert_msg(p && (p = strstr(p, "\"value_arcsec\"")) &&
-                      sscanf(p, "\"value_arcsec\": %lf, \"error_arcsec\": %lf", &h_fit, &h_err) == 2,
-                  "%.2000s", out);
+    ck_assert_msg(json_coef(NULL, "\"name\": \"c'*dir\"", &h_fit, &h_err), "%.2000s", out);
     ck_assert_msg(fabs(h_fit - 4.0) < 4 * h_err && h_err < 0.3, "c'*dir %.3f +- %.3f (4 injected)",
                   h_fit, h_err);
     /* a mount that does take the short way (pmfit simulate's) is not read so */
@@ -768,12 +772,8 @@ START_TEST(test_pmfit_explain_cable_wrap)
     snprintf(path, sizeof path, "%s/wrap.dat", tmpdir);
     write_counted_altaz(path, 777, 0, 540, 0, 10);
     ck_assert_msg(run("%s explain %s --json%s", path, "") == 0, "%.2000s", out);
-    const char *p = strstr(out, "\"effect\": \"cable_wrap\"");
-    ck_assert_msg(p != NULL, "%.2000s", out);
-    p = strstr(p, "\"name\": \"c'*aux1\", \"column\": \"az_turn\"");
-    ck_assert_msg(p && sscanf(strstr(p, "\"value_arcsec\""), "\"value_arcsec\": %lf, \"error_arcsec\": %lf",
-                              &v, &e) == 2,
-                  "%.2000s", out);
+    static const char turn[] = "\"name\": \"c'*aux1\", \"column\": \"az_turn\"";
+    ck_assert_msg(json_coef("\"effect\": \"cable_wrap\"", turn, &v, &e), "%.2000s", out);
     ck_assert_msg(fabs(v - 10.0) < 4 * e && e < 1, "c'*az_turn %.3f +- %.3f (10 injected)", v, e);
     ck_assert_msg(run("%s explain %s%s", path, "") == 0, "%.2000s", out);
     ck_assert_msg(strstr(out, "--add 'aux:az_turn'") != NULL, "%.2000s", out);
@@ -784,11 +784,7 @@ START_TEST(test_pmfit_explain_cable_wrap)
     ** north (it had not been tried there, and 30" were read as gears) */
     write_counted_altaz(path, 778, 90, 360, 0, 30);
     ck_assert_msg(run("%s explain %s --json%s", path, "") == 0, "%.2000s", out);
-    p = strstr(out, "\"effect\": \"cable_wrap\"");
-    ck_assert_msg(p && (p = strstr(p, "\"name\": \"c'*aux1\", \"column\": \"az_turn\"")) &&
-                      sscanf(strstr(p, "\"value_arcsec\""),
-                             "\"value_arcsec\": %lf, \"error_arcsec\": %lf", &v, &e) == 2,
-                  "%.2000s", out);
+    ck_assert_msg(json_coef("\"effect\": \"cable_wrap\"", turn, &v, &e), "%.2000s", out);
     ck_assert_msg(fabs(v - 30.0) < 4 * e && e < 1.5, "c'*az_turn %.3f +- %.3f (30 injected)", v, e);
 }
 END_TEST
