@@ -1337,10 +1337,9 @@ void print_robust_explained(const RobustFit &rf, const Run &full, const Run &run
                 run.obs.size(), rf.sigma_robust * RAD2AS, rf.clip);
 }
 
-// pmfit explain: report, JSON, plots.
-int cmd_explain(const Options &o, const Run &full)
+// The explanation's options from pmfit's.
+ExplainOptions explain_options(const Options &o)
 {
-    check_gear_names(o, full);
     ExplainOptions eo;
     eo.order = o.order;
     eo.adds = o.adds;
@@ -1348,6 +1347,59 @@ int cmd_explain(const Options &o, const Run &full)
     eo.gears_ha = o.gears_ha;
     eo.gears_dec = o.gears_dec;
     eo.compose = o.compose;
+    return eo;
+}
+
+// After an explanation of an alt-az run whose slew directions were taken
+// the short way round: count_reading_hint again with its terms (a periodic
+// error it found, left out, had hidden the difference: an outside probe's
+// mounts that never turn through north with a 20" two-cycle error were
+// missed in 28 of 37 runs, the backlash read at half its size).  The text
+// of the hint, or "".
+std::string count_hint_after(const Run &run, const Explanation &ex)
+{
+    if (ex.findings.empty())
+        return "";
+    std::vector<std::string> adds; /* (count_reading_hint adds the backlash) */
+    for (const std::string &a : ex.final_adds)
+        if (a != "hysteresis" && a.rfind("aux:" + std::string(axis2_dir_name(run.mount)), 0) != 0)
+            adds.push_back(a);
+    return count_reading_hint(run, ex.final_order, adds);
+}
+
+// The run read again with its azimuth as the mount's count, with the note
+// that says why, where count_reading_hint (with the user's terms, or with
+// those of a first explanation, which is then in *pre) finds that far
+// better; else the run itself.
+Run count_reading(const Options &o, const Run &run, Explanation *pre, bool *have_pre)
+{
+    *have_pre = false;
+    if (o.az_count || run.az_count || !count_reading_possible(run))
+        return run;
+    std::string hint = count_reading_hint(run, o.order, o.adds);
+    if (hint.empty()) {
+        *pre = explain(run, explain_options(o));
+        *have_pre = true;
+        hint = count_hint_after(run, *pre);
+    }
+    if (hint.empty())
+        return run;
+    Run r = load_run(o.run, o.refraction, o.skip_bad, o.format, o.equinox, true);
+    r.read_options = run.read_options + " --azimuth-count";
+    r.notes.push_back(o.run + ": " + hint + " (read so here)");
+    std::fprintf(stderr, "pmfit: note: %s\n", r.notes.back().c_str());
+    *have_pre = false;
+    return r;
+}
+
+// pmfit explain: report, JSON, plots.
+int cmd_explain(const Options &o, const Run &full_in)
+{
+    check_gear_names(o, full_in);
+    Explanation pre;
+    bool have_pre = false;
+    const Run full = count_reading(o, full_in, &pre, &have_pre);
+    ExplainOptions eo = explain_options(o);
     // --robust: explain the observations a robust fit of the baseline keeps
     Run clean;
     RobustFit rf;
@@ -1370,7 +1422,7 @@ int cmd_explain(const Options &o, const Run &full)
                 clean.obs.push_back(full.obs[rf.use[j]]);
     }
     const Run &run = o.robust ? clean : full;
-    Explanation ex = explain(run, eo);
+    Explanation ex = have_pre && !o.robust ? pre : explain(run, eo);
     if (o.json) {
         std::printf("{\"n_obs\": %zu%s, %s}\n", run.obs.size(),
                     o.robust ? (", " + robust_json(rf, full.obs)).c_str() : "",
@@ -1561,9 +1613,19 @@ void check_distinct(const std::vector<std::pair<std::string, std::string>> &outs
 // stderr: on a terminal one line updated per stage; otherwise a line per
 // stage once the page has taken a second (a short run stays quiet but for
 // the closing 'wrote'); --progress: a line per stage always; --quiet: none.
-int cmd_report(const Options &o, const Run &run, int argc, char **argv)
+int cmd_report(const Options &o, const Run &run_in, int argc, char **argv)
 {
-    check_gear_names(o, run);
+    check_gear_names(o, run_in);
+    // (an alt-az run read as the mount's count where that fits far better,
+    // as explain reads it)
+    Explanation pre;
+    bool have_pre = false;
+    Run run;
+    try {
+        run = count_reading(o, run_in, &pre, &have_pre);
+    } catch (const std::exception &x) {
+        die(std::string(x.what()) + " (no page written)", 1);
+    }
     ReportOptions ro;
     ro.order = o.order;
     ro.adds = o.adds;
@@ -1673,16 +1735,6 @@ int run_main(int argc, char **argv)
     Run run;
     try {
         run = load_run(o.run, o.refraction, o.skip_bad, o.format, o.equinox, o.az_count);
-        // explain and report: an alt-az run whose slew directions fit far
-        // better read from the azimuth as the mount's count is explained so
-        // (count_reading_hint), and says so
-        if ((o.cmd == "explain" || o.cmd == "report") && !o.az_count) {
-            const std::string hint = count_reading_hint(run, o.order, o.adds);
-            if (!hint.empty()) {
-                run = load_run(o.run, o.refraction, o.skip_bad, o.format, o.equinox, true);
-                run.notes.push_back(o.run + ": " + hint + " (read so here)");
-            }
-        }
     } catch (const std::exception &x) {
         // (report says so of every failure; its run's had lacked it)
         die(std::string(x.what()) + (o.cmd == "report" ? " (no page written)" : ""), 1);

@@ -379,21 +379,38 @@ void derive_directions(Run &r, bool az_count)
     }
 }
 
-std::string count_reading_hint(const Run &run, int order, const std::vector<std::string> &adds)
+// The run with its slew directions read from the azimuth as the mount's
+// count, and how many of them differ from the run's (0 where the reading
+// does not apply: not alt-az, directions given or already counted, no raw
+// azimuth, fewer than 10 points).
+static long count_directions(const Run &run, Run *rc)
 {
     if (run.mount != PM_MOUNT_ALTAZ || !run.dir_derived || run.az_count || run.obs.size() < 10 ||
         raw_counted(run.obs))
-        return "";
+        return 0;
     for (const Obs &o : run.obs)
         if (!std::isfinite(o.raw1))
-            return "";
-    Run rc = run;
-    for (Obs &o : rc.obs)
+            return 0;
+    *rc = run;
+    for (Obs &o : rc->obs)
         o.ctx.dir = 0;
-    derive_directions(rc, true);
+    derive_directions(*rc, true);
     long differ = 0;
     for (size_t i = 0; i < run.obs.size(); i++)
-        differ += rc.obs[i].ctx.dir != run.obs[i].ctx.dir;
+        differ += rc->obs[i].ctx.dir != run.obs[i].ctx.dir;
+    return differ;
+}
+
+bool count_reading_possible(const Run &run)
+{
+    Run rc;
+    return count_directions(run, &rc) >= 3;
+}
+
+std::string count_reading_hint(const Run &run, int order, const std::vector<std::string> &adds)
+{
+    Run rc;
+    const long differ = count_directions(run, &rc);
     if (differ < 3)
         return "";
     std::vector<std::string> h = adds;

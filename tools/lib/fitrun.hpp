@@ -94,6 +94,9 @@ void derive_directions(Run &r, bool az_count = false);
 // file's 0/360 seam) gives other ones, and with a backlash term they fit
 // far better so (order, adds as the fit's): the text that says so; else "".
 std::string count_reading_hint(const Run &run, int order, const std::vector<std::string> &adds);
+// Whether count_reading_hint can apply at all (its reading gives 3 or more
+// other directions; no fit).
+bool count_reading_possible(const Run &run);
 // The name of the derived slew direction on axis 2: "el_dir" on an alt-az
 // mount, "dec_dir" on an equatorial one.
 const char *axis2_dir_name(int mount);
