@@ -744,6 +744,16 @@ START_TEST(test_pmfit_explain_azimuth_count_reading)
                   "%.2000s", out);
     ck_assert_msg(fabs(h_fit - 5.0) < 4 * h_err && h_err < 0.3, "c'*dir %.3f +- %.3f (5 injected)",
                   h_fit, h_err);
+    /* a short-way mount's backlash of 10 sigma: the run's first record, whose
+    ** slew direction cannot be known, misses by it, and is said to be so, not
+    ** only "a failed plate solve" (an outside probe's, each such run) */
+    snprintf(path, sizeof path, "%s/tests/data/altaz_short_backlash.dat",
+             getenv("PM_TOP") ? getenv("PM_TOP") : ".");
+    ck_assert_msg(run("%s explain %s%s", path, "") == 0, "%.2000s", out);
+    ck_assert_msg(strstr(out, "line 5 is the run's first record, the direction of whose slew "
+                              "cannot be known") != NULL &&
+                      strstr(out, "azimuth-count") == NULL,
+                  "%.3000s", out);
     /* a mount that does take the short way (pmfit simulate's) is not read so */
     snprintf(path, sizeof path, "%s/short.dat", tmpdir);
     ck_assert_int_eq(run("%s simulate %s --mount altaz --n 150 --seed 3 --effect hysteresis=3%s",

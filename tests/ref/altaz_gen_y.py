@@ -4,6 +4,8 @@
 # with backlash, a periodic azimuth error, flexure and noise.  tests/data/altaz_count_pe.dat:
 #   /usr/bin/python3 tests/ref/altaz_gen_y.py tests/data/altaz_count_pe.dat \
 #     '{"n":300,"seed":5075,"mount":"count","backlash":5.0,"pe":20.0,"pecyc":2,"noise":0.5,"wrap":"360"}'
+# tests/data/altaz_short_backlash.dat: the same with
+#     '{"n":120,"seed":5036,"mount":"short","backlash":5.0,"pecyc":2,"flex":5.0,"noise":0.5,"wrap":"360"}'
 import numpy as np, sys, json
 def gen(path, n, seed, mount='short', backlash=0.0, pe=0.0, pecyc=1, flex=0.0, noise=1.0,
         wrap='360', order='random', lat=40.0, g=None):

@@ -296,6 +296,20 @@ void describe_outlier(const Run &run, const State &st, const Candidate &c, Findi
                   lines.c_str(), fd.amplitude_arcsec,
                   worst / (c.fit.ok ? c.fit.f.res.sigma : cur.res.sigma));
     fd.text = buf;
+    // The run's first record, where the model has a backlash and the slew
+    // directions came from the sequence: its own slew is not known (an
+    // outside probe's high signal-to-noise backlash runs each named it a
+    // failed plate solve).
+    bool backlash = false;
+    for (int i = cur.model.n_base; i < cur.model.n_terms; i++)
+        backlash = backlash || (cur.model.term[i].kind == PM_TERM_AUX &&
+                                cur.model.term[i].aux == PM_AUX_DIR);
+    if (run.dir_derived && backlash && !run.obs.empty() &&
+        std::find(c.drop.begin(), c.drop.end(), 0) != c.drop.end())
+        fd.text += fmt("; line %d is the run's first record, the direction of whose slew "
+                       "cannot be known from the sequence (0 in its backlash term): give the "
+                       "run a direction column (dir) to keep it",
+                       run.obs[0].line);
 }
 
 void describe_higher(const Run &run, const State &st, const Candidate &c, Finding &fd)
