@@ -39,6 +39,7 @@
 #include <cstring>
 #include <memory>
 #include <random>
+#include <optional>
 #include <string>
 #include <vector>
 #include <algorithm>
@@ -1369,26 +1370,26 @@ std::string count_hint_after(const Run &run, const Explanation &ex)
 
 // The run read again with its azimuth as the mount's count, with the note
 // that says why, where count_reading_hint (with the user's terms, or with
-// those of a first explanation, which is then in *pre) finds that far
-// better; else the run itself.
-Run count_reading(const Options &o, const Run &run, Explanation *pre, bool *have_pre)
+// those of a first explanation) finds that far better; else the run
+// itself, and in *pre the first explanation where one was made (of that
+// run, with explain_options(o): the caller's to use, not to make again).
+Run count_reading(const Options &o, const Run &run, std::optional<Explanation> *pre)
 {
-    *have_pre = false;
+    pre->reset();
     if (o.az_count || run.az_count || !count_reading_possible(run))
         return run;
     std::string hint = count_reading_hint(run, o.order, o.adds);
     if (hint.empty()) {
         *pre = explain(run, explain_options(o));
-        *have_pre = true;
-        hint = count_hint_after(run, *pre);
+        hint = count_hint_after(run, **pre);
     }
     if (hint.empty())
         return run;
+    pre->reset();
     Run r = load_run(o.run, o.refraction, o.skip_bad, o.format, o.equinox, true);
     r.read_options = run.read_options + " --azimuth-count";
     r.notes.push_back(o.run + ": " + hint + " (read so here)");
     std::fprintf(stderr, "pmfit: note: %s\n", r.notes.back().c_str());
-    *have_pre = false;
     return r;
 }
 
@@ -1396,18 +1397,14 @@ Run count_reading(const Options &o, const Run &run, Explanation *pre, bool *have
 int cmd_explain(const Options &o, const Run &full_in)
 {
     check_gear_names(o, full_in);
-    Explanation pre;
-    bool have_pre = false;
-    const Run full = count_reading(o, full_in, &pre, &have_pre);
+    std::optional<Explanation> pre;
+    const Run full = count_reading(o, full_in, &pre);
     ExplainOptions eo = explain_options(o);
     // --robust: explain the observations a robust fit of the baseline keeps
     Run clean;
     RobustFit rf;
     if (o.robust) {
-        std::vector<int> all(full.obs.size());
-        for (size_t i = 0; i < all.size(); i++)
-            all[i] = (int)i;
-        rf = robust_fit(full.obs, all,
+        rf = robust_fit(full.obs, all_of(full.obs.size()),
                         build_model(o.order, o.adds, full.obs, full.mount, full.latitude,
                                     full.aux_names),
                         o.clip, MAX_PASSES);
@@ -1422,7 +1419,7 @@ int cmd_explain(const Options &o, const Run &full_in)
                 clean.obs.push_back(full.obs[rf.use[j]]);
     }
     const Run &run = o.robust ? clean : full;
-    Explanation ex = have_pre && !o.robust ? pre : explain(run, eo);
+    Explanation ex = pre && !o.robust ? *pre : explain(run, eo);
     if (o.json) {
         std::printf("{\"n_obs\": %zu%s, %s}\n", run.obs.size(),
                     o.robust ? (", " + robust_json(rf, full.obs)).c_str() : "",
@@ -1618,11 +1615,10 @@ int cmd_report(const Options &o, const Run &run_in, int argc, char **argv)
     check_gear_names(o, run_in);
     // (an alt-az run read as the mount's count where that fits far better,
     // as explain reads it)
-    Explanation pre;
-    bool have_pre = false;
+    std::optional<Explanation> pre;
     Run run;
     try {
-        run = count_reading(o, run_in, &pre, &have_pre);
+        run = count_reading(o, run_in, &pre);
     } catch (const std::exception &x) {
         die(std::string(x.what()) + " (no page written)", 1);
     }
@@ -1641,6 +1637,7 @@ int cmd_report(const Options &o, const Run &run_in, int argc, char **argv)
     ro.format = o.format;
     ro.equinox = o.equinox;
     ro.max_passes = MAX_PASSES;
+    ro.explained = pre ? &*pre : nullptr; /* (count_reading's, with the page's options) */
     ro.command = "pmfit";
     for (int i = 1; i < argc; i++)
         ro.command += std::string(" ") + argv[i];

@@ -106,9 +106,7 @@ std::vector<std::pair<std::string, std::string>> not_tried_why(const Run &run)
         out.push_back({"refraction", "the run gives no latitude"});
         out.push_back({"tube_flexure", "the run gives no latitude"});
     }
-    std::vector<int> all(run.obs.size());
-    for (size_t i = 0; i < all.size(); i++)
-        all[i] = (int)i;
+    const std::vector<int> all = all_of(run.obs.size());
     // temperature and time (physical_candidates' input_usable), said where
     // the run cannot give them (an outside probe: the MMT run's JSON listed
     // nothing not tried, and it has neither)

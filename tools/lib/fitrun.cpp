@@ -1,5 +1,6 @@
 // fitrun.cpp - fitting a pointing run with a chosen term set (host side).
 #include "fitrun.hpp"
+#include "hostutil.hpp"
 #include "runfile.h"
 
 #include <algorithm>
@@ -66,17 +67,17 @@ std::string folded_pier_hint(const Run &run, int order, const std::vector<std::s
     sided.push_back("e'@W");
     sided.push_back("i@W");
     stepped.push_back("c'@W");
-    FitOut f[3];
-    try {
-        f[0] = do_fit(run.obs, use,
-                      build_model(order, adds, run.obs, run.mount, run.latitude, run.aux_names));
-        f[1] = do_fit(by_ha.obs, use,
-                      build_model(order, sided, by_ha.obs, run.mount, run.latitude, run.aux_names));
-        f[2] = do_fit(by_ha.obs, use, build_model(order, stepped, by_ha.obs, run.mount,
-                                                  run.latitude, run.aux_names));
+    pm_model m[3];
+    try { /* (a term the run cannot give throws: then nothing is said) */
+        m[0] = build_model(order, adds, run.obs, run.mount, run.latitude, run.aux_names);
+        m[1] = build_model(order, sided, by_ha.obs, run.mount, run.latitude, run.aux_names);
+        m[2] = build_model(order, stepped, by_ha.obs, run.mount, run.latitude, run.aux_names);
     } catch (const std::exception &) {
         return "";
     }
+    FitOut f[3];
+    f[0] = do_fit(run.obs, use, m[0]);
+    f[1] = do_fit(by_ha.obs, use, m[1]);
     if (f[0].status != PM_OK || f[1].status != PM_OK)
         return "";
     const FTest t = f_test(f[0].res.chi2, f[0].res.n_par, f[1].res.chi2, f[1].res.n_par,
@@ -86,9 +87,11 @@ std::string folded_pier_hint(const Run &run, int order, const std::vector<std::s
     // Not where a step of the hour-angle index at the meridian does as well
     // (BIC, its one term against two): a German mount that never flips, its
     // worm changing flank as the balance reverses there, had been told its
-    // records were folded (an outside probe's 10" step: 4 runs of 8).
+    // records were folded (an outside probe's 10" step: 4 runs of 8).  (Its
+    // fit only here, past the tests every fork and one-sided run stops at.)
     const double s2 = f[1].res.sigma * f[1].res.sigma,
                  ln2n = std::log(2.0 * (double)use.size());
+    f[2] = do_fit(by_ha.obs, use, m[2]);
     if (f[2].status == PM_OK &&
         !(f[1].res.chi2 < f[2].res.chi2 - s2 * ln2n * (f[1].res.n_par - f[2].res.n_par)))
         return "";
@@ -134,13 +137,10 @@ void equinox_hint(Run &r, const pmrun *raw, const std::string &path, const pmrun
     double sigma[2];
     const Run *runs[2] = {&r, &j};
     for (int k = 0; k < 2; k++) {
-        std::vector<int> use(runs[k]->obs.size());
-        for (size_t i = 0; i < use.size(); i++)
-            use[i] = (int)i;
         const pm_model m =
             build_model(0, k == 0 ? std::vector<std::string>{"refraction"} : std::vector<std::string>{},
                         runs[k]->obs, runs[k]->mount, runs[k]->latitude, runs[k]->aux_names);
-        FitOut f = do_fit(runs[k]->obs, use, m, FIT_MAX_PASSES);
+        FitOut f = do_fit(runs[k]->obs, all_of(runs[k]->obs.size()), m, FIT_MAX_PASSES);
         if (f.status != PM_OK)
             return;
         sigma[k] = f.res.sigma * RAD2AS;
@@ -264,6 +264,27 @@ std::string mount_words(const std::string &s, int mount)
     return r;
 }
 
+// Every observation has axis 1 as its file wrote it (runs from arrays
+// have none), and there is one.
+static bool raw_known(const std::vector<Obs> &obs)
+{
+    return !obs.empty() && std::all_of(obs.begin(), obs.end(),
+                                       [](const Obs &ob) { return std::isfinite(ob.raw1); });
+}
+
+// The derived input `name` appended to the run's columns (a context slot
+// of each observation, and the run's columns as read where they are kept
+// alongside: run_for_model takes an input from there by its name).
+static void add_derived_input(Run &r, const std::string &name, const std::vector<double> &v)
+{
+    const int j = (int)r.aux_names.size();
+    r.aux_names.push_back(name);
+    for (size_t i = 0; i < r.obs.size(); i++)
+        r.obs[i].ctx.aux[j] = v[i];
+    if (r.aux_values.size() == (size_t)j)
+        r.aux_values.push_back(v);
+}
+
 // True where the file wrote axis 1 as a count that runs on past a turn
 // (every value finite, and not all within one of the two ranges a modular
 // writer uses, 0..360 and -180..180 deg, both ends and a micro-degree
@@ -280,12 +301,10 @@ static bool raw_counted(const std::vector<Obs> &obs)
     const double eps = 1e-6 * PI / 180, turn = 2 * PI;
     bool in_0_360 = true, in_pm180 = true;
     for (const Obs &ob : obs) {
-        if (!std::isfinite(ob.raw1))
-            return false;
         in_0_360 = in_0_360 && ob.raw1 >= -eps && ob.raw1 <= turn + eps;
         in_pm180 = in_pm180 && ob.raw1 >= -PI - eps && ob.raw1 <= PI + eps;
     }
-    return !obs.empty() && !in_0_360 && !in_pm180;
+    return raw_known(obs) && !in_0_360 && !in_pm180;
 }
 
 void derive_directions(Run &r, bool az_count)
@@ -305,11 +324,8 @@ void derive_directions(Run &r, bool az_count)
     bool have_dir = false;
     for (const Obs &ob : r.obs)
         have_dir = have_dir || ob.ctx.dir != 0;
-    bool finite_raw = !r.obs.empty();
-    for (const Obs &ob : r.obs)
-        finite_raw = finite_raw && std::isfinite(ob.raw1);
     const bool counted =
-        r.mount == PM_MOUNT_ALTAZ && (raw_counted(r.obs) || (az_count && finite_raw));
+        r.mount == PM_MOUNT_ALTAZ && (raw_counted(r.obs) || (az_count && raw_known(r.obs)));
     r.az_count = counted && az_count;
     if (!have_dir) {
         r.dir_derived = true;
@@ -335,18 +351,11 @@ void derive_directions(Run &r, bool az_count)
     for (const std::string &n : r.aux_names)
         have_dec_dir = have_dec_dir || n == dir2;
     if (!have_dec_dir && (int)r.aux_names.size() < PM_MAX_AUX && r.obs.size() > 1) {
-        int j = (int)r.aux_names.size();
-        r.aux_names.push_back(dir2);
-        r.dec_dir_derived = true;
-        r.obs[0].ctx.aux[j] = 0;
+        std::vector<double> v(r.obs.size(), 0.0);
         for (size_t i = 1; i < r.obs.size(); i++)
-            r.obs[i].ctx.aux[j] = move_sign(r.obs[i - 1].ed, r.obs[i].ed, cut2, true);
-        if (r.aux_values.size() == (size_t)j) {
-            std::vector<double> col;
-            for (const Obs &ob : r.obs)
-                col.push_back(ob.ctx.aux[j]);
-            r.aux_values.push_back(col);
-        }
+            v[i] = move_sign(r.obs[i - 1].ed, r.obs[i].ed, cut2, true);
+        add_derived_input(r, dir2, v);
+        r.dec_dir_derived = true;
     }
     // The turn of an alt-az cable wrap, as the input "az_turn": where the
     // file counts its azimuth past a turn (raw_counted) and the run's count
@@ -365,17 +374,11 @@ void derive_directions(Run &r, bool az_count)
     if (counted && std::floor(hi / (2 * PI)) != std::floor(lo / (2 * PI)) &&
         std::find(r.aux_names.begin(), r.aux_names.end(), "az_turn") == r.aux_names.end() &&
         (int)r.aux_names.size() < PM_MAX_AUX) {
-        const int j = (int)r.aux_names.size();
-        r.aux_names.push_back("az_turn");
+        std::vector<double> v;
+        for (const Obs &ob : r.obs)
+            v.push_back(std::floor(ob.raw1 / (2 * PI)) - std::floor(lo / (2 * PI)));
+        add_derived_input(r, "az_turn", v);
         r.turn_derived = true;
-        for (Obs &ob : r.obs)
-            ob.ctx.aux[j] = std::floor(ob.raw1 / (2 * PI)) - std::floor(lo / (2 * PI));
-        if (r.aux_values.size() == (size_t)j) {
-            std::vector<double> col;
-            for (const Obs &ob : r.obs)
-                col.push_back(ob.ctx.aux[j]);
-            r.aux_values.push_back(col);
-        }
     }
 }
 
@@ -386,11 +389,8 @@ void derive_directions(Run &r, bool az_count)
 static long count_directions(const Run &run, Run *rc)
 {
     if (run.mount != PM_MOUNT_ALTAZ || !run.dir_derived || run.az_count || run.obs.size() < 10 ||
-        raw_counted(run.obs))
+        !raw_known(run.obs) || raw_counted(run.obs))
         return 0;
-    for (const Obs &o : run.obs)
-        if (!std::isfinite(o.raw1))
-            return 0;
     *rc = run;
     for (Obs &o : rc->obs)
         o.ctx.dir = 0;
@@ -416,9 +416,7 @@ std::string count_reading_hint(const Run &run, int order, const std::vector<std:
     std::vector<std::string> h = adds;
     if (std::find(h.begin(), h.end(), "hysteresis") == h.end())
         h.push_back("hysteresis");
-    std::vector<int> use(run.obs.size());
-    for (size_t i = 0; i < use.size(); i++)
-        use[i] = (int)i;
+    const std::vector<int> use = all_of(run.obs.size());
     FitOut f[3];
     try {
         f[0] = do_fit(run.obs, use, build_model(order, h, run.obs, run.mount, run.latitude,

@@ -253,7 +253,7 @@ void stage_explain(Data &d)
     eo.alpha = d.o.alpha;
     eo.gears_ha = d.o.gears_ha;
     eo.gears_dec = d.o.gears_dec;
-    d.ex = explain(d.run, eo);
+    d.ex = d.o.explained ? *d.o.explained : explain(d.run, eo);
 }
 
 // The next targets for the page's model, the run's sigma as the noise.

@@ -9,6 +9,7 @@
 #ifndef PM_REPORT_HPP
 #define PM_REPORT_HPP
 
+#include "explain.hpp"
 #include "fitrun.hpp"
 #include "runfile.h"
 
@@ -33,6 +34,9 @@ struct ReportOptions {
     int equinox = PMRUN_EQUINOX_FILE;
     std::string command;               // the command line, quoted at the end of the page
     int max_passes = 2000;             // Gauss-Newton passes of the fit (as pmfit fit)
+    // the run's explanation with these options, where the caller has made
+    // it already (pmfit's check of the azimuth reading); NULL: made here
+    const Explanation *explained = nullptr;
 };
 
 // Progress: the stage starting ("fit", "explain", ...) and the fraction of the
