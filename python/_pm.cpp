@@ -620,10 +620,16 @@ struct RunData {
 
 std::shared_ptr<RunData> read_run(const std::string &path, bool refraction, bool skip_bad,
                                   const std::string &format, const std::string &equinox,
-                                  bool azimuth_count = false)
+                                  bool azimuth_count, const std::vector<double> &weather)
 {
     pmrun_options ro;
     pmrun_options_default(&ro);
+    if (weather.size() != 4)
+        throw Failure{K_ARGUMENT, PMRUN_ERR_ARG, "weather: expected 4 values", ""};
+    ro.pressure_hpa = weather[0]; /* (NaN: the file's) */
+    ro.temp_c = weather[1];
+    ro.humidity = weather[2];
+    ro.wavelength_um = weather[3];
     ro.refraction = refraction ? 1 : 0;
     ro.skip_bad = skip_bad ? 1 : 0;
     ro.format = pmrun_format_from_name(format.c_str());
@@ -1177,8 +1183,7 @@ std::string compare_run(const Model *old_model, const std::shared_ptr<RunData> &
         } else if (old_run) {
             os = old_from_run(old_run->run, order, adds, passes);
         } else {
-            os = load_old(old_path, order, adds, true, false, PMRUN_FORMAT_AUTO, PMRUN_EQUINOX_FILE,
-                          passes);
+            os = load_old(old_path, order, adds, ReadOptions(), passes);
         }
     } catch (const std::runtime_error &e) {
         std::string w = e.what();
@@ -1292,7 +1297,7 @@ std::shared_ptr<RunData> simulate_run(const Model &truth, long n, unsigned long 
     }
     std::shared_ptr<RunData> r;
     try {
-        r = read_run(path, true, false, "named", "");
+        r = read_run(path, true, false, "named", "", false, std::vector<double>(4, NAN));
     } catch (...) {
         std::remove(path.c_str());
         throw;
@@ -1371,7 +1376,7 @@ PYBIND11_MODULE(_pm, mod)
         .def("columns", &run_columns)
         .def("info", &run_info);
     mod.def("read_run", &read_run, py::arg("path"), py::arg("refraction"), py::arg("skip_bad"),
-            py::arg("format"), py::arg("equinox"), py::arg("azimuth_count") = false);
+            py::arg("format"), py::arg("equinox"), py::arg("azimuth_count"), py::arg("weather"));
     mod.def("run_from_arrays", &run_from_arrays);
 
     py::class_<Fit>(mod, "Fit")

@@ -779,6 +779,72 @@ START_TEST(test_pmfit_explain_azimuth_count_reading)
 }
 END_TEST
 
+/* The weather of the refraction from the command line (--pressure,
+** --temperature, --humidity, --wavelength), for files that lack it (an
+** RTS2 gpoint file never has it): the CSV log's weather given as options
+** for a copy without its metadata fits to the same JSON byte for byte as
+** the file with it; options override the file's (a wrong weather fits
+** worse); explain's closing command repeats them; bad values are refused
+** naming the option; where no reduction refracts, a note says they were
+** not used. */
+START_TEST(test_pmfit_weather_options)
+{
+    char path[300], bare[300], cmd[1200];
+    static char with_meta[sizeof out];
+    const char *top = getenv("PM_TOP") ? getenv("PM_TOP") : ".";
+    double s_file, s_wrong;
+    make_tmpdir();
+    snprintf(path, sizeof path, "%s/tests/data/nina_j2000.csv", top);
+    snprintf(bare, sizeof bare, "%s/bare.csv", tmpdir);
+    snprintf(cmd, sizeof cmd, "grep -v '^# pressure\\|^# temperature' %s > %s", path, bare);
+    ck_assert_int_eq(system(cmd), 0);
+    ck_assert_msg(run("%s fit %s --order 0 --json%s", path, "") == 0, "%.2000s", out);
+    ck_assert(strstr(out, "{\"n_obs\"") != NULL);
+    snprintf(with_meta, sizeof with_meta, "%s", strstr(out, "{\"n_obs\"")); /* (the JSON) */
+    s_file = tu_json_num(out, "sigma_arcsec");
+    ck_assert_msg(run("%s fit %s --order 0 --json --pressure 950 --temperature 10%s",
+                      bare, "") == 0,
+                  "%.2000s", out);
+    ck_assert_msg(strstr(out, "{\"n_obs\"") && strcmp(strstr(out, "{\"n_obs\""), with_meta) == 0,
+                  "options:\n%.1500s\nmetadata:\n%.1500s", out, with_meta);
+    /* without them: the standard atmosphere and the temperature column */
+    ck_assert_msg(run("%s fit %s --order 0 --json%s", bare, "") == 0, "%.2000s", out);
+    ck_assert_msg(strstr(out, "{\"n_obs\"") && strcmp(strstr(out, "{\"n_obs\""), with_meta) != 0,
+                  "%.2000s", out);
+    ck_assert_msg(run("%s fit %s --order 0 --json --pressure 700 --temperature -10%s",
+                      path, "") == 0,
+                  "%.2000s", out);
+    s_wrong = tu_json_num(out, "sigma_arcsec");
+    ck_assert_msg(s_wrong > 5 * s_file, "sigma %.3f with the wrong weather, %.3f", s_wrong, s_file);
+    /* explain repeats them */
+    ck_assert_msg(run("%s explain %s --order 0 --pressure 950 --temperature 10 --humidity 0.5 "
+                      "--wavelength 0.55%s",
+                      bare, "") == 0,
+                  "%.2000s", out);
+    ck_assert_msg(strstr(out, " --pressure 950 --temperature 10 --humidity 0.5 --wavelength 0.55   "
+                              "# fits") != NULL,
+                  "%.3000s", out);
+    /* bad values, named */
+    ck_assert_int_ne(run("%s fit %s --pressure 2000%s", bare, ""), 0);
+    ck_assert_msg(strstr(out, "--pressure: expected a number in") != NULL, "%.2000s", out);
+    ck_assert_int_ne(run("%s fit %s --temperature warm%s", bare, ""), 0);
+    ck_assert_msg(strstr(out, "--temperature: expected a number") != NULL, "%.2000s", out);
+    ck_assert_msg(run("%s fit %s --order 0 --humidity 50%s", bare, "") == 0, "%.2000s", out);
+    ck_assert_msg(strstr(out, "humidity 50 (given as an option) taken as percent: 0.5") != NULL,
+                  "%.2000s", out);
+    ck_assert_int_ne(run("%s simulate %s/sim.dat --pressure 900%s", tmpdir, ""), 0);
+    ck_assert_msg(strstr(out, "apply to reading a run") != NULL, "%.2000s", out);
+    /* not used where nothing is refracted (observed places) */
+    snprintf(path, sizeof path, "%s/tests/data/rts2_gpoint.dat", top);
+    ck_assert_msg(run("%s fit %s --order 0 --pressure 900%s", path, "") == 0, "%.2000s", out);
+    ck_assert_msg(strstr(out, "the weather options (pressure, temperature, humidity, wavelength) "
+                              "are not used") != NULL,
+                  "%.2000s", out);
+    ck_assert_msg(run("%s fit %s --order 0%s", path, "") == 0, "%.2000s", out);
+    ck_assert_msg(strstr(out, "weather options") == NULL, "%.2000s", out);
+}
+END_TEST
+
 /* A cable wrap's second turn: where the azimuth count spans more than a
 ** turn (0..540 deg), explain tries the input az_turn (0, or 1 past 360)
 ** and names an offset there as cable_wrap (an outside probe's 10" and 30"
@@ -1466,6 +1532,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_pmfit_altaz_counted_azimuth_direction);
     tcase_add_test(tc, test_pmfit_explain_cable_wrap);
     tcase_add_test(tc, test_pmfit_explain_azimuth_count_reading);
+    tcase_add_test(tc, test_pmfit_weather_options);
     tcase_add_test(tc, test_pmfit_rts2_equinox_hint);
     tcase_add_test(tc, test_pmfit_folded_records_without_pier);
     tcase_add_test(tc, test_pmfit_explain_close_rival_above_alpha);

@@ -101,9 +101,9 @@ struct Options {
     std::string output, compare;     // report: -o PAGE.html, --compare OLD
     bool quiet = false;              // report: no progress on stderr
     bool progress = false;           // report: a line per stage on stderr, always
-    int format = PMRUN_FORMAT_AUTO;  // --format NAME (docs/formats.md)
-    int equinox = PMRUN_EQUINOX_FILE; // --equinox J2000|JNow
-    bool az_count = false;            // --azimuth-count
+    // --no-refraction, --skip-bad, --format NAME (docs/formats.md),
+    // --equinox J2000|JNow, --azimuth-count, --pressure HPA, ...
+    ReadOptions read;
     std::string tpoint_terms;        // fit --tpoint-terms FILE
     bool order_given = false;        // --order on the command line
 };
@@ -115,7 +115,8 @@ void usage(FILE *f)
         "                     [--residuals FILE] [--save MODEL] [--emit-c HEADER]\n"
         "                     [--error-map F] [--tpoint-terms FILE] [--no-refraction]\n"
         "                     [--skip-bad] [--robust [--clip K]] [--format NAME]\n"
-        "                     [--equinox J2000|JNow] [--azimuth-count]\n"
+        "                     [--equinox J2000|JNow] [--azimuth-count] [--pressure HPA]\n"
+        "                     [--temperature C] [--humidity H] [--wavelength UM]\n"
         "\n"
         "  RUN              pointing run: four-column, named-column, TPOINT, RTS2 gpoint,\n"
         "                   MountWizzard4 JSON, CSV log or MMT log (docs/formats.md)\n"
@@ -160,6 +161,11 @@ void usage(FILE *f)
         "                   0..360 deg: the slew direction is its change (the mount never\n"
         "                   turns through the file's seam; explain offers it where it fits\n"
         "                   far better; docs/explain.md)\n"
+        "  --pressure HPA, --temperature C, --humidity H (0..1), --wavelength UM\n"
+        "                   the weather of the refraction where a reduction refracts\n"
+        "                   (TPOINT equatorial, J2000 places of CSV and RTS2 files), over\n"
+        "                   the file's or the defaults (an RTS2 file has none; every command\n"
+        "                   reading a run)\n"
         "  --robust         ignore gross outliers (failed plate solves): clip points whose\n"
         "                   residual on the sky exceeds K robust sigmas, refit, repeat until\n"
         "                   stable; the report lists them by line (docs/robust.md)\n"
@@ -336,37 +342,70 @@ void check_gear_names(const Options &o, const Run &run)
             " is of an equatorial mount: ha:G or dec:G");
 }
 
-// --format NAME and --equinox E (every command that reads a run).
-void set_format(Options &o, const std::string &v)
-{
-    o.format = pmrun_format_from_name(v.c_str());
-    if (o.format == -2)
-        die("--format: expected auto, four-column, named, tpoint, rts2, mw4, csv or mmt, "
-            "got '" + v + "'");
-}
+struct Args {
+    int argc;
+    char **argv;
+    int i;
+    std::string a;
+    /* The next argument, the value of option a (what it should be). */
+    const char *need(const char *what)
+    {
+        if (i + 1 >= argc)
+            die(a + " needs " + what);
+        return argv[++i];
+    }
+};
 
-void set_equinox(Options &o, const std::string &v)
+// The options of reading a run (every command that reads one; ReadOptions);
+// true where g.a was one.
+bool read_option(Options &o, Args &g)
 {
-    std::string l = v;
-    for (char &c : l)
-        c = (char)std::tolower((unsigned char)c);
-    if (l == "j2000")
-        o.equinox = PMRUN_EQUINOX_J2000;
-    else if (l == "jnow")
-        o.equinox = PMRUN_EQUINOX_JNOW;
-    else
-        die("--equinox: expected J2000 or JNow, got '" + v + "'");
+    const std::string &a = g.a;
+    ReadOptions &r = o.read;
+    if (a == "--format") {
+        const std::string v = g.need("a format name");
+        r.format = pmrun_format_from_name(v.c_str());
+        if (r.format == -2)
+            die("--format: expected auto, four-column, named, tpoint, rts2, mw4, csv or mmt, "
+                "got '" + v + "'");
+    } else if (a == "--equinox") {
+        const std::string v = g.need("J2000 or JNow");
+        std::string l = v;
+        for (char &c : l)
+            c = (char)std::tolower((unsigned char)c);
+        if (l == "j2000")
+            r.equinox = PMRUN_EQUINOX_J2000;
+        else if (l == "jnow")
+            r.equinox = PMRUN_EQUINOX_JNOW;
+        else
+            die("--equinox: expected J2000 or JNow, got '" + v + "'");
+    } else if (a == "--azimuth-count") {
+        r.az_count = true;
+    } else if (a == "--no-refraction") {
+        r.refraction = false;
+    } else if (a == "--skip-bad") {
+        r.skip_bad = true;
+    } else if (a == "--pressure") {
+        r.pressure_hpa = number(a, g.need("hPa (mbar)"), 1e-3, 1100);
+    } else if (a == "--temperature") {
+        r.temp_c = number(a, g.need("degrees Celsius"), -100, 60);
+    } else if (a == "--humidity") {
+        r.humidity = number(a, g.need("a relative humidity, 0..1 (or percent)"), 0, 100);
+    } else if (a == "--wavelength") {
+        r.wavelength_um = number(a, g.need("micrometres"), 0.2, 30);
+    } else {
+        return false;
+    }
+    return true;
 }
 
 Options parse_report(Options o, int argc, char **argv)
 {
-    for (int i = 2; i < argc; i++) {
-        std::string a = argv[i];
-        auto need = [&](const char *what) -> const char * {
-            if (i + 1 >= argc)
-                die(a + " needs " + what);
-            return argv[++i];
-        };
+    Args g{argc, argv, 2, ""};
+    for (; g.i < argc; g.i++) {
+        g.a = argv[g.i];
+        const std::string &a = g.a;
+        auto need = [&](const char *what) { return g.need(what); };
         if (a == "--order") {
             const char *v = need("an order");
             if (!parse_int(v, &o.order) || o.order < 0 || o.order > PM_MAX_L)
@@ -390,21 +429,12 @@ Options parse_report(Options o, int argc, char **argv)
             std::string v = need("a gear period in cycles per revolution ([ha:|dec:]G)");
             bool ha, dec;
             v = gear_axes(v, &ha, &dec, &o.gears_altaz_names);
-            double g = number(a, v.c_str(), 1e-6, 1e6);
+            double gear = number(a, v.c_str(), 1e-6, 1e6);
             if (ha)
-                o.gears_ha.push_back(g);
+                o.gears_ha.push_back(gear);
             if (dec)
-                o.gears_dec.push_back(g);
-        } else if (a == "--no-refraction") {
-            o.refraction = false;
-        } else if (a == "--skip-bad") {
-            o.skip_bad = true;
-        } else if (a == "--format") {
-            set_format(o, need("a format name"));
-        } else if (a == "--equinox") {
-            set_equinox(o, need("J2000 or JNow"));
-        } else if (a == "--azimuth-count") {
-            o.az_count = true;
+                o.gears_dec.push_back(gear);
+        } else if (read_option(o, g)) {
         } else if (a == "--quiet" || a == "-q") {
             o.quiet = true;
         } else if (a == "--progress") {
@@ -425,21 +455,6 @@ Options parse_report(Options o, int argc, char **argv)
         die("report: --quiet and --progress contradict each other");
     return o;
 }
-
-/* The command line of parse_args: the argument at i (a), its value. */
-struct Args {
-    int argc;
-    char **argv;
-    int i;
-    std::string a;
-    /* The next argument, the value of option a (what it should be). */
-    const char *need(const char *what)
-    {
-        if (i + 1 >= argc)
-            die(a + " needs " + what);
-        return argv[++i];
-    }
-};
 
 /* Which command parse_args reads the options of. */
 struct Cmd {
@@ -624,18 +639,8 @@ bool run_option(Options &o, const Cmd &c, Args &g)
         o.seed = (unsigned long long)number(a, g.need("a seed"), 0, 1e15);
     } else if (c.sim && a == "--phase") {
         o.phase_deg = number(a, g.need("degrees"), -360, 360);
-    } else if (a == "--format") {
-        set_format(o, g.need("a format name"));
-    } else if (a == "--equinox") {
-        set_equinox(o, g.need("J2000 or JNow"));
-    } else if (a == "--azimuth-count") {
-        o.az_count = true;
-    } else if (a == "--no-refraction") {
-        o.refraction = false;
-    } else if (a == "--skip-bad") {
-        o.skip_bad = true;
     } else {
-        return false;
+        return read_option(o, g);
     }
     return true;
 }
@@ -665,10 +670,9 @@ void check_combinations(const Options &o, const Cmd &c, int argc, char **argv)
             "an effect use --effect");
     if (sim && !o.into.empty() && o.inject.empty())
         die("--into RUN needs at least one --inject EFFECT[=SIZE]");
-    if (sim && o.into.empty() && (!o.refraction || o.skip_bad || o.format != PMRUN_FORMAT_AUTO ||
-                                  o.equinox != PMRUN_EQUINOX_FILE))
-        die("--no-refraction, --skip-bad, --format and --equinox apply to reading a run: with "
-            "--into only");
+    if (sim && o.into.empty() && !o.read.text().empty())
+        die("--no-refraction, --skip-bad, --format, --equinox, --azimuth-count, --pressure, "
+            "--temperature, --humidity and --wavelength apply to reading a run: with --into only");
     if ((cmp || pln) && !o.tpoint_terms.empty())
         die("--tpoint-terms writes the model of pmfit fit; see pmfit --help");
     if (o.clip_given && !o.robust)
@@ -1065,7 +1069,7 @@ int cmd_plan(const Options &o)
     Run run;
     PlanOptions po;
     if (!o.run.empty()) {
-        run = load_run(o.run, o.refraction, o.skip_bad, o.format, o.equinox);
+        run = load_run(o.run, o.read);
         po.mount = run.mount;
         po.latitude = run.latitude;
         /* the run's observations are of its mount: planning another one's
@@ -1177,8 +1181,7 @@ int cmd_compare(const Options &o, const Run &run)
             die(o.model + " is a model file: the comparison is of its own terms; --order and "
                           "--add choose the model fitted to an OLD run");
     }
-    OldSide os = load_old(o.model, o.order, o.adds, o.refraction, o.skip_bad, o.format,
-                          o.equinox, 100);
+    OldSide os = load_old(o.model, o.order, o.adds, o.read, 100);
     if (os.is_run && os.fit.status != PM_OK)
         fail_fit(os.fit, o.model + " (the old run)");
     Comparison c;
@@ -1376,7 +1379,7 @@ std::string count_hint_after(const Run &run, const Explanation &ex)
 Run count_reading(const Options &o, const Run &run, std::optional<Explanation> *pre)
 {
     pre->reset();
-    if (o.az_count || run.az_count || !count_reading_possible(run))
+    if (o.read.az_count || run.az_count || !count_reading_possible(run))
         return run;
     std::string hint = count_reading_hint(run, o.order, o.adds);
     if (hint.empty()) {
@@ -1386,8 +1389,9 @@ Run count_reading(const Options &o, const Run &run, std::optional<Explanation> *
     if (hint.empty())
         return run;
     pre->reset();
-    Run r = load_run(o.run, o.refraction, o.skip_bad, o.format, o.equinox, true);
-    r.read_options = run.read_options + " --azimuth-count";
+    ReadOptions counted = o.read;
+    counted.az_count = true;
+    Run r = load_run(o.run, counted);
     r.notes.push_back(o.run + ": " + hint + " (read so here)");
     std::fprintf(stderr, "pmfit: note: %s\n", r.notes.back().c_str());
     return r;
@@ -1452,7 +1456,7 @@ int cmd_inject(const Options &o, int argc, char **argv)
         in.seed = o.seed;
         list.push_back(in);
     }
-    Run run = load_run(o.into, o.refraction, o.skip_bad, o.format, o.equinox);
+    Run run = load_run(o.into, o.read);
     for (const std::string &n : run.notes)
         std::fprintf(stderr, "pmfit: note: %s\n", n.c_str());
     InjectReport rep = inject(run, list);
@@ -1632,10 +1636,7 @@ int cmd_report(const Options &o, const Run &run_in, int argc, char **argv)
     ro.min_el_deg = o.min_el;
     ro.horizon = o.horizon;
     ro.compare = o.compare;
-    ro.refraction = o.refraction;
-    ro.skip_bad = o.skip_bad;
-    ro.format = o.format;
-    ro.equinox = o.equinox;
+    ro.read = o.read;
     ro.max_passes = MAX_PASSES;
     ro.explained = pre ? &*pre : nullptr; /* (count_reading's, with the page's options) */
     ro.command = "pmfit";
@@ -1731,20 +1732,11 @@ int run_main(int argc, char **argv)
 
     Run run;
     try {
-        run = load_run(o.run, o.refraction, o.skip_bad, o.format, o.equinox, o.az_count);
+        run = load_run(o.run, o.read);
     } catch (const std::exception &x) {
         // (report says so of every failure; its run's had lacked it)
         die(std::string(x.what()) + (o.cmd == "report" ? " (no page written)" : ""), 1);
     }
-    run.read_options = std::string(o.refraction ? "" : " --no-refraction") +
-                       (o.skip_bad ? " --skip-bad" : "") +
-                       (o.format != PMRUN_FORMAT_AUTO
-                            ? std::string(" --format ") + pmrun_format_name(o.format)
-                            : "") +
-                       (o.equinox == PMRUN_EQUINOX_J2000  ? " --equinox J2000"
-                        : o.equinox == PMRUN_EQUINOX_JNOW ? " --equinox JNow"
-                                                          : "") +
-                       (run.az_count ? " --azimuth-count" : "");
     for (const std::string &n : run.notes)
         std::fprintf(stderr, "pmfit: note: %s\n", n.c_str());
     std::vector<Obs> &obs = run.obs;

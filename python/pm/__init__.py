@@ -649,8 +649,23 @@ class Run:
         return explain(self, **kw)
 
 
+def _weather(name, v):
+    """A weather value of read_run: NaN for None (the file's), else a finite
+    float, or ArgumentError naming the argument."""
+    if v is None:
+        return float("nan")
+    try:
+        x = float(v)
+    except (TypeError, ValueError):
+        raise ArgumentError("%s: expected a number or None, got %r" % (name, v)) from None
+    if not _isfinite(x):
+        raise ArgumentError("%s: expected a finite number or None, got %r" % (name, v))
+    return x
+
+
 def read_run(path, refraction=True, skip_bad=False, format="auto", equinox=None,
-             azimuth_count=False):
+             azimuth_count=False, pressure_hpa=None, temp_c=None, humidity=None,
+             wavelength_um=None):
     """Read a pointing run file: four-column, named-column, TPOINT, RTS2
     gpoint, MountWizzard4 JSON, N.I.N.A./ASCOM CSV or MMT log
     (docs/formats.md), detected from its content.
@@ -664,9 +679,20 @@ def read_run(path, refraction=True, skip_bad=False, format="auto", equinox=None,
     malformed records, each listed in ``run.skipped`` (--skip-bad); otherwise
     the first one raises FormatError("path:LINE: ...").  ``azimuth_count``:
     an alt-az file's azimuth is the mount's count even within 0..360 deg, the
-    slew direction its change (pmfit --azimuth-count)."""
+    slew direction its change (pmfit --azimuth-count).
+
+    ``pressure_hpa``, ``temp_c``, ``humidity`` (0..1, or percent),
+    ``wavelength_um``: the weather of the refraction where a reduction
+    refracts (TPOINT equatorial files, J2000 places of RTS2 and CSV files),
+    in place of the file's or the defaults (pmfit --pressure, --temperature,
+    --humidity, --wavelength); None takes the file's.  Given for a run that
+    no reduction refracts, a warning in ``run.warnings`` says they were not
+    used."""
+    weather = [_weather("pressure_hpa", pressure_hpa), _weather("temp_c", temp_c),
+               _weather("humidity", humidity), _weather("wavelength_um", wavelength_um)]
     return Run(_pm.read_run(_path(path), bool(refraction), bool(skip_bad), str(format),
-                            "" if equinox is None else str(equinox), bool(azimuth_count)))
+                            "" if equinox is None else str(equinox), bool(azimuth_count),
+                            weather))
 
 
 def _run(run):

@@ -59,6 +59,40 @@ def test_forced_format_and_equinox():
     assert len(pm.read_run(csv, equinox="J2000")) > 0
 
 
+def test_weather_options(tmp_path):
+    """pressure_hpa=, temp_c=, humidity=, wavelength_um= are pmfit's
+    --pressure, --temperature, --humidity, --wavelength: given for a CSV log
+    without its weather metadata, the places are the file's with it, bit
+    for bit; a wrong weather moves them by the refraction's change; bad
+    values are ArgumentErrors; unused ones are said so."""
+    csv = os.path.join(TOP, "tests", "data", "nina_j2000.csv")
+    bare = tmp_path / "bare.csv"
+    with open(csv) as f:
+        bare.write_text("".join(l for l in f
+                                if not l.startswith(("# pressure", "# temperature"))))
+    ref = pm.read_run(csv)
+    given = pm.read_run(str(bare), pressure_hpa=950, temp_c=10.0)
+    default = pm.read_run(str(bare))
+    wrong = pm.read_run(csv, pressure_hpa=700, temp_c=-10)
+    assert np.array_equal(ref.app_dec, given.app_dec) and np.array_equal(ref.app_ha, given.app_ha)
+    assert given.site["pressure_hpa"] == 950
+    assert not np.array_equal(ref.app_dec, default.app_dec)
+    # the refraction at these elevations is tens of arcseconds: a quarter of
+    # it less moves the observed places by arcseconds
+    moved = np.degrees(np.abs(wrong.app_dec - ref.app_dec)).max() * 3600
+    assert 1 < moved < 60, moved
+    for kw in ({"pressure_hpa": "high"}, {"temp_c": float("nan")}, {"humidity": [1]},
+               {"wavelength_um": float("inf")}):
+        with pytest.raises(pm.ArgumentError):
+            pm.read_run(csv, **kw)
+    with pytest.raises(pm.FormatError) as e:
+        pm.read_run(csv, pressure_hpa=5000)
+    assert "pressure 5000 hPa (given as an option) is absurd" in str(e.value)
+    rts2 = os.path.join(TOP, "tests", "data", "rts2_gpoint.dat")
+    assert [w for w in pm.read_run(rts2, pressure_hpa=900).warnings if "not used" in w]
+    assert not [w for w in pm.read_run(rts2).warnings if "not used" in w]
+
+
 def test_missing_and_unreadable_files(tmp_path):
     with pytest.raises(pm.FileError) as e:
         pm.read_run(tmp_path / "nothing.dat")

@@ -619,7 +619,7 @@ OldSide old_from_model(const pm_model &m, const pmmodel_info &info, const std::v
 }
 
 OldSide load_old(const std::string &path, int order, const std::vector<std::string> &adds,
-                 bool refraction, bool skip_bad, int format, int equinox, int max_passes)
+                 const ReadOptions &ro, int max_passes)
 {
     OldSide o;
     char err[1024];
@@ -636,7 +636,7 @@ OldSide load_old(const std::string &path, int order, const std::vector<std::stri
         cov.resize(has_cov ? (size_t)o.model.n_terms * (size_t)o.model.n_terms : 0);
         return old_from_model(o.model, info, cov);
     }
-    return old_from_run(load_run(path, refraction, skip_bad, format, equinox), order, adds,
+    return old_from_run(load_run(path, ro), order, adds,
                         max_passes);
 }
 

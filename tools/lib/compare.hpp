@@ -81,7 +81,7 @@ struct OldSide {
 // Throws std::runtime_error with the file's message when OLD cannot be
 // opened or read (its file:line).
 OldSide load_old(const std::string &path, int order, const std::vector<std::string> &adds,
-                 bool refraction, bool skip_bad, int format, int equinox, int max_passes);
+                 const ReadOptions &ro, int max_passes);
 
 // OLD as a model (prepared) and what its file says: its inputs' names, its
 // pier side, its coefficients' errors where it keeps them.

@@ -2200,7 +2200,7 @@ extern "C" int pmx_explain_opts(const char *path, const pmx_options *opt, pmx_re
     const double *gears = opt->gears;
     int n_gears = opt->n_gears;
     try {
-        Run run = load_run(path, true, false);
+        Run run = load_run(path);
         ExplainOptions o;
         o.order = opt->order;
         o.alpha = opt->alpha;

@@ -13,22 +13,55 @@
 
 namespace pmhost {
 
-Run load_run(const std::string &path, bool refraction, bool skip_bad, int format, int equinox,
-             bool az_count)
+std::string ReadOptions::text() const
+{
+    std::string t = std::string(refraction ? "" : " --no-refraction") + (skip_bad ? " --skip-bad" : "");
+    if (format != PMRUN_FORMAT_AUTO)
+        t += std::string(" --format ") + pmrun_format_name(format);
+    if (equinox == PMRUN_EQUINOX_J2000)
+        t += " --equinox J2000";
+    else if (equinox == PMRUN_EQUINOX_JNOW)
+        t += " --equinox JNow";
+    if (az_count)
+        t += " --azimuth-count";
+    const struct {
+        const char *opt;
+        double v;
+    } w[] = {{"--pressure", pressure_hpa},
+             {"--temperature", temp_c},
+             {"--humidity", humidity},
+             {"--wavelength", wavelength_um}};
+    for (const auto &x : w)
+        if (!std::isnan(x.v)) {
+            char b[64];
+            std::snprintf(b, sizeof b, " %s %.12g", x.opt, x.v); /* (as typed) */
+            t += b;
+        }
+    return t;
+}
+
+Run load_run(const std::string &path, const ReadOptions &o)
 {
     pmrun_options ro;
     pmrun_options_default(&ro);
-    ro.refraction = refraction ? 1 : 0;
-    ro.skip_bad = skip_bad ? 1 : 0;
-    ro.format = format;
-    ro.equinox = equinox;
+    ro.refraction = o.refraction ? 1 : 0;
+    ro.skip_bad = o.skip_bad ? 1 : 0;
+    ro.format = o.format;
+    ro.equinox = o.equinox;
+    ro.pressure_hpa = o.pressure_hpa;
+    ro.temp_c = o.temp_c;
+    ro.humidity = o.humidity;
+    ro.wavelength_um = o.wavelength_um;
     pmrun *run = nullptr;
     char err[1024];
     if (pmrun_read(path.c_str(), &ro, &run, err, sizeof err) != 0)
         throw std::runtime_error(err);
     std::unique_ptr<pmrun, void (*)(pmrun *)> guard(run, pmrun_free);
-    Run r = run_from_pmrun(run, path, az_count);
+    Run r = run_from_pmrun(run, path, o.az_count);
     equinox_hint(r, run, path, ro);
+    ReadOptions shown = o;
+    shown.az_count = r.az_count; /* (asked for, and the run is alt-az with its raw axis) */
+    r.read_options = shown.text();
     return r;
 }
 

@@ -63,15 +63,34 @@ struct Run {
     std::vector<std::vector<double>> aux_values;
 };
 
+// How a run file is read: pmfit's reading options (pmrun_options, with
+// az_count).  format: a PMRUN_FORMAT_* id or -1 (PMRUN_FORMAT_AUTO,
+// detect); equinox: a PMRUN_EQUINOX_* id (0: as the file says)
+// (tools/lib/runfile.h).  az_count: an alt-az file's azimuth is the mount's
+// count, read so even within 0..360 deg (the mount never turns through the
+// file's seam; pmfit --azimuth-count; derive_directions).  The weather of
+// the refraction in the reductions: NaN takes the file's (pmfit
+// --pressure, --temperature, --humidity, --wavelength).
+struct ReadOptions {
+    bool refraction = true;
+    bool skip_bad = false;
+    int format = -1;
+    int equinox = 0;
+    bool az_count = false;
+    double pressure_hpa = std::numeric_limits<double>::quiet_NaN();
+    double temp_c = std::numeric_limits<double>::quiet_NaN();
+    double humidity = std::numeric_limits<double>::quiet_NaN();
+    double wavelength_um = std::numeric_limits<double>::quiet_NaN();
+    // the options as pmfit's arguments, each after a space (" --equinox
+    // J2000 --pressure 780"; "" for the defaults): what a command that
+    // reads the run again repeats (Run::read_options)
+    std::string text() const;
+};
+
 // Read a run (pmrun_read); without a direction column the slew direction on
 // axis 1 is the sign of the encoder's change from the previous observation.
-// format: a PMRUN_FORMAT_* id or -1 (PMRUN_FORMAT_AUTO, detect); equinox:
-// a PMRUN_EQUINOX_* id (0: as the file says) (tools/lib/runfile.h).
-// az_count: an alt-az file's azimuth is the mount's count, read so even
-// within 0..360 deg (the mount never turns through the file's seam;
-// pmfit --azimuth-count; derive_directions).
-Run load_run(const std::string &path, bool refraction, bool skip_bad, int format = -1,
-             int equinox = 0, bool az_count = false);
+// r.read_options is ro.text().
+Run load_run(const std::string &path, const ReadOptions &ro = ReadOptions());
 // Where an equatorial run's records are all one pier side but its residuals
 // change at the meridian as a German mount's sides do (records folded to the
 // sky, no pier column): the text that says so (fit order, adds); else "".

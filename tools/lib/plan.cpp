@@ -862,7 +862,7 @@ extern "C" int pmplan_next(const char *run_path, const pmplan_options *c, int k,
         o.next = k;
         Run run;
         if (run_path) {
-            run = load_run(run_path, true, false);
+            run = load_run(run_path);
             o.mount = run.mount;
             if (std::isfinite(run.latitude))
                 o.latitude = run.latitude;

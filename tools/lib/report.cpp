@@ -231,8 +231,7 @@ void stage_fit(Data &d)
 void stage_compare(Data &d)
 {
     const std::string &old = d.o.compare;
-    OldSide os = load_old(old, d.o.order, d.o.adds, d.o.refraction, d.o.skip_bad, d.o.format,
-                          d.o.equinox, d.o.max_passes);
+    OldSide os = load_old(old, d.o.order, d.o.adds, d.o.read, d.o.max_passes);
     if (os.is_run && os.fit.status != PM_OK)
         fit_failed(os.fit, old + " (the old run)", d.o.max_passes);
     d.old_what = os.is_run ? fmt("the run %s (fitted at order %d)", old.c_str(), d.o.order)

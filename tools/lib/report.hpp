@@ -28,10 +28,7 @@ struct ReportOptions {
     double min_el_deg = 15;            // plan: the lowest elevation (pmfit plan --min-el)
     std::string horizon;               // plan: a horizon file (--horizon; empty: none)
     std::string compare;               // OLD: a model file or a run; empty: no comparison
-    bool refraction = true;            // reading OLD when it is a run
-    bool skip_bad = false;
-    int format = PMRUN_FORMAT_AUTO;    // reading OLD: as pmfit --format, --equinox
-    int equinox = PMRUN_EQUINOX_FILE;
+    ReadOptions read;                  // reading OLD when it is a run (as the run)
     std::string command;               // the command line, quoted at the end of the page
     int max_passes = 2000;             // Gauss-Newton passes of the fit (as pmfit fit)
     // the run's explanation with these options, where the caller has made

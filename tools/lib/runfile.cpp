@@ -1046,6 +1046,14 @@ int pmrun_read(const char *path, const pmrun_options *opt, pmrun **out, char *er
             set_error(err, errlen, ctx.error());
             return st;
         }
+        // Weather given for a run no reduction refracted: said, not dropped
+        // in silence (the places are observed ones already, alt-az, or
+        // refraction is off).
+        if (!run->weather_used && !(std::isnan(o.pressure_hpa) && std::isnan(o.temp_c) &&
+                                    std::isnan(o.humidity) && std::isnan(o.wavelength_um)))
+            ctx.warn(0, "the weather options (pressure, temperature, humidity, wavelength) are not "
+                        "used: no place of this run is reduced with refraction (its places are "
+                        "observed ones, or refraction is off)");
         *out = run.release();
         return PMRUN_OK;
     } catch (const std::bad_alloc &) {

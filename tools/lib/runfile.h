@@ -179,7 +179,8 @@ typedef struct pmrun_obs {
 **                            (CSV logs and RTS2 gpoint files only)
 **
 **  The weather options change the reductions (TPOINT equatorial, CSV and
-**  RTS2 J2000 places, CSV refraction); skip_bad and format apply to every
+**  RTS2 J2000 places, CSV refraction); where no reduction refracts, a
+**  warning says they were not used.  skip_bad and format apply to every
 **  format.  A zeroed struct (instead of pmrun_options_default) forces the
 **  four-column format.
 */

@@ -25,6 +25,7 @@ struct pmrun {
     std::vector<std::string> warnings;
     std::vector<std::string> skipped;
     int n_skipped = 0;
+    bool weather_used = false; // a reduction refracted with the weather
 };
 
 namespace pmrun_detail {

@@ -279,6 +279,7 @@ private:
         pmrun_site &site = ctx_.run()->site;
         bool refr = opt.refraction && mount_ == PMRUN_MOUNT_EQUATORIAL;
         const char *src;
+        ctx_.run()->weather_used = refr;
 
         if (std::isfinite(site.height_m) && (site.height_m < -500 || site.height_m > 9000))
             ctx_.warn(n, "height %g m is implausible, expected -500..9000 m", site.height_m);

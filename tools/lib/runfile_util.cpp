@@ -228,6 +228,7 @@ bool refraction_weather(Context &ctx, int line, const char *what, Weather &out)
 {
     const pmrun_options &opt = ctx.opt();
     pmrun_site &site = ctx.run()->site;
+    ctx.run()->weather_used = true;
     double h = std::isfinite(site.height_m) ? site.height_m : 0.0;
     double p0 = standard_pressure_hpa(h);
     if (!std::isnan(opt.pressure_hpa)) site.pressure_hpa = opt.pressure_hpa;
@@ -253,22 +254,25 @@ bool refraction_weather(Context &ctx, int line, const char *what, Weather &out)
         wl = 0.55;
         note("wavelength 0.55 um");
     }
+    // (where a value came from: the file, or the options)
+    auto src = [&](double given) { return std::isnan(given) ? what : "given as an option"; };
     if (!(p > 0 && p <= 1100))
-        return ctx.fail(line, "pressure %g hPa (%s) is absurd, expected 0 < p <= 1100 hPa", p, what);
+        return ctx.fail(line, "pressure %g hPa (%s) is absurd, expected 0 < p <= 1100 hPa", p,
+                        src(opt.pressure_hpa));
     if (!(tc > -273.15) || !std::isfinite(tc))
         return ctx.fail(line, "temperature %g C (%s) is below absolute zero, expected -60..+50 C",
-                        tc, what);
+                        tc, src(opt.temp_c));
     if (rh > 1 && rh <= 100) {
-        ctx.warn(line, "humidity %g (%s) taken as percent: %g", rh, what, rh / 100);
+        ctx.warn(line, "humidity %g (%s) taken as percent: %g", rh, src(opt.humidity), rh / 100);
         rh /= 100;
         site.humidity = rh;
     } else if (!(rh >= 0 && rh <= 1)) {
         return ctx.fail(line, "humidity %g (%s) is out of range, expected 0-1 (or percent 0-100)",
-                        rh, what);
+                        rh, src(opt.humidity));
     }
     if (!(wl > 0) || !std::isfinite(wl))
         return ctx.fail(line, "wavelength %g um (%s) is not positive, expected 0.3..25 um", wl,
-                        what);
+                        src(opt.wavelength_um));
     if (!defaulted.empty())
         ctx.warn(line, "refraction uses defaults for what %s does not give: %s (height %g m)", what,
                  defaulted.c_str(), h);
