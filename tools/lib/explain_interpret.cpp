@@ -191,6 +191,13 @@ void axis_items(const Run &run, const FitOut &f, std::vector<Interpretation> &ou
 
 // The tube-flexure field as an exact combination x of the model's terms
 // (least squares over the run's points; exact to rounding or not at all).
+// The combination is sparse (alt-az: a*Y(1,-1) and b*Y(1,1) alone), but on a
+// sky that nearly confounds the terms (an elevation band) the normal
+// equations' solution carries rounding of 1e-9 on the others; read as part
+// of the sag, those terms' coefficients of degrees made the reading 3026" +-
+// 86" of a sag of -6" (an outside probe's control run, el 10-35 deg).  So
+// the components above 1e-6 of the largest are solved for again alone and
+// kept where that is exact.
 bool sag_combination(const Run &run, const FitOut &f, std::vector<double> &x)
 {
     std::vector<std::string> tf = {"tube_flexure"};
@@ -204,8 +211,7 @@ bool sag_combination(const Run &run, const FitOut &f, std::vector<double> &x)
         return false;
     int P = f.model.n_terms;
     std::vector<double> A((size_t)(P * P), 0.0), r0(PM_MAX_TERMS), r1(PM_MAX_TERMS), t0(PM_MAX_TERMS),
-        t1(PM_MAX_TERMS), rows;
-    x.assign((size_t)P, 0.0);
+        t1(PM_MAX_TERMS), rows, b((size_t)P, 0.0);
     double ss = 0;
     for (int i : f.idx) {
         const Obs &o = run.obs[i];
@@ -214,9 +220,9 @@ bool sag_combination(const Run &run, const FitOut &f, std::vector<double> &x)
             pm_fit_row(&s, &o.ctx, o.eh, o.ed, o.ah, o.ad, t0.data(), t1.data(), r) != PM_OK)
             return false;
         for (int a = 0; a < P; a++) {
-            x[(size_t)a] += r0[(size_t)a] * t0[6] + r1[(size_t)a] * t1[6];
-            for (int b = 0; b < P; b++)
-                A[(size_t)(a * P + b)] += r0[(size_t)a] * r0[(size_t)b] + r1[(size_t)a] * r1[(size_t)b];
+            b[(size_t)a] += r0[(size_t)a] * t0[6] + r1[(size_t)a] * t1[6];
+            for (int c = 0; c < P; c++)
+                A[(size_t)(a * P + c)] += r0[(size_t)a] * r0[(size_t)c] + r1[(size_t)a] * r1[(size_t)c];
         }
         ss += t0[6] * t0[6] + t1[6] * t1[6];
         rows.insert(rows.end(), r0.begin(), r0.begin() + P);
@@ -224,18 +230,48 @@ bool sag_combination(const Run &run, const FitOut &f, std::vector<double> &x)
         rows.push_back(t0[6]);
         rows.push_back(t1[6]);
     }
-    if (!(ss > 0) || !solve(A, x, P))
+    if (!(ss > 0))
         return false;
-    double miss = 0; // is the combination exact?
-    size_t stride = (size_t)(2 * P + 2);
-    for (size_t j = 0; j + stride <= rows.size(); j += stride)
-        for (int c = 0; c < 2; c++) {
-            double v = -rows[j + (size_t)(2 * P + c)];
-            for (int a = 0; a < P; a++)
-                v += rows[j + (size_t)(c * P + a)] * x[(size_t)a];
-            miss += v * v;
+    // the least squares on the terms `on` alone: x (zero elsewhere), exact?
+    auto combination = [&](const std::vector<int> &on, std::vector<double> &out) {
+        const int n = (int)on.size();
+        std::vector<double> As((size_t)(n * n)), bs((size_t)n);
+        for (int a = 0; a < n; a++) {
+            bs[(size_t)a] = b[(size_t)on[(size_t)a]];
+            for (int c = 0; c < n; c++)
+                As[(size_t)(a * n + c)] = A[(size_t)(on[(size_t)a] * P + on[(size_t)c])];
         }
-    return miss <= 1e-16 * ss;
+        if (n == 0 || !solve(As, bs, n))
+            return false;
+        out.assign((size_t)P, 0.0);
+        for (int a = 0; a < n; a++)
+            out[(size_t)on[(size_t)a]] = bs[(size_t)a];
+        double miss = 0;
+        size_t stride = (size_t)(2 * P + 2);
+        for (size_t j = 0; j + stride <= rows.size(); j += stride)
+            for (int c = 0; c < 2; c++) {
+                double v = -rows[j + (size_t)(2 * P + c)];
+                for (int a = 0; a < P; a++)
+                    v += rows[j + (size_t)(c * P + a)] * out[(size_t)a];
+                miss += v * v;
+            }
+        return miss <= 1e-16 * ss;
+    };
+    std::vector<int> all, big;
+    for (int a = 0; a < P; a++)
+        all.push_back(a);
+    if (!combination(all, x))
+        return false;
+    double top = 0;
+    for (double v : x)
+        top = std::max(top, std::fabs(v));
+    for (int a = 0; a < P; a++)
+        if (std::fabs(x[(size_t)a]) > 1e-6 * top)
+            big.push_back(a);
+    std::vector<double> sparse;
+    if (big.size() < all.size() && combination(big, sparse))
+        x = sparse;
+    return true;
 }
 
 // The sag that the order-1 terms hold: generalised least squares of their
@@ -289,6 +325,19 @@ void sag_item(const Run &run, const FitOut &f, std::vector<Interpretation> &out)
     if (!consistent)
         et *= birge;
     char buf[700];
+    // An error of more than 100" (a tube's sag is tens of arcseconds at
+    // most) reads nothing: said so, not a value of thousands of arcseconds
+    // (an outside probe's control runs in a band of elevation: -2065" +-
+    // 2870" of a sag of -6")
+    if (et * RAD2AS > 100) {
+        std::snprintf(buf, sizeof buf,
+                      "tube flexure held by the order-1 terms: not determined on this sky (%.0f\" "
+                      "+- %.0f\"; a sag is tens of arcseconds): the %zu terms that would hold it are "
+                      "too loosely fixed by these points",
+                      t * RAD2AS, et * RAD2AS, S.size());
+        out.push_back(item("tube_flexure_in_order1", t * RAD2AS, et * RAD2AS, "arcsec", buf));
+        return;
+    }
     std::snprintf(buf, sizeof buf,
                   "tube flexure held by the order-1 terms: %.2f\" +- %.2f\" of cos(el) toward the "
                   "zenith (a sag toward the horizon is negative); it is %zu of them in fixed "
