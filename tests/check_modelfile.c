@@ -474,7 +474,7 @@ START_TEST(test_pmmodel_covariance)
         ** was taken (an outside probe) */
         {"corr 2 1 1\ncorr 3 1 1 -1\ncorr 4 1 0 0 0\ncorr 5 1 0 0 0 0\n"
          "corr 6 1 0 0 0 0 0\nend\n",
-         "14", "fully correlated"},
+         "14", "not positive semi-definite at term 3, c'"},
     };
     pm_model a, b;
     pmmodel_info in, got;
@@ -526,6 +526,28 @@ START_TEST(test_pmmodel_covariance)
             ck_assert_msg(fabs(back[i * P + j] - cov[i * P + j]) <=
                               1e-9 * sqrt(cov[i * P + i] * cov[j * P + j]),
                           "cov[%d][%d] %.17g read back %.17g", i, j, cov[i * P + j], back[i * P + j]);
+    /* a nearly singular covariance, as a fit of hardly more stars than
+    ** terms has, reads back (an outside probe's order-2 fit of 26 stars had
+    ** been refused reading its own file: the 10 digits of a pivot of 1e-12) */
+    for (k = 0; k < 16; k++) {
+        tu_seed(&r, 40 + (unsigned long long)k);
+        for (j = 0; j < P; j++) /* row 2 of A nearly rows 0 + 1: a pivot of 1e-4 .. 1e-19 */
+            A[2 * P + j] = A[j] + A[P + j] + pow(10.0, -2 - 0.5 * k) * (tu_uniform(&r) - 0.5);
+        for (i = 0; i < P; i++)
+            for (j = 0; j < P; j++) {
+                double c = 0;
+                for (int m = 0; m < P; m++)
+                    c += A[i * P + m] * A[j * P + m];
+                cov[i * P + j] = 1e-12 * c;
+            }
+        for (i = 0; i < P; i++)
+            in.err[i] = sqrt(cov[i * P + i]);
+        ck_assert_msg(pmmodel_save_cov(path, &a, &in, cov, "c", err, sizeof err) == 0, "%s", err);
+        ck_assert_msg(pmmodel_load_cov(path, &b, &got, back, (size_t)(PM_MAX_TERMS * PM_MAX_TERMS),
+                                       &has, err, sizeof err) == 0,
+                      "near-singular, noise 1e-%g: %s", 2 + 0.5 * k, err);
+        ck_assert_int_eq(has, 1);
+    }
     /* the older calls read it, without the covariance */
     ck_assert_msg(pmmodel_load_info(path, &b, &got, err, sizeof err) == 0, "%s", err);
     ck_assert_int_eq(got.has_err, 1);

@@ -814,6 +814,23 @@ START_TEST(test_pmfit_explain_sag_reading_on_a_band)
 }
 END_TEST
 
+/* A model saved from a fit of hardly more stars than terms reads back: an
+** outside probe's closed loop of 26 stars, order 2 (46 terms, two of them
+** correlated -0.99999), had been refused by eval reading its own --save
+** ("the correlations are not those of a covariance"). */
+START_TEST(test_pmfit_save_nearly_singular_reads_back)
+{
+    char path[300], model[300];
+    make_tmpdir();
+    snprintf(path, sizeof path, "%s/tests/data/plan_loop_altaz26.dat",
+             getenv("PM_TOP") ? getenv("PM_TOP") : ".");
+    snprintf(model, sizeof model, "%s/m26.pm", tmpdir);
+    ck_assert_msg(run("%s fit %s --order 2 --save %s", path, model) == 0, "%.2000s", out);
+    ck_assert_msg(run("%s eval %s %s", model, path) == 0, "%.2000s", out);
+    ck_assert_msg(run("%s compare %s %s", model, path) == 0, "%.2000s", out);
+}
+END_TEST
+
 /* The weather of the refraction from the command line (--pressure,
 ** --temperature, --humidity, --wavelength), for files that lack it (an
 ** RTS2 gpoint file never has it): the CSV log's weather given as options
@@ -1568,6 +1585,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_pmfit_explain_cable_wrap);
     tcase_add_test(tc, test_pmfit_explain_azimuth_count_reading);
     tcase_add_test(tc, test_pmfit_weather_options);
+    tcase_add_test(tc, test_pmfit_save_nearly_singular_reads_back);
     tcase_add_test(tc, test_pmfit_explain_sag_reading_on_a_band);
     tcase_add_test(tc, test_pmfit_rts2_equinox_hint);
     tcase_add_test(tc, test_pmfit_folded_records_without_pier);
