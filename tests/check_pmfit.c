@@ -831,6 +831,25 @@ START_TEST(test_pmfit_save_nearly_singular_reads_back)
 }
 END_TEST
 
+/* A baseline the sky cannot fit: a fork's 200 stars in a band of
+** declination (outside probe Z1's generator, tests/ref/equ_gen_z1.py) fail at
+** order 1 with advice that fits a one-sided run's mount (it had said "use
+** both pier sides" to a fork), and --order 0 explains it. */
+START_TEST(test_pmfit_explain_baseline_advice)
+{
+    char path[300];
+    snprintf(path, sizeof path, "%s/tests/data/fork_decband.dat",
+             getenv("PM_TOP") ? getenv("PM_TOP") : ".");
+    ck_assert_int_eq(run("%s explain %s%s", path, ""), 1);
+    ck_assert_msg(strstr(out, "the baseline fit failed") &&
+                      strstr(out, "lower --order or add stars over more of the sky (a German "
+                                  "mount: on both pier sides)") &&
+                      !strstr(out, "lower --order or use both pier sides"),
+                  "%.2000s", out);
+    ck_assert_msg(run("%s explain %s --order 0%s", path, "") == 0, "%.2000s", out);
+}
+END_TEST
+
 /* The weather of the refraction from the command line (--pressure,
 ** --temperature, --humidity, --wavelength), for files that lack it (an
 ** RTS2 gpoint file never has it): the CSV log's weather given as options
@@ -1585,6 +1604,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_pmfit_explain_cable_wrap);
     tcase_add_test(tc, test_pmfit_explain_azimuth_count_reading);
     tcase_add_test(tc, test_pmfit_weather_options);
+    tcase_add_test(tc, test_pmfit_explain_baseline_advice);
     tcase_add_test(tc, test_pmfit_save_nearly_singular_reads_back);
     tcase_add_test(tc, test_pmfit_explain_sag_reading_on_a_band);
     tcase_add_test(tc, test_pmfit_rts2_equinox_hint);

@@ -680,13 +680,17 @@ FitOut do_fit(pm_fit &fit, const std::vector<Obs> &obs, const std::vector<int> &
     f.model = start;
     std::vector<double> eh, ed, ah, ad;
     std::vector<pm_context> ctx;
+    bool east = false, west = false;
     for (int i : use) {
+        east = east || obs[i].pier > 0;
+        west = west || obs[i].pier < 0;
         eh.push_back(obs[i].eh);
         ed.push_back(obs[i].ed);
         ah.push_back(obs[i].ah);
         ad.push_back(obs[i].ad);
         ctx.push_back(obs[i].ctx);
     }
+    f.both_sides = east && west;
     f.status = pm_fit_run(&fit, &f.model, ctx.data(), (long)use.size(), eh.data(), ed.data(),
                           ah.data(), ad.data(), max_passes, &f.res);
     f.bad_term = f.status == PM_OK ? -1 : fit.bad_term;
@@ -1146,9 +1150,10 @@ std::string fit_failure_detail(const FitOut &f, int passes, const std::string &o
         std::snprintf(buf, sizeof buf, "%.6f", f.corr);
         return " in " + std::to_string(passes) + " passes: the sky coverage hardly separates " +
                term_name(m, f.corr_j) + " from " + term_name(m, f.corr_i) + " (correlation " +
-               buf + "); lower " + order + " or " +
-               (m.mount == PM_MOUNT_ALTAZ ? "add stars over more of the sky"
-                                          : "use both pier sides");
+               buf + "); lower " + order + " or add stars over more of the sky" +
+               // (a fork has one side: "use both pier sides" had been its advice)
+               (m.mount == PM_MOUNT_ALTAZ || f.both_sides ? ""
+                                                          : " (a German mount: on both pier sides)");
     case PM_ERR_TOO_FEW:
         return " (P = " + std::to_string(m.n_terms) + " terms need at least " +
                std::to_string(m.n_terms / 2 + 1) + " observations, 2N > P; there are " +

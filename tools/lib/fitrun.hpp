@@ -35,6 +35,7 @@ struct FitOut {
     int bad_term = -1;
     int corr_i = -1, corr_j = -1; // most correlated pair when not converged
     double corr = 0;
+    bool both_sides = false;    // the observations fitted hold both pier sides
     std::vector<double> r0, r1; // residuals (rad), sky frame
     std::vector<int> idx;       // indices into the run
     double rms = 0;
