@@ -493,7 +493,7 @@ void real_run(const std::string &path, const std::string &label)
 {
     Run run;
     try {
-        run = load_run(path, true, false);
+        run = load_run(path);
     } catch (const std::exception &x) {
         std::printf("\n%s: skipped (%s)\n", label.c_str(), x.what());
         return;
