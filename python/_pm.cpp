@@ -1006,6 +1006,10 @@ std::string explain_run(const RunData &d, int order, std::vector<std::string> ad
                         std::vector<double> gears_ha, std::vector<double> gears_dec, bool pairs,
                         int folds, bool compose)
 {
+    // order -1: the default (1, or 0 where order0_instead says so)
+    const bool chosen = order >= 0;
+    if (!chosen)
+        order = 1;
     if (order < 0 || order > PM_MAX_L)
         fail(K_ARGUMENT, "order " + std::to_string(order) + ": expected 0.." + std::to_string(PM_MAX_L));
     if (!(alpha > 0 && alpha < 1))
@@ -1030,13 +1034,21 @@ std::string explain_run(const RunData &d, int order, std::vector<std::string> ad
     // explain() fits through pmhost::do_fit's one static workspace: the GIL
     // is kept, so that two Python threads never explain at once.
     Explanation ex;
+    std::string note;
     try {
         ex = explain(d.run, eo);
+        note = chosen ? "" : order0_instead(d.run, ex, eo);
+        if (!note.empty()) {
+            eo.order = order = 0;
+            ex = explain(d.run, eo);
+        }
     } catch (const std::runtime_error &e) {
         std::string w = e.what();
         fail(w.rfind("--add", 0) == 0 ? K_ARGUMENT : K_ERROR, w);
     }
-    return "{\"n_obs\": " + std::to_string(d.run.obs.size()) + ", " + explain_json(d.run, ex, order) + "}";
+    return "{\"n_obs\": " + std::to_string(d.run.obs.size()) + ", \"order_note\": " +
+           (note.empty() ? std::string("null") : "\"" + json_escape(note) + "\"") + ", " +
+           explain_json(d.run, ex, order) + "}";
 }
 
 // A number keyword of plan(): finite and within [lo, hi], else ArgumentError.

@@ -823,7 +823,7 @@ def fit(enc_ha, enc_dec, app_ha, app_dec, *, order=1, add=(), split=False, mount
 # Explain
 
 
-def explain(run, *, order=1, add=(), alpha=0.01, gears=(), gears_ha=(), gears_dec=(),
+def explain(run, *, order=None, add=(), alpha=0.01, gears=(), gears_ha=(), gears_dec=(),
             pairs=True, folds=0, compose=True):
     """What did the model leave out? ``pmfit explain RUN --json`` as a dict
     (keys in docs/formats.md, "pmfit explain --json"; docs/explain.md for
@@ -833,7 +833,10 @@ def explain(run, *, order=1, add=(), alpha=0.01, gears=(), gears_ha=(), gears_de
     revolution) of both axes (--gear G), ``gears_ha``/``gears_dec`` of one;
     ``compose=False``: the baseline read to first order (--no-compose);
     ``folds``: 0 cross-validates leave-one-out (from each fit itself), k >= 2
-    k-fold (k more fits each)."""
+    k-fold (k more fits each).  ``order``: None (pmfit's default) explains at
+    order 1, or at order 0 where the run has fewer points than the order-1
+    baseline's terms and order 0 predicts them better; ``order_note`` says
+    so (None otherwise)."""
     r = _run(run)
 
     def g(name, v):
@@ -843,7 +846,10 @@ def explain(run, *, order=1, add=(), alpha=0.01, gears=(), gears_ha=(), gears_de
     gd = g("gears", gears) + g("gears_dec", gears_dec)
     if not isinstance(folds, (int, _np.integer)) or isinstance(folds, bool):
         raise ArgumentError("folds: expected an integer")
-    text = _pm.explain_run(r._data, _order(order), _adds(add), float(alpha), gh, gd,
+    if order is not None and _order(order) < 0:
+        raise ArgumentError("order: expected an integer 0..%d or None, got %r" % (MAX_L, order))
+    text = _pm.explain_run(r._data, -1 if order is None else _order(order), _adds(add),
+                           float(alpha), gh, gd,
                            bool(pairs), int(folds), bool(compose))
     return _json.loads(text)
 

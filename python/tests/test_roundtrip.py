@@ -285,6 +285,24 @@ def test_explain_options_match_pmfit(sim_dir):
     assert got["baseline"]["order"] == 2
 
 
+def test_explain_default_order_matches_pmfit(tmp_path):
+    """order=None is pmfit explain without --order: 20 points of an alt-az
+    mount are explained at order 0, which predicts them better than the
+    order-1 baseline's 22 terms, and order_note says so; order=1 is --order 1."""
+    run = str(tmp_path / "az20.dat")
+    run_cmd(PMFIT, "simulate", run, "--mount", "altaz", "--n", "20", "--noise", "3", "--seed", "2",
+            "--effect", "ha_periodic:2=20")
+    got = pm.explain(run)
+    assert got == json.loads(run_cmd(PMFIT, "explain", run, "--json").stdout)
+    assert got["baseline"]["order"] == 0
+    assert got["order_note"].startswith("20 points do not determine the order-1 baseline's 22 terms")
+    one = pm.explain(run, order=1)
+    assert one == json.loads(run_cmd(PMFIT, "explain", run, "--json", "--order", "1").stdout)
+    assert one["baseline"]["order"] == 1 and one["order_note"] is None
+    with pytest.raises(pm.ArgumentError):
+        pm.explain(run, order=-1)
+
+
 def test_explain_compose_matches_pmfit():
     """compose=False is pmfit explain --no-compose (docs/explain.md, step 1): on a run of
     10' of gimbal anisotropy, the composition taken out is reported, and off it is 0."""

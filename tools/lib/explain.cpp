@@ -766,6 +766,65 @@ void prefer_integer(const Run &run, const State &st, const char *prefix, double 
 // a relative 2% beside it missed 180 + 177 and 180 + 183).
 constexpr double HELD_WINDOW_CYCLES = 2.5;
 
+// Aliases.  An axis sampled over part of its circle (a declination band, a
+// German mount's two sides) shows a gear's period and its aliases, about
+// 360 deg / (the sampled extent) cycles apart, with powers the baseline's
+// residuals rank by chance: an outside probe's 144-cycle declination worm
+// in a band of 20-30 deg was read as 141.36 (or 150, 152, 177 for 180) in
+// 12 of 36 runs, "141.28 to 141.44 fit as well", while 144 fit better
+// (sigma 2.83" against 2.99").  So the three highest other peaks of the
+// periodogram (local maxima beyond 1.5 cycles of G and of a held period,
+// with a third of its power or more) are fitted in full as G is
+// (prefer_integer): the best fit is taken, and the others within
+// PERIOD_RANGE_CHI2 sigma^2 of it are the periods that fit as well.
+void alias_peaks(const Run &run, const State &st, const char *prefix, double g_lo, double g_hi,
+                 const Periodogram &pg, const std::vector<double> &held, double &G, Fit &chosen,
+                 std::vector<double> &aliases)
+{
+    aliases.clear();
+    if (!chosen.ok)
+        return;
+    std::vector<size_t> peaks;
+    for (size_t k = 0; k < pg.g.size(); k++) {
+        const bool local = (k == 0 || pg.power[k] >= pg.power[k - 1]) &&
+                           (k + 1 == pg.g.size() || pg.power[k] >= pg.power[k + 1]);
+        bool near = std::fabs(pg.g[k] - G) < 1.5 || pg.g[k] < g_lo || pg.g[k] > g_hi;
+        for (double p : held)
+            near = near || std::fabs(pg.g[k] - p) < HELD_WINDOW_CYCLES;
+        if (local && !near && pg.power[k] >= pg.peak_power / 3)
+            peaks.push_back(k);
+    }
+    std::sort(peaks.begin(), peaks.end(),
+              [&](size_t a, size_t b) { return pg.power[a] > pg.power[b]; });
+    if (peaks.size() > 3)
+        peaks.resize(3);
+    std::vector<double> gs = {G};
+    std::vector<Fit> fits = {chosen};
+    for (size_t k : peaks) {
+        double g = pg.g[k];
+        Fit f;
+        prefer_integer(run, st, prefix, g_lo, g_hi, g, &f);
+        bool again = false; // (two peaks can walk to one period)
+        for (double h : gs)
+            again = again || std::fabs(h - g) < 1e-9;
+        if (f.ok && !again) {
+            gs.push_back(g);
+            fits.push_back(f);
+        }
+    }
+    size_t best = 0;
+    for (size_t k = 1; k < fits.size(); k++)
+        if (fits[k].chi2 < fits[best].chi2)
+            best = k;
+    G = gs[best];
+    chosen = fits[best];
+    const double s2 = chosen.chi2 / (double)std::max(1L, 2 * chosen.N - chosen.P);
+    for (size_t k = 0; k < fits.size(); k++)
+        if (k != best && (fits[k].chi2 - chosen.chi2) / s2 <= PERIOD_RANGE_CHI2)
+            aliases.push_back(gs[k]);
+    std::sort(aliases.begin(), aliases.end());
+}
+
 void periodic_candidates(const Run &run, const State &st, const ExplainOptions &opt,
                          std::vector<Candidate> &cands)
 {
@@ -819,14 +878,18 @@ void periodic_candidates(const Run &run, const State &st, const ExplainOptions &
         }
         Fit chosen;
         const bool scan = opt_is_scan(opt, comp);
-        if (scan)
-            prefer_integer(run, st, prefix, refine_floor(run, st.use, comp, opt), opt.g_max,
-                           pg.peak_g, &chosen);
+        std::vector<double> aliases;
+        if (scan) {
+            const double floor_g = refine_floor(run, st.use, comp, opt);
+            prefer_integer(run, st, prefix, floor_g, opt.g_max, pg.peak_g, &chosen);
+            alias_peaks(run, st, prefix, floor_g, opt.g_max, pg, held, pg.peak_g, chosen, aliases);
+        }
         char spec[64];
         std::snprintf(spec, sizeof spec, "%s%.6g", prefix, pg.peak_g);
         add_candidate(cands, st, comp ? "dec_periodic" : "ha_periodic", {spec});
         cands.back().trials = pg.trials;
         cands.back().peak_g = pg.peak_g;
+        cands.back().aliases = aliases;
         if (scan) { /* (the same spec, order and start as score's) */
             cands.back().fit = chosen;
             cands.back().fitted = true;
@@ -1765,6 +1828,11 @@ Explanation explain_pass(const Run &run, const ExplainOptions &opt)
     ex.periodograms.push_back(periodogram(run, st.cur.f, 1, opt, s2));
     ex.interpretation = interpret(run, st.cur.f);
     ex.physical_reading = physical_reading(run, ex, opt);
+    if (opt.order == 1 && opt.adds.empty() && (long)st.use.size() < st.cur.P) {
+        Fit f0 = fit_spec(run, st.use, 0, {});
+        if (f0.ok)
+            ex.order0_cv_rms_arcsec = arcsec(cv_of(run, st.use, 0, {}, opt, f0, ex.cv_left_out));
+    }
     ex.folded_pier = folded_pier_hint(run, opt.order, opt.adds);
     while ((int)ex.findings.size() < opt.max_findings && step(run, st, opt, ex)) {
     }
@@ -2049,6 +2117,20 @@ ExplainOptions composition_options(const Run &run, const ExplainOptions &opt,
     if (std::fabs(f.f.model.coef[k]) >= NUISANCE_SIGMAS * f.f.res.err[k])
         o.adds = with;
     return o;
+}
+
+std::string order0_instead(const Run &run, const Explanation &ex, const ExplainOptions &opt)
+{
+    // (an outside probe's 15 stars had "nothing significant is left out"
+    // at order 1, sigma 21" for 3" of noise, where order 0 found its two
+    // 18-sigma outliers)
+    if (opt.order != 1 || !opt.adds.empty() ||
+        !(ex.order0_cv_rms_arcsec < ex.base_cv_rms_arcsec))
+        return "";
+    return fmt("%zu points do not determine the order-1 baseline's %d terms, and order 0 "
+               "predicts them better (cross-validated RMS %.3f\" vs %.3f\"): explained at "
+               "order 0 (--order 1 explains it at order 1)",
+               run.obs.size(), ex.base_n_params, ex.order0_cv_rms_arcsec, ex.base_cv_rms_arcsec);
 }
 
 Explanation explain(const Run &given, const ExplainOptions &opt)

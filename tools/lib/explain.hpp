@@ -96,6 +96,7 @@ struct Finding {
     std::vector<Coefficient> coefficients;
     double cycles_per_rev = 0, amplitude_arcsec = 0, amplitude_err_arcsec = 0, phase_deg = 0;
     double cycles_lo = 0, cycles_hi = 0; // periodic: the periods that fit as well (lo..hi)
+    std::vector<double> aliases;          // periodic: periods of other peaks that fit as well
     double sampled_deg = 0;               // periodic: the extent of the axis the run samples
     double f_stat = 0, log10_p = 0, false_alarm_probability = 1;
     double sigma_after_arcsec = 0, cv_rms_after_arcsec = 0;
@@ -134,6 +135,9 @@ struct Explanation {
     std::vector<std::string> withdrawn_why;
     std::vector<Interpretation> interpretation; // the physical reading of the baseline
     std::string physical_reading;        // order 0 + one term predicts as well as order 1
+    // fewer points than the order-1 baseline has terms (N < P; its own
+    // options order 1, no --add): order 0's cross-validated RMS, else NaN
+    double order0_cv_rms_arcsec = std::numeric_limits<double>::quiet_NaN();
     std::string folded_pier;             // folded_pier_hint (fitrun.hpp): sides not in the file
     FitOut baseline, final;              // the two fits (residuals for plots)
     std::vector<int> kept;               // observations used by the final fit
@@ -160,6 +164,13 @@ struct Explanation {
 // The pipeline: baseline -> locate -> candidates -> select (singles, then
 // pairs) -> describe, repeated while something is found; then interpret.
 Explanation explain(const Run &run, const ExplainOptions &opt);
+
+// Where the caller left the order to explain (pmfit explain without
+// --order, pm.explain without order=) and ex is the order-1 explanation
+// (opt.order 1, no adds): the note that says why the run is better
+// explained at order 0 -- fewer points than the baseline's terms, which
+// order 0 predicts better (Explanation::order0_cv_rms_arcsec) -- else "".
+std::string order0_instead(const Run &run, const Explanation &ex, const ExplainOptions &opt);
 
 // The physical reading of a fitted model (stage "interpret"): polar axis,
 // non-perpendicularity, collimation, indices, the tube-flexure-like part of

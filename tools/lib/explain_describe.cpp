@@ -235,13 +235,21 @@ void describe_periodic(const Run &run, const Candidate &c, const std::vector<int
                   head, G, 360 / G, fd.amplitude_arcsec, fd.amplitude_err_arcsec,
                   fd.phase_deg, axis_word(run, axis, true));
     fd.text = buf;
-    if (fd.cycles_lo < G || fd.cycles_hi > G) {
+    std::string others; // other peaks that fit as well (alias_peaks)
+    for (double a : fd.aliases)
+        others += fmt("%s%.6g", others.empty() ? "" : ", ", a);
+    if (fd.cycles_lo < G || fd.cycles_hi > G || !others.empty()) {
         // the tooth count is not fixed by this run: say which counts fit
+        std::string which = fd.cycles_lo < G || fd.cycles_hi > G
+                                ? fmt("%.6g to %.6g cycles", fd.cycles_lo, fd.cycles_hi)
+                                : std::string();
+        if (!others.empty())
+            which += (which.empty() ? "" : ", and ") + others + " cycles (other peaks)";
         std::snprintf(buf, sizeof buf,
-                      "; %.6g to %.6g cycles fit as well (chi^2 within %.2f, 95%%): the run "
-                      "samples %.0f deg of the axis, too little to fix the count (give a known "
-                      "tooth count with --gear)",
-                      fd.cycles_lo, fd.cycles_hi, PERIOD_RANGE_CHI2, fd.sampled_deg);
+                      "; %s fit as well (chi^2 within %.2f, 95%%): the run samples %.0f deg of "
+                      "the axis, too little to fix the count (give a known tooth count with "
+                      "--gear)",
+                      which.c_str(), PERIOD_RANGE_CHI2, fd.sampled_deg);
         fd.text += buf;
     }
     // A period that is not a whole number of cycles per revolution jumps
@@ -439,6 +447,8 @@ std::vector<Finding> describe(const Run &run, const State &st, const Candidate &
             double G = k < c.member_g.size() ? c.member_g[k] : c.peak_g;
             period_range(run, st, opt, c.fit, c.adds, e == "ha_periodic" ? 0 : 1, G,
                          &fd.cycles_lo, &fd.cycles_hi, &fd.sampled_deg);
+            if (c.members.size() == 1)
+                fd.aliases = c.aliases;
             describe_periodic(run, c, newi, e, G, fd);
         }
         else if (e == "outlier")

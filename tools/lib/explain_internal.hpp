@@ -69,6 +69,7 @@ struct Candidate {
     std::vector<std::string> new_adds; // what this candidate adds
     double trials = 1;                 // periods scanned
     double peak_g = 0;
+    std::vector<double> aliases;       // periodic: other periods (other peaks) that fit as well
     std::vector<double> member_g;      // per member of a pair: its G (periodic), else 0
     std::vector<int> drop;             // outliers: observations to drop
     std::vector<double> miss;          // outliers: each one's deleted residual (rad)

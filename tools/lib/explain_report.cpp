@@ -42,10 +42,15 @@ std::string finding_json(const Finding &f, int mount)
     // on an alt-az mount; effect: the name of either mount's axis 1 and 2)
     std::string j = "{\"effect\": " + str(f.effect) + ", \"label\": " +
                     str(mount_words(f.effect, mount));
-    if (f.effect == "ha_periodic" || f.effect == "dec_periodic")
+    if (f.effect == "ha_periodic" || f.effect == "dec_periodic") {
+        std::string aliases;
+        for (double a : f.aliases)
+            aliases += (aliases.empty() ? "" : ", ") + num(a);
         j += ", \"cycles_per_rev\": " + num(f.cycles_per_rev) + ", \"cycles_per_rev_range\": [" +
-             num(f.cycles_lo) + ", " + num(f.cycles_hi) + "], \"axis_sampled_deg\": " +
-             num(f.sampled_deg) + ", \"phase_deg\": " + num(f.phase_deg);
+             num(f.cycles_lo) + ", " + num(f.cycles_hi) + "], \"cycles_per_rev_aliases\": [" +
+             aliases + "], \"axis_sampled_deg\": " + num(f.sampled_deg) +
+             ", \"phase_deg\": " + num(f.phase_deg);
+    }
     j += ", \"amplitude_arcsec\": " + num(f.amplitude_arcsec) +
          ", \"amplitude_error_arcsec\": " +
          (f.amplitude_err_arcsec > 0 ? num(f.amplitude_err_arcsec) : std::string("null")) +

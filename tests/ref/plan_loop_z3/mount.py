@@ -1,4 +1,5 @@
 # Independent mount simulator (first principles, small-angle TPOINT-like terms).
+# Written by an outside probe (Z3, stop 45) without the library's simulator; table.py runs it.
 import numpy as np
 AS = np.pi/180/3600
 D = np.pi/180
