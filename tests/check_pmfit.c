@@ -895,6 +895,56 @@ START_TEST(test_pmfit_explain_period_aliases)
 }
 END_TEST
 
+/* A sigma on few degrees of freedom: the error map's JSON gives 2N - P and
+** the 95% range of the true sigma over it, and where the range's top is
+** above 2 (2N - P <= 7) the fit warns (an outside probe's 5 stars for 9
+** terms: sigma 0.154" for 1" of noise, the map 0.283" where the model was
+** 1.53" off, without a word).  The ranges are scipy's:
+**   python3 -c "from scipy.stats import chi2; import math; k = 7;
+**               print(math.sqrt(k / chi2.ppf(0.975, k)), math.sqrt(k / chi2.ppf(0.025, k)))" */
+START_TEST(test_pmfit_few_dof_warning)
+{
+    static const struct {
+        int n, tf;
+        long dof;
+        double lo, hi;
+    } c[5] = {{4, 1, 1, 0.4461491849, 31.910159350}, {4, 0, 2, 0.5206582667, 6.2847346965},
+              {7, 1, 7, 0.6611741488, 2.0352720908}, {7, 0, 8, 0.6754570344, 1.9157708829},
+              {13, 0, 20, 0.7650591375, 1.4440694900}};
+    char path[300], n[16];
+    int k;
+    make_tmpdir();
+    for (k = 0; k < 5; k++) {
+        const char *p;
+        snprintf(path, sizeof path, "%s/s%d.dat", tmpdir, c[k].n);
+        snprintf(n, sizeof n, "%d", c[k].n);
+        ck_assert_int_eq(run("%s simulate %s --seed 3 --n %s > /dev/null", path, n), 0);
+        ck_assert_msg(run(c[k].tf ? "%s fit %s --order 0 --add tube_flexure --json%s"
+                                  : "%s fit %s --order 0 --json%s",
+                          path, "") == 0,
+                      "%.2000s", out);
+        p = strstr(out, "\"sigma_dof\": ");
+        ck_assert_msg(p != NULL, "%.2000s", out);
+        ck_assert_int_eq((long)tu_json_num(p, "sigma_dof"), c[k].dof);
+        p = strstr(p, "\"sigma_factor_95\": [");
+        ck_assert_ptr_nonnull(p);
+        {
+            double lo = 0, hi = 0;
+            ck_assert_int_eq(sscanf(p, "\"sigma_factor_95\": [%lf, %lf]", &lo, &hi), 2);
+            ck_assert_msg(fabs(lo / c[k].lo - 1) < 2e-4 && fabs(hi / c[k].hi - 1) < 2e-4,
+                          "dof %ld: %g..%g, scipy %g..%g", c[k].dof, lo, hi, c[k].lo, c[k].hi);
+        }
+        ck_assert_msg((strstr(out, "rest on only") != NULL) == (c[k].hi > 2), "dof %ld: %.2000s",
+                      c[k].dof, out);
+    }
+    ck_assert_msg(strstr(out, "rest on only") == NULL, "%.2000s", out);
+    ck_assert_int_eq(run("%s fit %s/s4.dat --order 0 --add tube_flexure%s", tmpdir, ""), 0);
+    ck_assert_msg(strstr(out, "its sigma, and the map scaled by it, rest on only 1 degree of "
+                              "freedom (2N - P): the true sigma may be 0.45 to 31.9 times it") != NULL,
+                  "%.2000s", out);
+}
+END_TEST
+
 /* The weather of the refraction from the command line (--pressure,
 ** --temperature, --humidity, --wavelength), for files that lack it (an
 ** RTS2 gpoint file never has it): the CSV log's weather given as options
@@ -1649,6 +1699,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_pmfit_explain_cable_wrap);
     tcase_add_test(tc, test_pmfit_explain_azimuth_count_reading);
     tcase_add_test(tc, test_pmfit_weather_options);
+    tcase_add_test(tc, test_pmfit_few_dof_warning);
     tcase_add_test(tc, test_pmfit_explain_period_aliases);
     tcase_add_test(tc, test_pmfit_explain_baseline_advice);
     tcase_add_test(tc, test_pmfit_save_nearly_singular_reads_back);

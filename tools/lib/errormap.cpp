@@ -1,5 +1,6 @@
 // errormap.cpp - the predicted error map of a fitted model (errormap.hpp).
 #include "errormap.hpp"
+#include "hostutil.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -121,6 +122,7 @@ ErrorMap error_map(const Run &run, const FitOut &f, int side)
     int P = f.model.n_terms;
     if (f.cov.size() != (size_t)(P * P))
         throw std::runtime_error("error map: the fit has no covariance");
+    e.dof = 2 * f.res.n_obs - f.res.n_par;
     bool altaz = run.mount == PM_MOUNT_ALTAZ;
     e.elevation = altaz || std::isfinite(run.latitude);
     // the usable sky: above the run's lowest star (whole degrees, >= 0 in elevation)
@@ -207,10 +209,59 @@ std::string error_map_text(const Run &run, const ErrorMap &e)
     return b;
 }
 
+namespace {
+
+// The regularised lower incomplete gamma P(a, x) (the chi^2 CDF with 2a
+// degrees of freedom at 2x), by its series, for the small a and x here.
+double gamma_p(double a, double x)
+{
+    if (!(x > 0))
+        return 0;
+    double term = 1 / a, sum = term;
+    for (int n = 1; n < 1000 && term > 1e-17 * sum; n++) {
+        term *= x / (a + n);
+        sum += term;
+    }
+    return std::min(1.0, sum * std::exp(-x + a * std::log(x) - std::lgamma(a)));
+}
+
+// The chi^2 quantile with k degrees of freedom at probability p: bisection.
+double chi2_quantile(long k, double p)
+{
+    double lo = 0, hi = 10.0 * (double)k + 100;
+    for (int i = 0; i < 200; i++) {
+        double mid = 0.5 * (lo + hi);
+        (gamma_p(0.5 * (double)k, 0.5 * mid) < p ? lo : hi) = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+
+std::string few_dof_text(const ErrorMap &e)
+{
+    const std::pair<double, double> f = sigma_factor_95(e.dof);
+    if (e.dof <= 0 || !(f.second > 2))
+        return "";
+    return fmt("its sigma, and the map scaled by it, rest on only %ld degree%s of freedom "
+               "(2N - P): the true sigma may be %.2g to %.3g times it (95%%); take more stars "
+               "or lower --order",
+               e.dof, e.dof == 1 ? "" : "s", f.first, f.second);
+}
+
+} // namespace
+
+std::pair<double, double> sigma_factor_95(long dof)
+{
+    if (dof <= 0)
+        return {1, 1};
+    const double k = (double)dof;
+    return {std::sqrt(k / chi2_quantile(dof, 0.975)), std::sqrt(k / chi2_quantile(dof, 0.025))};
+}
+
 std::string undetermined_warning(const ErrorMap &e, double sigma_arcsec)
 {
+    const std::string few = few_dof_text(e);
     if (!(e.mean_arcsec > UNDETERMINED_RATIO * sigma_arcsec) || !(sigma_arcsec > 0))
-        return "";
+        return few;
     char b[600];
     std::snprintf(b, sizeof b,
                   "the stars do not determine this model between them: its predicted error over "
@@ -219,7 +270,7 @@ std::string undetermined_warning(const ErrorMap &e, double sigma_arcsec)
                   "stars where the error is largest (pmfit plan RUN)",
                   e.elevation ? "elevation" : "declination", e.limit_deg, e.mean_arcsec,
                   e.mean_arcsec / sigma_arcsec, sigma_arcsec);
-    return b;
+    return few.empty() ? std::string(b) : std::string(b) + "; and " + few;
 }
 
 std::string error_map_json(const ErrorMap &e, double sigma_arcsec)
@@ -228,10 +279,12 @@ std::string error_map_json(const ErrorMap &e, double sigma_arcsec)
     std::snprintf(b, sizeof b,
                   "\"error_map\": {\"limit\": \"%s\", \"limit_deg\": %.6g, \"rms_arcsec\": %.6g, "
                   "\"max_arcsec\": %.6g, \"max_at_deg\": [%.6g, %.6g], \"at_points_arcsec\": %.6g, "
-                  "\"undetermined\": %s}",
+                  "\"undetermined\": %s, \"sigma_dof\": %ld, \"sigma_factor_95\": [%.4g, %.4g]}",
                   e.elevation ? "elevation" : "declination", e.limit_deg, e.mean_arcsec,
                   e.max_arcsec, e.max_x_deg, e.max_y_deg, e.at_points_arcsec,
-                  undetermined_warning(e, sigma_arcsec).empty() ? "false" : "true");
+                  e.mean_arcsec > UNDETERMINED_RATIO * sigma_arcsec && sigma_arcsec > 0 ? "true"
+                                                                                      : "false",
+                  e.dof, sigma_factor_95(e.dof).first, sigma_factor_95(e.dof).second);
     return b;
 }
 

@@ -21,6 +21,7 @@ struct ErrorMap {
     double mean_arcsec = 0, max_arcsec = 0; // over the usable sky, per axis
     double max_x_deg = 0, max_y_deg = 0;    // where the maximum is (HA, Dec or az, el)
     double at_points_arcsec = 0;  // RMS at the run's own points
+    long dof = 0;                 // 2N - P of the fit: what its sigma, and the map, rest on
     std::vector<pmplot::Cell> cells;             // the map (x, y in degrees)
     std::vector<std::pair<double, double>> marks; // the run's points, same axes
 };
@@ -47,8 +48,18 @@ std::string error_map_json(const ErrorMap &e, double sigma_arcsec);
 // runs of ../shared/data and the examples at orders 0-2 reach 1.05; the
 // first 12-80 stars of a run, with order 1-2: 4-20,000.)  "" or the warning
 // (one sentence, no leading spaces).
+//
+// And a sigma that rests on few degrees of freedom: the map is sigma times
+// the covariance's shape, and with 2N - P = k the true sigma is within
+// sigma_factor_95's factors of it (chi^2 with k degrees of freedom, 95%);
+// where the upper factor is above 2 (k <= 7) the warning says so too (an
+// outside probe's 5 stars for 9 terms: sigma 0.154" for 1" of noise, the
+// map 0.283" where the model was 1.53" off, and no word).
 const double UNDETERMINED_RATIO = 3;
 std::string undetermined_warning(const ErrorMap &e, double sigma_arcsec);
+// The factors (lo, hi) within which the true sigma is, 95%, of one
+// estimated on dof degrees of freedom; (1, 1) for dof <= 0.
+std::pair<double, double> sigma_factor_95(long dof);
 // The sky plot (an SVG file); throws with the reason on failure.
 void error_map_plot(const std::string &path, const Run &run, const ErrorMap &e,
                     const std::string &title);
