@@ -35,6 +35,9 @@ struct Comparison {
     // OLD a run: the old fit's predicted error (pm_fit_pointing_sigma) at
     // the new run's points and at its own; NaN for a model file
     double old_pred_new = NAN, old_pred_old = NAN;
+    // OLD a run: its fit's sigma (arcsec), and log10 of the chance that
+    // tonight's refit leaves so much more by chance (F-test); NaN else
+    double old_sigma = NAN, sigma_log10p = NAN;
     // The joint test of the changes (NaN where not made): log10 of the
     // chance of so large a change of all terms together, and of all but
     // c' and e' (what a re-zero leaves), with both fits' errors
