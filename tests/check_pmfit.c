@@ -945,6 +945,50 @@ START_TEST(test_pmfit_few_dof_warning)
 }
 END_TEST
 
+/* Where a pier-side offset is: between the sides, not the bin where the
+** refit moved the model most (outside probe Z1's generator: a west-side
+** offset on 80 stars was "largest at hour angle 6h..12h", 3 stars of the
+** normal side). */
+START_TEST(test_pmfit_explain_pier_side_where)
+{
+    char path[300];
+    snprintf(path, sizeof path, "%s/tests/data/gem_pier_side_west.dat",
+             getenv("PM_TOP") ? getenv("PM_TOP") : ".");
+    ck_assert_msg(run("%s explain %s%s", path, "") == 0, "%.2000s", out);
+    ck_assert_msg(strstr(out, "1. pier_side:") != NULL &&
+                      strstr(out, "where: between the pier sides: the 36 points beyond the pole "
+                                  "(pier west) against the 44 of the normal side") != NULL &&
+                      strstr(out, "where: largest at hour angle 6h..12h") == NULL,
+                  "%.3000s", out);
+}
+END_TEST
+
+/* A cable's drag that grows as the wrap winds (66.7" a turn of the
+** count, over -270..270 deg) against a step past count 0 (25"), outside
+** probe Z2's generator (tests/ref/altaz_gen_z2.py): the drag is named
+** cable_drag at its size, the step cable_wrap (a drag had been named a
+** step "on the next turn", with false gears beside it). */
+START_TEST(test_pmfit_explain_cable_drag)
+{
+    char path[300];
+    double v = 0, e = 1;
+    snprintf(path, sizeof path, "%s/tests/data/altaz_cable_drag.dat",
+             getenv("PM_TOP") ? getenv("PM_TOP") : ".");
+    ck_assert_msg(run("%s explain %s --json%s", path, "") == 0, "%.2000s", out);
+    ck_assert_msg(strstr(out, "\"findings\": [{\"effect\": \"cable_drag\"") != NULL, "%.3000s",
+                  out);
+    ck_assert_msg(json_coef("\"effect\": \"cable_drag\"", "\"column\": \"az_wind\"", &v, &e),
+                  "%.2000s", out);
+    ck_assert_msg(fabs(v + 66.67) < 3 * e && e < 4, "drag %.2f +- %.2f a turn (-66.7)", v, e);
+    snprintf(path, sizeof path, "%s/tests/data/altaz_cable_step.dat",
+             getenv("PM_TOP") ? getenv("PM_TOP") : ".");
+    ck_assert_msg(run("%s explain %s --json%s", path, "") == 0, "%.2000s", out);
+    ck_assert_msg(strstr(out, "\"findings\": [{\"effect\": \"cable_wrap\"") != NULL &&
+                      strstr(out, "\"effect\": \"cable_drag\"") == NULL,
+                  "%.3000s", out);
+}
+END_TEST
+
 /* The weather of the refraction from the command line (--pressure,
 ** --temperature, --humidity, --wavelength), for files that lack it (an
 ** RTS2 gpoint file never has it): the CSV log's weather given as options
@@ -1699,6 +1743,8 @@ static Suite *suite(void)
     tcase_add_test(tc, test_pmfit_explain_cable_wrap);
     tcase_add_test(tc, test_pmfit_explain_azimuth_count_reading);
     tcase_add_test(tc, test_pmfit_weather_options);
+    tcase_add_test(tc, test_pmfit_explain_cable_drag);
+    tcase_add_test(tc, test_pmfit_explain_pier_side_where);
     tcase_add_test(tc, test_pmfit_few_dof_warning);
     tcase_add_test(tc, test_pmfit_explain_period_aliases);
     tcase_add_test(tc, test_pmfit_explain_baseline_advice);

@@ -1893,6 +1893,9 @@ int run_main(int argc, char **argv)
                                 : std::string(info.input[j]) == "az_turn" && run.turn_derived
                                     ? " (the turn of the file's azimuth count past 360 deg "
                                       "multiples, less the run's least: 0, 1 or 2, derived)"
+                                : std::string(info.input[j]) == "az_wind" && run.wind_derived
+                                    ? " (the file's azimuth count in turns, count / 360 deg, "
+                                      "derived)"
                                     : "");
         // a write that fails now still lets the report below be printed
         if (!o.save.empty() &&

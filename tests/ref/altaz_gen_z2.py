@@ -11,8 +11,8 @@ tool reads about -6" (a sag toward the horizon is negative).
     /usr/bin/python3 tests/ref/altaz_gen_z2.py
 
 writes tests/data/altaz_lowband_sag.dat (seed 3338: 40 stars at elevations
-10-35 deg, noise 15", no effect beyond the base terms), which
-tests/check_pmfit.c reads.  Before stop 45 explain read "tube flexure held by
+10-35 deg, noise 15", no effect beyond the base terms), altaz_cable_drag.dat
+and altaz_cable_step.dat (below), which tests/check_pmfit.c reads.  Before stop 45 explain read "tube flexure held by
 the order-1 terms: 3026.37\" +- 85.55\"" from it."""
 import numpy as np
 
@@ -131,3 +131,7 @@ if __name__ == '__main__':
     import os
     top = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'data')
     write(os.path.join(top, 'altaz_lowband_sag.dat'), make(3338, 40, 'low', 15.0))
+    # a cable's drag of 50" * count / 270 deg (66.7" a turn) and a 25" step
+    # past count 0, 80 stars, 5" noise (tests/check_pmfit.c)
+    write(os.path.join(top, 'altaz_cable_drag.dat'), make(4242, 80, 'full', 5.0, effect='drag', amp=50.0))
+    write(os.path.join(top, 'altaz_cable_step.dat'), make(4243, 80, 'full', 5.0, effect='step', amp=25.0))

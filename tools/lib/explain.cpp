@@ -921,11 +921,16 @@ void physical_candidates(const Run &run, const State &st, std::vector<Candidate>
         h.push_back("aux:" + dir2 + ":e'");
     if (!h.empty())
         add_candidate(cands, st, "hysteresis", h);
-    // an alt-az cable wrap's second turn (the derived "az_turn")
-    for (size_t j = 0; j < run.aux_names.size() && j < (size_t)PM_MAX_AUX; j++)
+    // an alt-az cable wrap's second turn (the derived "az_turn"), and the
+    // cables' drag as the wrap winds ("az_wind")
+    for (size_t j = 0; j < run.aux_names.size() && j < (size_t)PM_MAX_AUX; j++) {
         if (run.turn_derived && run.aux_names[j] == "az_turn" &&
             column_unusable(run, st.use, j).empty())
             add_candidate(cands, st, "cable_wrap", {"aux:az_turn"});
+        if (run.wind_derived && run.aux_names[j] == "az_wind" &&
+            column_unusable(run, st.use, j).empty())
+            add_candidate(cands, st, "cable_drag", {"aux:az_wind"});
+    }
     // the run's own columns (a tube temperature, a focus position, TPOINT's
     // auxiliary readings): each a cause the run recorded, on c' and e' as
     // `--add aux:NAME` fits it.  Not the axes' own positions (gpoint's axis
@@ -936,6 +941,7 @@ void physical_candidates(const Run &run, const State &st, std::vector<Candidate>
         static const char *const position[] = {"axra", "axdec", "axaz", "axalt",
                                                "angularPosRA", "angularPosDEC"};
         if (name == dir2 || (name == "az_turn" && run.turn_derived) ||
+            (name == "az_wind" && run.wind_derived) ||
             std::any_of(std::begin(position), std::end(position),
                         [&](const char *p) { return name == p; }) ||
             !column_unusable(run, st.use, j).empty())
@@ -1506,6 +1512,19 @@ void record(const Run &run, State &st, const Candidate &c, const std::vector<Can
         fd.cv_rms_after_arcsec = arcsec(c.cv);
         fd.n_params_after = c.fit.P;
         fd.where = out ? "individual points (see lines)" : where_largest(run, st.use, d, "\"");
+        if (fd.effect == "pier_side") {
+            // the refit shares the side's offset among the common terms, so
+            // the model's change is about as large everywhere and its
+            // largest bin says little (an outside probe's: "hour angle
+            // 6h..12h", 3 stars of the normal side); the effect is the
+            // sides' difference
+            long w = 0;
+            for (int i : st.use)
+                w += run.obs[i].pier < 0;
+            fd.where = fmt("between the pier sides: the %ld points beyond the pole (pier west) "
+                           "against the %ld of the normal side",
+                           w, (long)st.use.size() - w);
+        }
         fd.alternatives = alts;
         ex.findings.push_back(fd);
     }

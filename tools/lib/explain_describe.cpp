@@ -97,6 +97,12 @@ std::map<std::string, Bin> bin_means(const Run &run, const std::vector<int> &use
     return bins;
 }
 
+// The fewest points a bin needs to be named: 3, and a tenth of the run (an
+// outside probe's pier-side offset on 80 stars was "largest at hour angle
+// 6h..12h", a bin of 3 stars under the pole on the normal side, where the
+// refit's other terms moved most; 32 of the stars were west)
+long min_bin(const std::vector<int> &use) { return std::max(3L, (long)use.size() / 10); }
+
 } // namespace
 
 std::string largest_bin(const Run &run, const std::vector<int> &use, const std::vector<double> &v)
@@ -104,7 +110,7 @@ std::string largest_bin(const Run &run, const std::vector<int> &use, const std::
     std::string best;
     double bv = -1;
     for (const auto &b : bin_means(run, use, v))
-        if (b.second.n >= 3 && b.second.sum / b.second.n > bv) {
+        if (b.second.n >= min_bin(use) && b.second.sum / b.second.n > bv) {
             bv = b.second.sum / b.second.n;
             best = b.first;
         }
@@ -120,7 +126,7 @@ std::string where_largest(const Run &run, const std::vector<int> &use,
         all += x;
     all /= v.empty() ? 1 : (double)v.size();
     for (const auto &b : bin_means(run, use, v)) {
-        if (b.second.n < 3)
+        if (b.second.n < min_bin(use))
             continue;
         double m = b.second.sum / b.second.n;
         if (m > bv) {
@@ -390,8 +396,12 @@ const char *family_words(const Run &run, const std::string &e, double sign)
                "encoders or a clock error";
     if (e == "cable_wrap")
         return "the pointing differs on the cable wrap's next turn (the file's azimuth count "
-               "past the next multiple of 360 deg): the cables' drag, or an offset that depends "
-               "on the wrap, on the azimuth and elevation index (arcsec on the next turn)";
+               "past the next multiple of 360 deg): an offset that depends on the wrap, on the "
+               "azimuth and elevation index (arcsec on the next turn)";
+    if (e == "cable_drag")
+        return "the pointing changes as the cable wrap winds (in proportion to the file's "
+               "azimuth count): the cables' drag, on the azimuth and elevation index (arcsec "
+               "per turn of the wrap)";
     if (e.rfind("aux:", 0) == 0)
         return az ? "the pointing follows the run's own column (arcsec per unit of it, about its "
                     "mean), on the azimuth and elevation index: a cause the run recorded (a "

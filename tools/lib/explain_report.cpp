@@ -136,7 +136,7 @@ std::vector<std::pair<std::string, std::string>> not_tried_why(const Run &run)
     for (size_t j = 0; j < run.aux_names.size(); j++) {
         const std::string &name = run.aux_names[j];
         if ((name == axis2_dir_name(run.mount) && run.dec_dir_derived) ||
-            (name == "az_turn" && run.turn_derived))
+            (name == "az_turn" && run.turn_derived) || (name == "az_wind" && run.wind_derived))
             continue;
         const std::string why = j >= (size_t)PM_MAX_AUX
                                     ? "beyond the first " + std::to_string(PM_MAX_AUX) +

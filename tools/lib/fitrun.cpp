@@ -413,6 +413,21 @@ void derive_directions(Run &r, bool az_count)
         add_derived_input(r, "az_turn", v);
         r.turn_derived = true;
     }
+    // And how far the wrap is wound, "az_wind": the count in turns (count /
+    // 360 deg, zero at the count's zero, the middle of a -270..270 wrap), for
+    // a drag that grows with the wind, a line and not a step at a turn (an
+    // outside probe's drag of 100" over -270..270 deg was named a step "on
+    // the next turn", sigma 12.9" left for 10" of noise, a false gear beside
+    // it in another run).  Where az_turn is, and a slot is free.
+    if (r.turn_derived &&
+        std::find(r.aux_names.begin(), r.aux_names.end(), "az_wind") == r.aux_names.end() &&
+        (int)r.aux_names.size() < PM_MAX_AUX) {
+        std::vector<double> v;
+        for (const Obs &ob : r.obs)
+            v.push_back(ob.raw1 / (2 * PI));
+        add_derived_input(r, "az_wind", v);
+        r.wind_derived = true;
+    }
 }
 
 // The run with its slew directions read from the azimuth as the mount's
@@ -1030,8 +1045,9 @@ Run run_for_model(const Run &run, const pm_model &m, const std::vector<std::stri
             c += (c.empty() ? "" : ", ") + n +
                  (n == axis2_dir_name(run.mount) && run.dec_dir_derived
                       ? " (derived from the sequence)"
-                  : n == "az_turn" && run.turn_derived ? " (derived from the azimuth count)"
-                                                       : "");
+                  : (n == "az_turn" && run.turn_derived) || (n == "az_wind" && run.wind_derived)
+                      ? " (derived from the azimuth count)"
+                      : "");
         return c.empty() ? std::string("none") : c;
     };
     for (size_t j = 0; j < (size_t)PM_MAX_AUX; j++) {

@@ -53,6 +53,7 @@ struct Run {
     bool dir_derived = false;       // slew directions from the sequence
     bool dec_dir_derived = false;   // the input "dec_dir" too (derive_directions)
     bool turn_derived = false;      // the input "az_turn" (derive_directions)
+    bool wind_derived = false;      // the input "az_wind" (derive_directions)
     bool az_count = false;          // axis 1 read as the mount's count (load_run)
     // the reading options a command that refits the run repeats
     // (" --equinox J2000 --no-refraction ..."; explain's closing command)
