@@ -97,12 +97,6 @@ std::map<std::string, Bin> bin_means(const Run &run, const std::vector<int> &use
     return bins;
 }
 
-// The fewest points a bin needs to be named: 3, and a tenth of the run (an
-// outside probe's pier-side offset on 80 stars was "largest at hour angle
-// 6h..12h", a bin of 3 stars under the pole on the normal side, where the
-// refit's other terms moved most; 32 of the stars were west)
-long min_bin(const std::vector<int> &use) { return std::max(3L, (long)use.size() / 10); }
-
 } // namespace
 
 std::string largest_bin(const Run &run, const std::vector<int> &use, const std::vector<double> &v)
@@ -110,7 +104,7 @@ std::string largest_bin(const Run &run, const std::vector<int> &use, const std::
     std::string best;
     double bv = -1;
     for (const auto &b : bin_means(run, use, v))
-        if (b.second.n >= min_bin(use) && b.second.sum / b.second.n > bv) {
+        if (b.second.n >= 3 && b.second.sum / b.second.n > bv) {
             bv = b.second.sum / b.second.n;
             best = b.first;
         }
@@ -126,7 +120,7 @@ std::string where_largest(const Run &run, const std::vector<int> &use,
         all += x;
     all /= v.empty() ? 1 : (double)v.size();
     for (const auto &b : bin_means(run, use, v)) {
-        if (b.second.n < min_bin(use))
+        if (b.second.n < 3)
             continue;
         double m = b.second.sum / b.second.n;
         if (m > bv) {
