@@ -380,6 +380,21 @@ START_TEST(test_pmfit_explain_few_points_order0)
     v = tu_json_num(strstr(out, "\"label\": \"az_periodic\""), "amplitude_arcsec");
     e = tu_json_num(strstr(out, "\"label\": \"az_periodic\""), "amplitude_error_arcsec");
     ck_assert_msg(fabs(v - 20) < 3 * e, "runout %.2f +- %.2f (20 injected)", v, e);
+    /* the report page's explain section the same (its fit stays order 1) */
+    {
+        char page[400];
+        char *html;
+        snprintf(page, sizeof page, "%s/az20.html", tmpdir);
+        snprintf(cmd, sizeof cmd, "%s report %s -o %s -q", tu_pmfit_path(), runp, page);
+        ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
+        html = tu_slurp(page);
+        ck_assert_ptr_nonnull(html);
+        ck_assert_msg(strstr(html, "20 points do not determine the order-1 baseline&apos;s 22 "
+                                   "terms, and order 0 predicts them better") != NULL &&
+                          strstr(html, "The baseline (order 0, P = 6)") != NULL,
+                      "%.3000s", strstr(html, "What the model left out") ? strstr(html, "What the model left out") : html);
+        free(html);
+    }
     snprintf(cmd, sizeof cmd, "%s explain %s --order 1", tu_pmfit_path(), runp);
     ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
     ck_assert_msg(strstr(out, "order 0 alone predicts better than the order-1 baseline") != NULL,

@@ -408,6 +408,7 @@ Options parse_report(Options o, int argc, char **argv)
         auto need = [&](const char *what) { return g.need(what); };
         if (a == "--order") {
             const char *v = need("an order");
+            o.order_given = true;
             if (!parse_int(v, &o.order) || o.order < 0 || o.order > PM_MAX_L)
                 die(std::string("--order: expected an integer 0..") + std::to_string(PM_MAX_L) +
                     ", got '" + v + "'");
@@ -1643,6 +1644,7 @@ int cmd_report(const Options &o, const Run &run_in, int argc, char **argv)
     }
     ReportOptions ro;
     ro.order = o.order;
+    ro.order_given = o.order_given;
     ro.adds = o.adds;
     ro.alpha = o.alpha;
     ro.gears_ha = o.gears_ha;

@@ -160,6 +160,7 @@ struct Data {
     FitOut fit;
     ErrorMap emap;
     Explanation ex;
+    std::string explain_note; // explained at order 0 instead, and why (stage_explain)
     Plan plan;
     PlanOptions plan_opt;
     std::string plan_error;
@@ -253,6 +254,12 @@ void stage_explain(Data &d)
     eo.gears_ha = d.o.gears_ha;
     eo.gears_dec = d.o.gears_dec;
     d.ex = d.o.explained ? *d.o.explained : explain(d.run, eo);
+    // as pmfit explain without --order (explain.hpp, order0_instead)
+    d.explain_note = d.o.order_given ? "" : order0_instead(d.run, d.ex, eo);
+    if (!d.explain_note.empty()) {
+        eo.order = 0;
+        d.ex = explain(d.run, eo);
+    }
 }
 
 // The next targets for the page's model, the run's sigma as the noise.
@@ -701,7 +708,10 @@ void section_explain(Page &p, const Data &d)
 {
     const Explanation &ex = d.ex;
     section(p, "explain", "What the model left out (pmfit explain)");
-    para(p, fmt("The baseline (order %d%s, P = %d) leaves &sigma; = %s, cross-validated RMS %s; ", d.o.order,
+    if (!d.explain_note.empty())
+        para(p, h(d.explain_note) + ".");
+    para(p, fmt("The baseline (order %d%s, P = %d) leaves &sigma; = %s, cross-validated RMS %s; ",
+                d.explain_note.empty() ? d.o.order : 0,
                 d.o.adds.empty() ? "" : " with the added terms", ex.base_n_params,
                 arcsec_text(ex.base_sigma_arcsec).c_str(), arcsec_text(ex.base_cv_rms_arcsec).c_str()) +
                 (ex.findings.empty()

@@ -34,6 +34,9 @@ struct ReportOptions {
     // the run's explanation with these options, where the caller has made
     // it already (pmfit's check of the azimuth reading); NULL: made here
     const Explanation *explained = nullptr;
+    // false: the order was left to the page (pmfit report without --order),
+    // and explain's section takes order 0 where order0_instead says so
+    bool order_given = true;
 };
 
 // Progress: the stage starting ("fit", "explain", ...) and the fraction of the
