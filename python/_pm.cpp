@@ -1036,12 +1036,9 @@ std::string explain_run(const RunData &d, int order, std::vector<std::string> ad
     Explanation ex;
     std::string note;
     try {
-        ex = explain(d.run, eo);
-        note = chosen ? "" : order0_instead(d.run, ex, eo);
-        if (!note.empty()) {
-            eo.order = order = 0;
-            ex = explain(d.run, eo);
-        }
+        ex = chosen ? explain(d.run, eo) : explain_default(d.run, eo, &note);
+        if (!note.empty())
+            order = 0;
     } catch (const std::runtime_error &e) {
         std::string w = e.what();
         fail(w.rfind("--add", 0) == 0 ? K_ARGUMENT : K_ERROR, w);

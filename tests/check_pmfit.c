@@ -371,7 +371,7 @@ START_TEST(test_pmfit_explain_few_points_order0)
              "> /dev/null && %s explain %s --json",
              tu_pmfit_path(), runp, tu_pmfit_path(), runp);
     ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
-    ck_assert_msg(strstr(out, "\"order_note\": \"20 points do not determine the order-1 "
+    ck_assert_msg(strstr(out, "\"order_note\": \"20 points are too few to pin down the order-1 "
                               "baseline's 22 terms, and order 0 predicts them better") != NULL,
                   "%.3000s", out);
     ck_assert_msg(strstr(out, "\"effect\": \"ha_periodic\", \"label\": \"az_periodic\", "
@@ -389,7 +389,7 @@ START_TEST(test_pmfit_explain_few_points_order0)
         ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
         html = tu_slurp(page);
         ck_assert_ptr_nonnull(html);
-        ck_assert_msg(strstr(html, "20 points do not determine the order-1 baseline&apos;s 22 "
+        ck_assert_msg(strstr(html, "20 points are too few to pin down the order-1 baseline&apos;s 22 "
                                    "terms, and order 0 predicts them better") != NULL &&
                           strstr(html, "The baseline (order 0, P = 6)") != NULL,
                       "%.3000s", strstr(html, "What the model left out") ? strstr(html, "What the model left out") : html);
@@ -401,6 +401,26 @@ START_TEST(test_pmfit_explain_few_points_order0)
                   "%s", out);
     ck_assert_msg(strstr(out, "explain with --order 0") != NULL, "%s", out);
     ck_assert_msg(strstr(out, "are that one term") == NULL, "%s", out);
+    /* 8 points, too few for order 1 at all (it was refused) and 12, where
+    ** order 1 cannot predict most points from the others (a probe's 12
+    ** stayed at order 1 on the cross-validation of the few it could) */
+    ck_assert_int_eq(run("%s simulate %s --n 8 --seed 3 > /dev/null%s", runp, ""), 0);
+    snprintf(cmd, sizeof cmd, "%s explain %s; %s explain %s --order 1", tu_pmfit_path(), runp,
+             tu_pmfit_path(), runp);
+    ck_assert_int_ne(tu_capture(cmd, out, sizeof out), 0);
+    ck_assert_msg(strstr(out, "8 points are too few for the order-1 baseline's 22 terms (they "
+                              "need 12): explained at order 0") != NULL &&
+                      strstr(out, "baseline: order 0, P = 6") != NULL &&
+                      strstr(out, "P = 22 terms need at least 12") != NULL,
+                  "%s", out);
+    snprintf(cmd, sizeof cmd,
+             "%s simulate %s --mount altaz --n 12 --seed 1 > /dev/null && %s explain %s",
+             tu_pmfit_path(), runp, tu_pmfit_path(), runp);
+    ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
+    ck_assert_msg(strstr(out, "12 points are too few to pin down the order-1 baseline's 22 terms") !=
+                          NULL &&
+                      strstr(out, "baseline: order 0, P = 6") != NULL,
+                  "%s", out);
     snprintf(cmd, sizeof cmd, "%s explain %s/examples/sim_gem.dat", tu_pmfit_path(),
              top ? top : ".");
     ck_assert_msg(tu_capture(cmd, out, sizeof out) == 0, "%s", out);
@@ -1378,7 +1398,8 @@ START_TEST(test_pmfit_explain_no_composition_undetermined)
     ck_assert_int_eq((int)tu_json_num(out, "n_obs"), 13);
     ck_assert_msg(strstr(out, "\"undetermined\": true") != NULL, "%s", out);
     fit_sigma = tu_json_num(out, "sigma_arcsec");
-    ck_assert_msg(run("%s explain %s --json%s", few, "") == 0, "%s", out);
+    /* (--order 1: without it 13 points for 22 terms are explained at order 0) */
+    ck_assert_msg(run("%s explain %s --order 1 --json%s", few, "") == 0, "%s", out);
     ck_assert_double_eq_tol(tu_json_num(out, "composition_rms_arcsec"), 0.0, 1e-12);
     ck_assert_double_eq_tol(tu_json_num(out, "sigma_arcsec"), fit_sigma, 1e-4);
 }

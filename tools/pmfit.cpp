@@ -1424,19 +1424,20 @@ int cmd_explain(const Options &o, const Run &full_in)
                 clean.obs.push_back(full.obs[rf.use[j]]);
     }
     const Run &run = o.robust ? clean : full;
-    Explanation ex = pre && !o.robust ? *pre : explain(run, eo);
-    // Fewer points than the default baseline's terms, which order 0
-    // predicts better: explained at order 0 (an outside probe's 15 stars
-    // had "nothing significant is left out" at order 1, sigma 21" for 3" of
-    // noise, where order 0 found its two 18-sigma outliers)
-    int order = o.order;
-    const std::string order_note = o.order_given ? "" : order0_instead(run, ex, eo);
-    if (!order_note.empty()) {
-        order = 0;
-        eo.order = 0;
-        ex = explain(run, eo);
-        std::fprintf(stderr, "pmfit: note: %s: %s\n", run.path.c_str(), order_note.c_str());
+    // Without --order: order 0 where the run is too few points for order 1
+    // (explain.hpp, explain_default)
+    std::string order_note;
+    Explanation ex;
+    try {
+        const Explanation *first = pre && !o.robust ? &*pre : nullptr;
+        ex = o.order_given ? (first ? *first : explain(run, eo))
+                           : explain_default(run, eo, &order_note, first);
+    } catch (const std::exception &x) {
+        die(x.what(), 1);
     }
+    const int order = order_note.empty() ? o.order : 0;
+    if (!order_note.empty())
+        std::fprintf(stderr, "pmfit: note: %s: %s\n", run.path.c_str(), order_note.c_str());
     if (o.json) {
         std::printf("{\"n_obs\": %zu%s, \"order_note\": %s, %s}\n", run.obs.size(),
                     o.robust ? (", " + robust_json(rf, full.obs)).c_str() : "",

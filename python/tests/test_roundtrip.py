@@ -295,7 +295,8 @@ def test_explain_default_order_matches_pmfit(tmp_path):
     got = pm.explain(run)
     assert got == json.loads(run_cmd(PMFIT, "explain", run, "--json").stdout)
     assert got["baseline"]["order"] == 0
-    assert got["order_note"].startswith("20 points do not determine the order-1 baseline's 22 terms")
+    assert got["order_note"].startswith("20 points are too few to pin down the order-1 baseline's "
+                                        "22 terms")
     one = pm.explain(run, order=1)
     assert one == json.loads(run_cmd(PMFIT, "explain", run, "--json", "--order", "1").stdout)
     assert one["baseline"]["order"] == 1 and one["order_note"] is None

@@ -138,6 +138,7 @@ struct Explanation {
     // fewer points than the order-1 baseline has terms (N < P; its own
     // options order 1, no --add): order 0's cross-validated RMS, else NaN
     double order0_cv_rms_arcsec = std::numeric_limits<double>::quiet_NaN();
+    std::string order0_with; // the physical term that order 0 did so with ("" for none)
     std::string folded_pier;             // folded_pier_hint (fitrun.hpp): sides not in the file
     FitOut baseline, final;              // the two fits (residuals for plots)
     std::vector<int> kept;               // observations used by the final fit
@@ -171,6 +172,12 @@ Explanation explain(const Run &run, const ExplainOptions &opt);
 // explained at order 0 -- fewer points than the baseline's terms, which
 // order 0 predicts better (Explanation::order0_cv_rms_arcsec) -- else "".
 std::string order0_instead(const Run &run, const Explanation &ex, const ExplainOptions &opt);
+// The explanation where the caller left the order (opt.order 1, no adds;
+// else explain(run, opt) as asked): at order 1, or at order 0 where the run
+// is too few points for order 1 or order0_instead says so, *note then saying
+// why ("" else).  first: the order-1 explanation where made already.
+Explanation explain_default(const Run &run, const ExplainOptions &opt, std::string *note,
+                            const Explanation *first = nullptr);
 
 // The physical reading of a fitted model (stage "interpret"): polar axis,
 // non-perpendicularity, collimation, indices, the tube-flexure-like part of

@@ -253,13 +253,11 @@ void stage_explain(Data &d)
     eo.alpha = d.o.alpha;
     eo.gears_ha = d.o.gears_ha;
     eo.gears_dec = d.o.gears_dec;
-    d.ex = d.o.explained ? *d.o.explained : explain(d.run, eo);
-    // as pmfit explain without --order (explain.hpp, order0_instead)
-    d.explain_note = d.o.order_given ? "" : order0_instead(d.run, d.ex, eo);
-    if (!d.explain_note.empty()) {
-        eo.order = 0;
-        d.ex = explain(d.run, eo);
-    }
+    // as pmfit explain without --order (explain.hpp, explain_default)
+    if (d.o.order_given)
+        d.ex = d.o.explained ? *d.o.explained : explain(d.run, eo);
+    else
+        d.ex = explain_default(d.run, eo, &d.explain_note, d.o.explained);
 }
 
 // The next targets for the page's model, the run's sigma as the noise.
