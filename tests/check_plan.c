@@ -677,6 +677,42 @@ START_TEST(test_plan_slew)
     }
     printf("check_plan: 15 targets: slews of %.0f deg in all, with --slew %.0f deg\n", da, dw);
     ck_assert(dw < 0.5 * da);
+    /* While the points do not determine the model the quickest of the
+    ** nearly best is taken, not the best per second: an order-2 plan of 40
+    ** (an outside probe's) had stayed on one side of the meridian, 2,000"
+    ** off, and order 1 printed "predicted 0.000"" from the 19th target on
+    ** (the criterion updated step by step had drifted below 0) */
+    {
+        static pmplan_target ps[40], pn[40];
+        pmplan_options o;
+        char err[512];
+        double b, es, en;
+        int k, east = 0, west = 0;
+        pmplan_options_default(&o);
+        o.order = 2;
+        ck_assert_msg(pmplan_next(NULL, &o, 40, pn, &b, err, sizeof err) == 40, "%s", err);
+        o.slew_rate_deg_s = 2;
+        ck_assert_msg(pmplan_next(NULL, &o, 40, ps, &b, err, sizeof err) == 40, "%s", err);
+        for (k = 0; k < 40; k++) {
+            ck_assert_msg(isnan(ps[k].after_arcsec) || ps[k].after_arcsec > 0.1, "target %d: %g", k,
+                          ps[k].after_arcsec);
+            east += ps[k].x_deg < -15;
+            west += ps[k].x_deg > 15;
+        }
+        o.slew_rate_deg_s = 0;
+        es = predicted(&o, ps, 40);
+        en = predicted(&o, pn, 40);
+        printf("check_plan: order 2, 40 targets: predicted %.3f\" with --slew 2, %.3f\" without; "
+               "%d east and %d west of the meridian\n", es, en, east, west);
+        ck_assert(es < 2 * en);
+        ck_assert(east >= 8 && west >= 8);
+        o.order = 1;
+        o.slew_rate_deg_s = 2;
+        ck_assert_msg(pmplan_next(NULL, &o, 25, ps, &b, err, sizeof err) == 25, "%s", err);
+        for (k = 0; k < 25; k++)
+            ck_assert_msg(isnan(ps[k].after_arcsec) || ps[k].after_arcsec > 0.1, "order 1, target %d: %g",
+                          k, ps[k].after_arcsec);
+    }
 }
 END_TEST
 

@@ -59,17 +59,19 @@ Fit fit_model(const Run &run, const std::vector<int> &use, pm_model m, const pm_
     if (!warm) {
         r.f = do_fit(run.obs, use, m, FIT_MAX_PASSES);
     } else {
+        const pm_model cold = m;
         r.f = do_fit(run.obs, use, m, COLD_MAX_PASSES);
         if (r.f.status == PM_ERR_DIVERGED) {
             warm_start(m, *warm);
             r.f = do_fit(run.obs, use, m, WARM_MAX_PASSES);
         }
         // a model of up to 50 terms (order 2 and a few) gets pmfit fit's
-        // passes: an alt-az run's order-2 candidate creeps (an outside
-        // probe's 80-star runs: 181 passes, "not judged" in 34 of 68 where
-        // pmfit fit --order 2 converges); more terms cost too much a step
+        // passes from the cold start, as pmfit fit: an alt-az run's order-2
+        // candidate creeps (an outside probe's 80-star runs: 181 passes,
+        // "not judged" in 34 of 68 where pmfit fit --order 2 converges; from
+        // the warm start 2,000 did not); more terms cost too much a step
         if (r.f.status == PM_ERR_DIVERGED && m.n_terms <= 50)
-            r.f = do_fit(run.obs, use, m, FIT_MAX_PASSES);
+            r.f = do_fit(run.obs, use, cold, FIT_MAX_PASSES);
     }
     if (r.f.status != PM_OK)
         return r;
