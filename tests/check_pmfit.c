@@ -1077,9 +1077,15 @@ START_TEST(test_pmfit_weather_options)
     ck_assert_msg(strstr(out, "--pressure: expected a number in") != NULL, "%.2000s", out);
     ck_assert_int_ne(run("%s fit %s --temperature warm%s", bare, ""), 0);
     ck_assert_msg(strstr(out, "--temperature: expected a number") != NULL, "%.2000s", out);
-    ck_assert_msg(run("%s fit %s --order 0 --humidity 50%s", bare, "") == 0, "%.2000s", out);
-    ck_assert_msg(strstr(out, "humidity 50 (given as an option) taken as percent: 0.5") != NULL,
+    /* unit slips refused (inches of mercury, percent), as an outside probe's
+    ** 29.9 and 1.5 had been read as hPa and as 1.5% */
+    ck_assert_int_ne(run("%s fit %s --pressure 29.9%s", bare, ""), 0);
+    ck_assert_msg(strstr(out, "(in inches of mercury that is 1013 hPa)") != NULL, "%.2000s", out);
+    ck_assert_int_ne(run("%s fit %s --humidity 50%s", bare, ""), 0);
+    ck_assert_msg(strstr(out, "--humidity: expected a fraction in 0..1, got '50' (50% is 0.5)") !=
+                      NULL,
                   "%.2000s", out);
+    ck_assert_int_ne(run("%s fit %s --humidity 1.5%s", bare, ""), 0);
     ck_assert_int_ne(run("%s simulate %s/sim.dat --pressure 900%s", tmpdir, ""), 0);
     ck_assert_msg(strstr(out, "apply to reading a run") != NULL, "%.2000s", out);
     /* not used where nothing is refracted (observed places) */

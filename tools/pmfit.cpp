@@ -161,7 +161,8 @@ void usage(FILE *f)
         "                   0..360 deg: the slew direction is its change (the mount never\n"
         "                   turns through the file's seam; explain offers it where it fits\n"
         "                   far better; docs/explain.md)\n"
-        "  --pressure HPA, --temperature C, --humidity H (0..1), --wavelength UM\n"
+        "  --pressure HPA (400..1100), --temperature C (-60..50), --humidity H (0..1),\n"
+        "  --wavelength UM (0.3..25)\n"
         "                   the weather of the refraction where a reduction refracts\n"
         "                   (TPOINT equatorial, J2000 places of CSV and RTS2 files), over\n"
         "                   the file's or the defaults (an RTS2 file has none; every command\n"
@@ -386,13 +387,24 @@ bool read_option(Options &o, Args &g)
     } else if (a == "--skip-bad") {
         r.skip_bad = true;
     } else if (a == "--pressure") {
-        r.pressure_hpa = number(a, g.need("hPa (mbar)"), 1e-3, 1100);
+        // (the weather as typed: in the ranges of sites and light, so that a
+        // unit slip is refused, not reduced with; an outside probe's 29.9,
+        // inches of mercury, had been taken as hPa)
+        const char *v = g.need("hPa (mbar)");
+        const double p = std::strtod(v, nullptr);
+        if (p >= 20 && p <= 35)
+            die(std::string("--pressure: expected hPa (mbar) in 400..1100, got '") + v +
+                "' (in inches of mercury that is " + fmt("%.0f", p * 33.8639) + " hPa)");
+        r.pressure_hpa = number(a, v, 400, 1100);
     } else if (a == "--temperature") {
-        r.temp_c = number(a, g.need("degrees Celsius"), -100, 60);
+        r.temp_c = number(a, g.need("degrees Celsius"), -60, 50);
     } else if (a == "--humidity") {
-        r.humidity = number(a, g.need("a relative humidity, 0..1 (or percent)"), 0, 100);
+        const char *v = g.need("a relative humidity, 0..1");
+        if (std::strtod(v, nullptr) > 1)
+            die(std::string("--humidity: expected a fraction in 0..1, got '") + v + "' (50% is 0.5)");
+        r.humidity = number(a, v, 0, 1);
     } else if (a == "--wavelength") {
-        r.wavelength_um = number(a, g.need("micrometres"), 0.2, 30);
+        r.wavelength_um = number(a, g.need("micrometres"), 0.3, 25);
     } else {
         return false;
     }

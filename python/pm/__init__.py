@@ -649,17 +649,25 @@ class Run:
         return explain(self, **kw)
 
 
+_WEATHER_RANGE = {"pressure_hpa": (400, 1100, "hPa"), "temp_c": (-60, 50, "deg C"),
+                  "humidity": (0, 1, "(a fraction: 50% is 0.5)"),
+                  "wavelength_um": (0.3, 25, "micrometres")}
+
+
 def _weather(name, v):
-    """A weather value of read_run: NaN for None (the file's), else a finite
-    float, or ArgumentError naming the argument."""
+    """A weather value of read_run: NaN for None (the file's), else a float
+    in pmfit's range for it (--pressure 400..1100 hPa, --temperature -60..50
+    C, --humidity 0..1, --wavelength 0.3..25 um), or ArgumentError naming the
+    argument."""
     if v is None:
         return float("nan")
     try:
         x = float(v)
     except (TypeError, ValueError):
         raise ArgumentError("%s: expected a number or None, got %r" % (name, v)) from None
-    if not _isfinite(x):
-        raise ArgumentError("%s: expected a finite number or None, got %r" % (name, v))
+    lo, hi, unit = _WEATHER_RANGE[name]
+    if not (lo <= x <= hi):
+        raise ArgumentError("%s: expected %g..%g %s or None, got %r" % (name, lo, hi, unit, v))
     return x
 
 

@@ -82,12 +82,13 @@ def test_weather_options(tmp_path):
     moved = np.degrees(np.abs(wrong.app_dec - ref.app_dec)).max() * 3600
     assert 1 < moved < 60, moved
     for kw in ({"pressure_hpa": "high"}, {"temp_c": float("nan")}, {"humidity": [1]},
-               {"wavelength_um": float("inf")}):
+               {"wavelength_um": float("inf")}, {"pressure_hpa": 29.9}, {"pressure_hpa": 5000},
+               {"humidity": 50}, {"temp_c": 80}, {"wavelength_um": 0.1}):
         with pytest.raises(pm.ArgumentError):
             pm.read_run(csv, **kw)
-    with pytest.raises(pm.FormatError) as e:
-        pm.read_run(csv, pressure_hpa=5000)
-    assert "pressure 5000 hPa (given as an option) is absurd" in str(e.value)
+    with pytest.raises(pm.ArgumentError) as e:
+        pm.read_run(csv, humidity=1.5)
+    assert "humidity: expected 0..1 (a fraction: 50% is 0.5)" in str(e.value)
     rts2 = os.path.join(TOP, "tests", "data", "rts2_gpoint.dat")
     assert [w for w in pm.read_run(rts2, pressure_hpa=900).warnings if "not used" in w]
     assert not [w for w in pm.read_run(rts2).warnings if "not used" in w]
