@@ -943,7 +943,8 @@ END_TEST
 ** the 95% range of the true sigma over it, and where the range's top is
 ** above 2 (2N - P <= 7) the fit warns (an outside probe's 5 stars for 9
 ** terms: sigma 0.154" for 1" of noise, the map 0.283" where the model was
-** 1.53" off, without a word).  The ranges are scipy's:
+** 1.53" off, without a word).  The ranges are scipy's (beyond 100 degrees
+** of freedom Wilson and Hilferty's form; the series had overflowed at 2000):
 **   python3 -c "from scipy.stats import chi2; import math; k = 7;
 **               print(math.sqrt(k / chi2.ppf(0.975, k)), math.sqrt(k / chi2.ppf(0.025, k)))" */
 START_TEST(test_pmfit_few_dof_warning)
@@ -952,13 +953,14 @@ START_TEST(test_pmfit_few_dof_warning)
         int n, tf;
         long dof;
         double lo, hi;
-    } c[5] = {{4, 1, 1, 0.4461491849, 31.910159350}, {4, 0, 2, 0.5206582667, 6.2847346965},
+    } c[7] = {{4, 1, 1, 0.4461491849, 31.910159350}, {4, 0, 2, 0.5206582667, 6.2847346965},
               {7, 1, 7, 0.6611741488, 2.0352720908}, {7, 0, 8, 0.6754570344, 1.9157708829},
-              {13, 0, 20, 0.7650591375, 1.4440694900}};
+              {13, 0, 20, 0.7650591375, 1.4440694900}, {56, 0, 106, 0.8816052035, 1.1554181825},
+              {1003, 0, 2000, 0.9699502859, 1.0319851395}};
     char path[300], n[16];
     int k;
     make_tmpdir();
-    for (k = 0; k < 5; k++) {
+    for (k = 0; k < 7; k++) {
         const char *p;
         snprintf(path, sizeof path, "%s/s%d.dat", tmpdir, c[k].n);
         snprintf(n, sizeof n, "%d", c[k].n);
