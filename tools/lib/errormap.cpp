@@ -287,6 +287,7 @@ std::string undetermined_warning(const ErrorMap &e, double sigma_arcsec)
 
 std::string error_map_json(const ErrorMap &e, double sigma_arcsec)
 {
+    const std::pair<double, double> f95 = sigma_factor_95(e.dof);
     char b[400];
     std::snprintf(b, sizeof b,
                   "\"error_map\": {\"limit\": \"%s\", \"limit_deg\": %.6g, \"rms_arcsec\": %.6g, "
@@ -296,7 +297,7 @@ std::string error_map_json(const ErrorMap &e, double sigma_arcsec)
                   e.max_arcsec, e.max_x_deg, e.max_y_deg, e.at_points_arcsec,
                   e.mean_arcsec > UNDETERMINED_RATIO * sigma_arcsec && sigma_arcsec > 0 ? "true"
                                                                                       : "false",
-                  e.dof, sigma_factor_95(e.dof).first, sigma_factor_95(e.dof).second);
+                  e.dof, f95.first, f95.second);
     return b;
 }
 

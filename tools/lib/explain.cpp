@@ -59,11 +59,11 @@ Fit fit_model(const Run &run, const std::vector<int> &use, pm_model m, const pm_
     if (!warm) {
         r.f = do_fit(run.obs, use, m, FIT_MAX_PASSES);
     } else {
-        const pm_model cold = m;
         r.f = do_fit(run.obs, use, m, COLD_MAX_PASSES);
         if (r.f.status == PM_ERR_DIVERGED) {
-            warm_start(m, *warm);
-            r.f = do_fit(run.obs, use, m, WARM_MAX_PASSES);
+            pm_model w = m; // (m stays the cold start, for below)
+            warm_start(w, *warm);
+            r.f = do_fit(run.obs, use, w, WARM_MAX_PASSES);
         }
         // a model of up to 50 terms (order 2 and a few) gets pmfit fit's
         // passes from the cold start, as pmfit fit: an alt-az run's order-2
@@ -71,7 +71,7 @@ Fit fit_model(const Run &run, const std::vector<int> &use, pm_model m, const pm_
         // "not judged" in 34 of 68 where pmfit fit --order 2 converges; from
         // the warm start 2,000 did not); more terms cost too much a step
         if (r.f.status == PM_ERR_DIVERGED && m.n_terms <= 50)
-            r.f = do_fit(run.obs, use, cold, FIT_MAX_PASSES);
+            r.f = do_fit(run.obs, use, m, FIT_MAX_PASSES);
     }
     if (r.f.status != PM_OK)
         return r;
