@@ -204,13 +204,27 @@ pm_status pm_indi_fit(int mount, long n, const double *enc1, const double *enc2,
     r.spread = pm_indi_spread(n, app1, app2);
 
     pm_model best;
-    double c = 0, e = 0;
+    double c = 0, e = 0, sec_min = HUGE_VAL;
     offsets(n, enc1, enc2, app1, app2, &c, &e);
-    pm_status st = start_model(&best, mount, 0, nullptr, wrap_pi(c), e);
+    /* every point within PM_INDI_POLE_CAP of the pole: no axis-1 index
+    ** from them (Note 3; the fits below still start from c) */
+    bool near_pole = n > 0;
+    for (long i = 0; i < n; i++) {
+        const double ca = std::fabs(std::cos(app2[i]));
+        near_pole = near_pole && ca < std::sin(PM_INDI_POLE_CAP);
+        sec_min = std::min(sec_min, ca > 0 ? 1.0 / ca : HUGE_VAL);
+    }
+    pm_status st = start_model(&best, mount, 0, nullptr, near_pole ? 0.0 : wrap_pi(c), e);
     if (st != PM_OK)
         return st;
     r.kind = n > 0 ? PM_INDI_OFFSET : PM_INDI_NONE;
-    r.n_par = n > 0 ? 2 : 0;
+    r.n_par = n > 0 ? (near_pole ? 1 : 2) : 0;
+    r.altaz = mount == PM_MOUNT_ALTAZ;
+    if (near_pole) {
+        r.axis1_unset = 1;
+        r.axis1_read = wrap_pi(c);
+        r.axis1_sec = sec_min;
+    }
 
     r.chosen_order = n > 0 ? pm_indi_choose_order(n, r.spread) : -1;
     /* Fit up the ladder 0 .. chosen (each start from the one below); a
@@ -253,6 +267,7 @@ pm_status pm_indi_fit(int mount, long n, const double *enc1, const double *enc2,
         if (r.kind != PM_INDI_FIT || r.cv[L] + PM_INDI_CV_FLOOR < PM_INDI_CV_GAIN * r.cv[r.order]) {
             best = fitted[L];
             r.kind = PM_INDI_FIT;
+            r.axis1_unset = 0;
             r.order = L;
             r.sigma = sig[L];
             r.n_par = npar[L];
@@ -307,6 +322,17 @@ void pm_indi_describe(const pm_indi_result *r, long n, long skipped, char *buf, 
                           "failed: these points hardly determine it (add sync points spread over "
                           "more of the sky)%s",
                           n, r->spread * 180.0 / kPi, extra);
+        if (r->axis1_unset) {
+            size_t k = std::strlen(buf);
+            std::snprintf(buf + k, len - k,
+                          "; the %s index is left at 0: every sync point is within %.0f deg of "
+                          "the %s, where 1 arcmin on the sky reads as %.0f arcmin or more of it "
+                          "(these read %.2f deg); sync on a star farther from the %s to set it",
+                          r->altaz ? "azimuth" : "hour-angle", PM_INDI_POLE_CAP * 180.0 / kPi,
+                          r->altaz ? "zenith" : "pole",
+                          r->axis1_sec < 1e6 ? r->axis1_sec : 1e6, r->axis1_read * 180.0 / kPi,
+                          r->altaz ? "zenith" : "pole");
+        }
         break;
     default: {
         char cv[160] = "";

@@ -62,7 +62,17 @@ typedef struct pm_indi_result {
     char corr_pair[64]; /* their names, "c' and i" */
     double gain;       /* the used fit's own pointing error over the sky per
                           unit residual sigma (RMS; Note 2); 0 if none */
+    int axis1_unset;   /* PM_INDI_OFFSET with every sync point within
+                          PM_INDI_POLE_CAP of the pole (an alt-az mount's
+                          zenith): the axis-1 index is left at 0 (Note 3) */
+    double axis1_read; /* then the axis-1 offset the points read (radians) */
+    double axis1_sec;  /* and the least 1 / cos(axis 2) of them */
+    int altaz;         /* the mount is alt-az (the words of the description) */
 } pm_indi_result;
+
+/* Index offsets only, every sync point within this of the pole (zenith):
+** the axis-1 (hour-angle, azimuth) index is not read from them (Note 3). */
+#define PM_INDI_POLE_CAP (10.0 * 3.14159265358979323846 / 180.0)
 
 /* A fit whose own pointing error over the sky is more than this many
 ** times its residual sigma (pm_indi_result.gain) does not determine the
@@ -130,6 +140,16 @@ int pm_indi_choose_order(long n, double spread);
 **     PM_INDI_GAIN_WARN, naming the most correlated pair of terms
 **     (res->corr, res->corr_pair).  A 3 x 3 grid of 16 x 16 deg: 9.2; 45
 **     points over a hemisphere at order 1: 1.6.
+**  3) An axis-1 offset read at axis-2 angle b is the sky's error there
+**     times 1 / cos b: within 10 deg of the pole a polar axis 5' off, read
+**     at Polaris (b = 89.4 deg), is an hour-angle index of 7.6 deg, and
+**     every GOTO away from the pole moved by that made GOTOs 8-14 times
+**     worse than no correction (an outside probe; INDI's own plugins did
+**     the same).  So where only offsets are allowed and every point is
+**     within PM_INDI_POLE_CAP of the pole (zenith), the axis-1 index stays
+**     0 and the axis-2 one is applied; res->axis1_unset says so, with what
+**     was read (res->axis1_read, res->axis1_sec), and pm_indi_describe
+**     asks for a sync farther from the pole.
 */
 pm_status pm_indi_fit(int mount, long n, const double *enc1, const double *enc2,
                       const double *app1, const double *app2, pm_fit *fit,
