@@ -579,6 +579,25 @@ class Run:
         if bad.size:  # (as invert; the fit refused it later as a bare PM_ERR_ARG)
             raise ArgumentError("app_dec: point %d is %r, beyond +-pi/2 (an apparent "
                                 "declination or elevation)" % (bad[0], float(arrays[3][1][bad[0]])))
+        # the angles' ranges in radians (a value in degrees or hours is
+        # caught where it leaves them; a probe's encoder dec of 10 rad had
+        # been fitted as a 50 deg outlier, sigma 18089", where pmfit refused
+        # the file): an encoder dec within +-3pi/2 (beyond the pole either
+        # way), an hour angle within +-2pi, an alt-az mount's azimuth count
+        # within +-4pi (a cable wrap beyond one turn)
+        lim = {"enc_ha": 4 * _np.pi if m == _MOUNTS["altaz"] else 2 * _np.pi,
+               "enc_dec": 1.5 * _np.pi, "app_ha": 2 * _np.pi}
+        what = {"enc_ha": "an encoder hour angle or azimuth", "enc_dec":
+                "an encoder declination or elevation, beyond the pole either way",
+                "app_ha": "an apparent hour angle or azimuth"}
+        for n, a in arrays[:3]:
+            bad = _np.flatnonzero(_np.abs(a) > lim[n] * (1 + 1e-12))
+            if bad.size:
+                raise ArgumentError("%s: point %d is %r, beyond +-%s (%s, in radians: degrees or "
+                                    "hours? np.radians converts degrees)" % (
+                                        n, bad[0], float(a[bad[0]]),
+                                        {"enc_dec": "3pi/2"}.get(n, "4pi" if lim[n] > 7 else "2pi"),
+                                        what[n]))
         extra = []
         if pier is not None:
             extra.append(("pier", _as_int("pier", pier, (-1, 0, 1))))
