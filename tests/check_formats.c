@@ -827,6 +827,57 @@ START_TEST(test_pmrun_read_bad_csv)
 }
 END_TEST
 
+/* Second 60 of a CSV log's time: the leap second only, 23:59:60 UTC at the
+** end of a day that has one (2016-12-31; the same instant written with a
+** zone, +01:00); on an ordinary day (2023-12-31 22:46:60, an outside probe's,
+** read as 22:47:00 without a word) or at 23:59:60 of a day without one, the
+** line is refused. */
+START_TEST(test_pmrun_read_csv_second_60)
+{
+    static const struct {
+        const char *time;
+        int ok;
+    } c[5] = {{"2016-12-31T23:59:60.500Z", 1},
+              {"2017-01-01T00:59:60.500+01:00", 1},
+              {"2016-12-31T23:59:59.500Z", 1},
+              {"2023-12-31T22:46:60.000Z", 0},
+              {"2023-12-31T23:59:60Z", 0}};
+    char path[4096], err[2048];
+    const char *dir = getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp";
+    int k;
+    double t[3] = {0, 0, 0};
+    for (k = 0; k < 5; k++) {
+        pmrun *run = NULL;
+        FILE *f;
+        int st;
+        snprintf(path, sizeof path, "%s/pm_sec60_%d_%d.csv", dir, (int)getpid(), k);
+        f = fopen(path, "w");
+        ck_assert(f != NULL);
+        fprintf(f, "# equinox: J2000\n# latitude: 47.0\n# longitude: 19.0\n"
+                   "Time,Mount RA,Mount Dec,Solved RA,Solved Dec,Pier Side\n"
+                   "%s,02:43:35.8170,+63:52:06.753,02:43:16.7290,+63:51:42.749,pierWest\n",
+                c[k].time);
+        fclose(f);
+        st = pmrun_read(path, NULL, &run, err, sizeof err);
+        if (c[k].ok) {
+            ck_assert_msg(st == PMRUN_OK, "%s: %s", c[k].time, err);
+            t[k] = pmrun_get(run, 0)->time_h;
+            pmrun_free(run);
+        } else {
+            ck_assert_msg(st == PMRUN_ERR_FORMAT && strstr(err, ":5: ") &&
+                              strstr(err, "second 60 is not a leap second here"),
+                          "%s: status %d: %s", c[k].time, st, err);
+        }
+        remove(path);
+    }
+    /* the leap second is the second after 23:59:59.5 (UTC hours since 0h
+    ** of the run's first date, one second on); the same written with its
+    ** zone, whose run starts on the next date (24 h less) */
+    ck_assert_double_eq_tol((t[0] - t[2]) * 3600, 1.0, 1e-6);
+    ck_assert_double_eq_tol((t[1] + 24 - t[0]) * 3600, 0.0, 1e-6);
+}
+END_TEST
+
 START_TEST(test_pmrun_read_bad_mmt)
 {
     expect_error("bad_mmt_no_taa.dat", NULL, 5,
@@ -964,6 +1015,7 @@ static Suite *formats_suite(void)
     tcase_add_test(tc, test_pmrun_read_bad_mw4);
     tcase_add_test(tc, test_pmrun_read_bad_csv);
     tcase_add_test(tc, test_pmrun_read_bad_mmt);
+    tcase_add_test(tc, test_pmrun_read_csv_second_60);
     tcase_add_test(tc, test_pmrun_read_skip_bad_lists_skipped);
     suite_add_tcase(s, tc);
     tc = tcase_create("realdata");

@@ -189,6 +189,26 @@ bool parse_iso_utc(const std::string &text, UtcTime &t, std::string &why)
         why = "not a valid date and time, " + std::string(expect);
         return false;
     }
+    if (sec >= 60) {
+        // second 60: only the leap second, 23:59:60 UTC at the end of a
+        // day ERFA's table (eraDat) ends with one (an outside probe's
+        // 22:46:60 on an ordinary day was read as 22:47:00 without a word)
+        const long umin = (long)h * 60 + mi - (long)zsign * (zh * 60 + zm);
+        const long day = (long)std::floor((double)umin / 1440.0);
+        int uy, um, ud, ny, nm, nd;
+        double fd, a0 = 0, a1 = 0;
+        const bool leap =
+            umin - day * 1440 == 23 * 60 + 59 &&
+            eraJd2cal(d1, d2 + (double)day, &uy, &um, &ud, &fd) == 0 &&
+            eraJd2cal(d1, d2 + (double)day + 1, &ny, &nm, &nd, &fd) == 0 &&
+            eraDat(uy, um, ud, 0.0, &a0) >= 0 && eraDat(ny, nm, nd, 0.0, &a1) >= 0 &&
+            std::fabs(a1 - a0 - 1.0) < 1e-9;
+        if (!leap) {
+            why = "second 60 is not a leap second here (only 23:59:60 UTC at the end of a day "
+                  "that has one), " + std::string(expect);
+            return false;
+        }
+    }
     t.year = y;
     t.month = mo;
     t.day = d;
