@@ -289,6 +289,43 @@ START_TEST(test_report_unmodelled)
 }
 END_TEST
 
+/* The sky of the targets' predicted error: 8 stars of the normal side of a
+** German mount (every 15th of the example's normal side) give it
+** over both sides, the other side unobserved, said with the map's figure
+** beside it (an outside probe's 5 stars: 0.450" in the map, 1.510" in the
+** plan, nothing to tell them apart); --fork plans the normal side only,
+** smaller, and says so; --fork on an alt-az run is refused. */
+START_TEST(test_report_plan_sky)
+{
+    char path[512], cmd[4096];
+    char *html, *fork;
+    double both, one, map;
+    snprintf(path, sizeof path, "%s/oneside.dat", tmp);
+    snprintf(cmd, sizeof cmd,
+             "awk '/^#/ {print; next} $5 == \"E\" && c++ %% 15 == 0 && n < 8 {print; n++}' "
+             "'%s/examples/sim_gem.dat' > '%s'", top(), path);
+    ck_assert_int_eq(system(cmd), 0);
+    html = checked_report(path, "--order 0 --next 3", "oneside.html", "one-side page", 8, 0);
+    ck_assert_msg(strstr(html, "The sky of this prediction is both pier sides") &&
+                      strstr(html, "this run's stars are all on the normal side"),
+                  "%.400s", strstr(html, "Predicted mean error now") ? strstr(html, "Predicted mean error now") : html);
+    both = after(html, "Predicted mean error now: <b>", "both sides");
+    map = after(html, "star) says ", "the map");
+    fork = checked_report(path, "--order 0 --next 3 --fork", "oneside_fork.html", "one-side page, --fork",
+                          8, 0);
+    ck_assert_msg(strstr(fork, "The sky of this prediction is that of a mount that does not flip") &&
+                      !strstr(fork, "this run's stars are all"),
+                  "--fork");
+    one = after(fork, "Predicted mean error now: <b>", "--fork");
+    ck_assert_msg(one < both && map < both, "both sides %g, normal side %g, map %g", both, one, map);
+    free(html);
+    free(fork);
+    snprintf(path, sizeof path, "%s/tests/data/indep_ho_altaz_n90_unmodelled.dat", top());
+    ck_assert_int_eq(report(path, "--fork", "altaz_fork.html"), 1);
+    ck_assert_msg(strstr(out, "--fork is for an equatorial mount") != NULL, "%s", out);
+}
+END_TEST
+
 /* An equatorial run without a latitude: no azimuth, elevation or targets,
 ** each said on the page; the rest drawn. */
 START_TEST(test_report_no_latitude)
@@ -609,6 +646,7 @@ static Suite *suite(void)
     tcase_add_test(t, test_report_example);
     tcase_add_test(t, test_report_altaz);
     tcase_add_test(t, test_report_no_latitude);
+    tcase_add_test(t, test_report_plan_sky);
     tcase_add_test(t, test_report_unmodelled);
     tcase_add_test(t, test_report_compare);
     suite_add_tcase(s, t);

@@ -100,6 +100,7 @@ struct Options {
     std::string shape_opt;           // a simulate option that shapes a simulated run
     std::string output, compare;     // report: -o PAGE.html, --compare OLD
     bool quiet = false;              // report: no progress on stderr
+    bool report_fork = false;        // report: plan a mount that does not flip (--fork)
     bool progress = false;           // report: a line per stage on stderr, always
     // --no-refraction, --skip-bad, --format NAME (docs/formats.md),
     // --equinox J2000|JNow, --azimuth-count, --pressure HPA, ...
@@ -239,7 +240,7 @@ void usage(FILE *f)
         "  index terms (c', e') suffices or a full refit is needed (cross-validated)\n"
         "\n"
         "usage: pmfit report RUN -o PAGE.html [--order L] [--add EFFECT ...] [--compare OLD]\n"
-        "                    [--next K] [--min-el DEG] [--horizon FILE] [--alpha P]\n"
+        "                    [--next K] [--min-el DEG] [--horizon FILE] [--fork] [--alpha P]\n"
         "                    [--gear [ha:|dec:|az:|el:]G ...] [--no-refraction] [--skip-bad]\n"
         "                    [--format NAME] [--equinox J2000|JNow] [--azimuth-count]\n"
         "                    [--quiet | --progress]\n"
@@ -248,7 +249,8 @@ void usage(FILE *f)
         "  table, the residuals on the sky and against azimuth, elevation, hour angle,\n"
         "  declination, time and temperature, the model's correction and predicted error\n"
         "  over the sky, the explain findings with before/after plots, the next K targets\n"
-        "  (default 5) and, with --compare OLD (a saved model or a run), what changed since;\n"
+        "  (default 5; --fork: an equatorial mount that does not flip, as pmfit plan) and,\n"
+        "  with --compare OLD (a saved model or a run), what changed since;\n"
         "  progress on stderr (on a terminal, or once it has taken a second; --progress:\n"
         "  always, a line per stage; --quiet: never) (docs/report.md)\n"
         "\n"
@@ -436,6 +438,8 @@ Options parse_report(Options o, int argc, char **argv)
             o.min_el = number(a, need("degrees"), -10, 80);
         } else if (a == "--horizon") {
             o.horizon = need("a horizon file");
+        } else if (a == "--fork") {
+            o.report_fork = true;
         } else if (a == "--alpha") {
             o.alpha = number(a, need("a probability"), 1e-12, 0.5);
         } else if (a == "--gear") {
@@ -1655,6 +1659,9 @@ int cmd_report(const Options &o, const Run &run_in, int argc, char **argv)
     } catch (const std::exception &x) {
         die(std::string(x.what()) + " (no page written)", 1);
     }
+    if (o.report_fork && run.mount == PM_MOUNT_ALTAZ)
+        die("report: --fork is for an equatorial mount that does not flip; " + run.path +
+            " is of an alt-az mount", 1);
     ReportOptions ro;
     ro.order = o.order;
     ro.order_given = o.order_given;
@@ -1665,6 +1672,7 @@ int cmd_report(const Options &o, const Run &run_in, int argc, char **argv)
     ro.next = o.next;
     ro.min_el_deg = o.min_el;
     ro.horizon = o.horizon;
+    ro.fork = o.report_fork;
     ro.compare = o.compare;
     ro.read = o.read;
     ro.max_passes = MAX_PASSES;

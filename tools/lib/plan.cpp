@@ -733,6 +733,7 @@ Plan plan_targets(const Run &taken, const PlanOptions &opt)
     }
     if (o.mount != PM_MOUNT_ALTAZ && o.gem)
         o.normal_west = run_normal_west(done, o.meridian_limit_deg, o.normal_west);
+    plan.sides = o.mount == PM_MOUNT_ALTAZ ? 0 : (o.gem ? 2 : 1);
     std::vector<SkyPlace> sky = sky_places(o, 4, done, ctx);
     if (sky.empty())
         throw std::runtime_error("plan: no usable sky " + horizon_text(o) + " at this latitude");

@@ -79,6 +79,8 @@ struct Plan {
     int n_catalogue = 0;          // stars read (n_candidates of them usable)
     std::string note;             // e.g. the run does not determine the model yet
     bool note_says_undetermined = false; // the note says why the model is not determined
+    int sides = 0;                // the sky planned: 2 a German mount's (both pier
+                                  // sides), 1 a mount that does not flip, 0 alt-az
 };
 
 // The highest elevation planned: o.max_el_deg, else the mount's: an

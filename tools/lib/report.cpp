@@ -271,6 +271,7 @@ void stage_plan(Data &d)
     po.next = d.o.next;
     po.noise_arcsec = d.fit.res.sigma * RAD2AS;
     po.min_el_deg = d.o.min_el_deg;
+    po.gem = !d.o.fork;
     try {
         d.plan = plan_targets(d.run, po);
     } catch (const std::exception &x) {
@@ -784,8 +785,32 @@ void section_plan(Page &p, const Data &d)
                 h(fmt("pmfit plan %s --next %d --order %d --min-el %g%s%s", shell_word(d.run.path).c_str(),
                       d.o.next, d.o.order, d.o.min_el_deg, d.o.horizon.empty() ? "" : " --horizon ",
                       d.o.horizon.empty() ? "" : shell_word(d.o.horizon).c_str()) +
-                  plan_adds(d.o.adds)) +
+                  plan_adds(d.o.adds) + (d.o.fork ? " --fork" : "")) +
                 "</code>.");
+    if (pl.sides > 0) {
+        // the sky the predicted error is over: a German mount's both pier
+        // sides (where a run of one side has not been, the model is not
+        // known: an outside probe's 5 stars said 0.450" over the sky in the
+        // map and 1.510" here, with nothing to tell the two apart)
+        long beyond = 0, normal = 0;
+        for (const Obs &ob : d.run.obs)
+            (ob.pier < 0 ? beyond : normal)++;
+        std::string s = pl.sides == 2 ? "The sky of this prediction is both pier sides, as a German mount reaches "
+                                        "it (beyond the pole on the one side of the meridian, normal on the other)"
+                                      : "The sky of this prediction is that of a mount that does not flip (all "
+                                        "on the normal side)";
+        if (pl.sides == 2 && (beyond == 0 || normal == 0))
+            s += fmt(": this run's stars are all %s, so it counts the sky of the other side, which the run has "
+                     "not observed; the map of the model above (each place on the side of the run's nearest "
+                     "star) says %s over the sky above %s %.0f&deg;. For a mount that does not flip: "
+                     "<code>--fork</code>",
+                     beyond ? "beyond the pole" : "on the normal side",
+                     arcsec_text(d.emap.mean_arcsec).c_str(), d.emap.elevation ? "elevation" : "declination",
+                     d.emap.limit_deg);
+        para(p, s + ".");
+    }
+    if (!pl.note.empty())
+        para(p, "Note: " + h(pl.note) + ".");
     std::vector<std::vector<std::string>> rows;
     std::vector<std::pair<double, double>> marks;
     std::vector<std::string> labels;

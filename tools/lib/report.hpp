@@ -26,6 +26,7 @@ struct ReportOptions {
     std::vector<double> gears_ha, gears_dec; // explain: known gear periods (--gear)
     int next = 5;                      // plan: how many targets
     double min_el_deg = 15;            // plan: the lowest elevation (pmfit plan --min-el)
+    bool fork = false;                 // plan: an equatorial mount that does not flip (--fork)
     std::string horizon;               // plan: a horizon file (--horizon; empty: none)
     std::string compare;               // OLD: a model file or a run; empty: no comparison
     ReadOptions read;                  // reading OLD when it is a run (as the run)
