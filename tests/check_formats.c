@@ -878,6 +878,41 @@ START_TEST(test_pmrun_read_csv_second_60)
 }
 END_TEST
 
+/* A CSV log's header that lacks a column is read as a CSV log, whose reader
+** names what is missing (an outside probe's "Mount Dec" twice and no
+** "Mount RA" had been read as a four-column file: "7 fields, expected 4"). */
+START_TEST(test_pmrun_read_csv_header_lacking_column)
+{
+    static const struct {
+        const char *header, *needle;
+    } c[2] = {{"Time (UTC),Target,Mount Dec,Mount Dec,Solved RA,Solved Dec,Pier Side",
+               "column 'Mount Dec' is a second mount Dec column"},
+              {"Time (UTC),Target,Mount Dec,Solved RA,Solved Dec,Pier Side",
+               "no mount RA column"}};
+    char path[4096], err[2048];
+    const char *dir = getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp";
+    int k;
+    for (k = 0; k < 2; k++) {
+        pmrun *run = NULL;
+        FILE *f;
+        int st;
+        snprintf(path, sizeof path, "%s/pm_csvhdr_%d_%d.csv", dir, (int)getpid(), k);
+        f = fopen(path, "w");
+        ck_assert(f != NULL);
+        fprintf(f, "# equinox: J2000\n# latitude: 39.5\n# longitude: -105.2\n%s\n"
+                   "2023-12-31T22:30:00.000Z,\"Star 1, field\",+24.9244310,+24.9,22.08027576,"
+                   "+24.8652908,pierEast\n",
+                c[k].header);
+        fclose(f);
+        st = pmrun_read(path, NULL, &run, err, sizeof err);
+        ck_assert_msg(st == PMRUN_ERR_FORMAT && strstr(err, ":4: read as a N.I.N.A./ASCOM-style CSV log") &&
+                          strstr(err, c[k].needle),
+                      "%s: status %d: %s", c[k].header, st, err);
+        remove(path);
+    }
+}
+END_TEST
+
 START_TEST(test_pmrun_read_bad_mmt)
 {
     expect_error("bad_mmt_no_taa.dat", NULL, 5,
@@ -1016,6 +1051,7 @@ static Suite *formats_suite(void)
     tcase_add_test(tc, test_pmrun_read_bad_csv);
     tcase_add_test(tc, test_pmrun_read_bad_mmt);
     tcase_add_test(tc, test_pmrun_read_csv_second_60);
+    tcase_add_test(tc, test_pmrun_read_csv_header_lacking_column);
     tcase_add_test(tc, test_pmrun_read_skip_bad_lists_skipped);
     suite_add_tcase(s, tc);
     tc = tcase_create("realdata");

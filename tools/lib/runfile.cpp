@@ -488,6 +488,24 @@ bool csv_header(const std::string &line)
     return ra >= 2 && dec >= 2;   // the mount's and the solved position
 }
 
+// A delimited line of four or more names, none a number, two or more of
+// them naming an RA or a Dec: a CSV log's header that lacks a column (an
+// outside probe's "Mount Dec" written twice, no "Mount RA", had been read as
+// a four-column file: "7 fields, expected 4"); read as one, its reader
+// names what is missing.
+bool csv_header_like(const std::string &line)
+{
+    if (line.find(',') == std::string::npos && line.find(';') == std::string::npos) return false;
+    std::vector<std::string> names = csv_header_names(line);
+    if (names.size() < 4) return false;
+    int radec = 0;
+    for (const std::string &n : names) {
+        if (n.empty() || is_number(n)) return false;
+        radec += n.find("ra") != std::string::npos || n.find("dec") != std::string::npos ? 1 : 0;
+    }
+    return radec >= 2;
+}
+
 // The first '#' line of an RTS2 gpoint file names its columns
 // ("#  Observation  MJD  LST-MNT  RA-MNT ..."), or a '#observatory',
 // '#gem' or '#altaz' line gives the site.
@@ -591,6 +609,9 @@ private:
             } else if (t && csv_header(*t)) {
                 format = PMRUN_FORMAT_CSV;
                 why = format_str("line %d is a header of delimited names with RA and Dec", n);
+            } else if (t && csv_header_like(*t)) {
+                format = PMRUN_FORMAT_CSV;
+                why = format_str("line %d is a header of delimited names, some of RA or Dec", n);
             } else {
                 format = PMRUN_FORMAT_FOUR_COLUMN;   // four-column or named
                 if (t && (t->find(',') != std::string::npos || t->find(';') != std::string::npos))
@@ -609,6 +630,9 @@ private:
         } else if (csv_header(*t)) {
             format = PMRUN_FORMAT_CSV;
             why = format_str("line %d is a header of delimited names with RA and Dec", n);
+        } else if (csv_header_like(*t)) {
+            format = PMRUN_FORMAT_CSV;
+            why = format_str("line %d is a header of delimited names, some of RA or Dec", n);
         } else {
             std::vector<std::string> tok = tokens(strip_comment(*t, '#'));
             if (!tok.empty() && is_number(tok[0])) {
