@@ -777,6 +777,20 @@ START_TEST(test_pmfit_format_option_errors)
     snprintf(cmd, sizeof cmd, "%s fit %s --format rts2", tu_pmfit_path(), path);
     ck_assert_int_eq(tu_capture(cmd, out, sizeof out), 1);
     ck_assert_ptr_nonnull(strstr(out, "read as an RTS2 gpoint input file (format forced: rts2)"));
+    /* a TPOINT file forced as another format: what the field is (an MJD,
+    ** not degrees), and a TPOINT file, not "mixed formats" in a '#' file
+    ** that has no '#' line (an outside probe's) */
+    data_path(path, sizeof path, "outside_altaz_el309.dat");
+    snprintf(cmd, sizeof cmd, "%s fit %s --format rts2", tu_pmfit_path(), path);
+    ck_assert_int_eq(tu_capture(cmd, out, sizeof out), 1);
+    ck_assert_msg(strstr(out, "field 2 (MJD) 'truth': not a number, expected a decimal number "
+                              "(a modified Julian date)") != NULL,
+                  "%s", out);
+    snprintf(cmd, sizeof cmd, "%s fit %s --format four-column", tu_pmfit_path(), path);
+    ck_assert_int_eq(tu_capture(cmd, out, sizeof out), 1);
+    ck_assert_msg(strstr(out, "in a column file (a TPOINT file? without --format it is detected, "
+                              "or --format tpoint)") != NULL,
+                  "%s", out);
 }
 END_TEST
 

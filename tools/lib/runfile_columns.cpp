@@ -106,12 +106,18 @@ public:
     {
         std::string t = trim(text);
         if (t.empty()) return true;
-        if (t[0] == '#') return comment(n, t.substr(1));
+        if (t[0] == '#') {
+            seen_hash_ = true;
+            return comment(n, t.substr(1));
+        }
         if (t[0] == '!' || t[0] == ':')
             return ctx_.fail(n,
-                             "TPOINT %s line '%s' in a '#' column file: mixed formats? expected "
-                             "'#' comments and records '%s'",
+                             "TPOINT %s line '%s' in a column file (%s): expected '#' comments "
+                             "and records '%s'",
                              t[0] == '!' ? "comment" : "option", excerpt(t).c_str(),
+                             seen_hash_ || first_data_ ? "mixed formats?"
+                                        : "a TPOINT file? without --format it is detected, or "
+                                          "--format tpoint",
                              column_list().c_str());
         if (first_data_ == 0) {
             first_data_ = n;
@@ -366,6 +372,7 @@ private:
     bool has_[9] = {};
     int header_line_ = 0;
     int first_data_ = 0;
+    bool seen_hash_ = false; // a '#' line read (a TPOINT line after one or a record: mixed formats)
     int mount_ = PMRUN_MOUNT_EQUATORIAL;
     int mount_line_ = 0;
     double latitude_deg_ = nan();

@@ -63,8 +63,11 @@ public:
             // (fields 2, 6 and 7 are the MJD and axis counts, the rest angles)
             const bool angle = i != 1 && i != 5 && i != 6;
             if (!(angle ? parse_angle(tok[i], v[i], why) : parse_number(tok[i], v[i], why)))
-                return ctx_.bad_record(n, format("field %zu (%s) '%s': %s (degrees)", i + 1,
-                                                 names[i], excerpt(tok[i]).c_str(), why.c_str()));
+                return ctx_.bad_record(n, format("field %zu (%s) '%s': %s (%s)", i + 1, names[i],
+                                                 excerpt(tok[i]).c_str(), why.c_str(),
+                                                 i == 1 ? "a modified Julian date"
+                                                 : angle ? "degrees"
+                                                         : "an axis count"));
         }
         if (v[1] > 2415000.5 && v[1] < 2500000.5) {
             // a Julian date where gpoint writes the modified one (the ranges
