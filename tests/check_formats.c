@@ -927,6 +927,39 @@ START_TEST(test_pmrun_read_csv_header_lacking_column)
 }
 END_TEST
 
+/* A dir column's "+0" and "-0" are 0, as "0" (an outside probe's "+0" was
+** refused); "+2" still is not a direction. */
+START_TEST(test_pmrun_read_dir_signed_zero)
+{
+    static const char *const tok[3] = {"+0", "-0", "+2"};
+    char path[4096], err[2048];
+    const char *dir = getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp";
+    int k;
+    for (k = 0; k < 3; k++) {
+        pmrun *run = NULL;
+        FILE *f;
+        int st;
+        snprintf(path, sizeof path, "%s/pm_dir0_%d_%d.dat", dir, (int)getpid(), k);
+        f = fopen(path, "w");
+        ck_assert(f != NULL);
+        fprintf(f, "# latitude: 47\n# tau delta T D dir\n10 20 10.01 20.01 %s\n"
+                   "20 30 20.01 30.01 -1\n", tok[k]);
+        fclose(f);
+        st = pmrun_read(path, NULL, &run, err, sizeof err);
+        if (k < 2) {
+            ck_assert_msg(st == PMRUN_OK, "%s: %s", tok[k], err);
+            ck_assert_int_eq(pmrun_get(run, 0)->dir, 0);
+            ck_assert_int_eq(pmrun_get(run, 1)->dir, -1);
+            pmrun_free(run);
+        } else {
+            ck_assert_msg(st == PMRUN_ERR_FORMAT && strstr(err, "expected +1, -1, 0 or '-'"),
+                          "%s: %s", tok[k], err);
+        }
+        remove(path);
+    }
+}
+END_TEST
+
 START_TEST(test_pmrun_read_bad_mmt)
 {
     expect_error("bad_mmt_no_taa.dat", NULL, 5,
@@ -1066,6 +1099,7 @@ static Suite *formats_suite(void)
     tcase_add_test(tc, test_pmrun_read_bad_mmt);
     tcase_add_test(tc, test_pmrun_read_csv_second_60);
     tcase_add_test(tc, test_pmrun_read_csv_header_lacking_column);
+    tcase_add_test(tc, test_pmrun_read_dir_signed_zero);
     tcase_add_test(tc, test_pmrun_read_skip_bad_lists_skipped);
     suite_add_tcase(s, tc);
     tc = tcase_create("realdata");

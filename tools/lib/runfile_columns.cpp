@@ -291,7 +291,7 @@ private:
                 o.dir = 1;
             else if (tok == "-1")
                 o.dir = -1;
-            else if (tok == "0" || missing)
+            else if (tok == "0" || tok == "+0" || tok == "-0" || missing)
                 o.dir = 0;
             else {
                 why = "expected +1, -1, 0 or '-'";
