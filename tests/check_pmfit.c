@@ -1009,6 +1009,38 @@ START_TEST(test_pmfit_explain_reading_pier_step)
 }
 END_TEST
 
+/* Refraction and tube flexure share their shape over a run's elevations:
+** 20 stars of a German mount (probe Z1's generator, the command in the
+** file's first line) with a 24" over-corrected refraction (cot el toward the
+** zenith) and a 15.65" sag (toward the horizon, read -15.65): explain names
+** the refraction at order 0, 17.01" +- 0.68", 10 sigma from its truth, as
+** the sag is left in it.  The finding now carries the two fitted together,
+** each within 3 sigma of its truth, and says so in words. */
+START_TEST(test_pmfit_explain_refraction_beside_sag)
+{
+    char path[300];
+    const char *p;
+    double v, e, ov, oe;
+    snprintf(path, sizeof path, "%s/tests/data/gem20_refr_sag.dat",
+             getenv("PM_TOP") ? getenv("PM_TOP") : ".");
+    ck_assert_msg(run("%s explain %s --json%s", path, "") == 0, "%.2000s", out);
+    p = strstr(out, "\"effect\": \"refraction\"");
+    ck_assert_msg(p != NULL, "%.2000s", out);
+    p = strstr(p, "\"beside\": {\"effect\": \"tube_flexure\"");
+    ck_assert_msg(p != NULL, "%.3000s", out);
+    v = tu_json_num(p, "value_arcsec");
+    e = tu_json_num(p, "error_arcsec");
+    ov = tu_json_num(p, "other_value_arcsec");
+    oe = tu_json_num(p, "other_error_arcsec");
+    ck_assert_msg(fabs(v - 24.0) <= 3 * e && fabs(ov + 15.65) <= 3 * oe,
+                  "refraction %g +- %g (24), sag %g +- %g (-15.65)", v, e, ov, oe);
+    ck_assert_msg(run("%s explain %s%s", path, "") == 0, "%.2000s", out);
+    ck_assert_msg(strstr(out, "with tube_flexure beside it (at its step): refraction ") != NULL &&
+                      strstr(out, "both are measured, and the size above holds part of the other"),
+                  "%.3000s", out);
+}
+END_TEST
+
 /* A sigma on few degrees of freedom: the error map's JSON gives 2N - P and
 ** the 95% range of the true sigma over it, and where the range's top is
 ** above 2 (2N - P <= 7) the fit warns (an outside probe's 5 stars for 9
@@ -1874,6 +1906,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_pmfit_few_dof_warning);
     tcase_add_test(tc, test_pmfit_explain_period_aliases);
     tcase_add_test(tc, test_pmfit_explain_reading_pier_step);
+    tcase_add_test(tc, test_pmfit_explain_refraction_beside_sag);
     tcase_add_test(tc, test_pmfit_explain_baseline_advice);
     tcase_add_test(tc, test_pmfit_save_nearly_singular_reads_back);
     tcase_add_test(tc, test_pmfit_explain_sag_reading_on_a_band);

@@ -1506,6 +1506,32 @@ void record(const Run &run, State &st, const Candidate &c, const std::vector<Can
     for (double &x : d)
         x = arcsec(x);
     std::vector<Alternative> alts = alternatives(run, st, c, cands, opt);
+    // refraction and tube flexure share their shape over a run's
+    // elevations: the one found is fitted again with the other beside it,
+    // whose values and errors say how much of the size is the choice (an
+    // outside probe's 20 stars: a cot(el) shift named tube flexure
+    // 1066.93" +- 80.33", the pair's errors 340" and 190"; a 24" refraction
+    // beside a 15.65" sag read 17.01" +- 0.68"); tube flexure is an
+    // order-1 combination, so beside order 0 only
+    Finding::Beside beside;
+    if ((c.effect == "refraction" || c.effect == "tube_flexure") && c.new_adds.size() == 1 &&
+        c.fit.P == st.cur.P + 1) {
+        const std::string other = c.effect == "refraction" ? "tube_flexure" : "refraction";
+        if (other == "refraction" || c.order == 0) {
+            std::vector<std::string> both = c.adds;
+            both.push_back(other);
+            Fit j = fit_spec(run, st.use, c.order, both, warm_of(c.fit));
+            if (j.ok && j.P == c.fit.P + 1) {
+                beside.effect = other;
+                beside.value = arcsec(j.f.model.coef[j.P - 2]);
+                beside.error = arcsec(j.f.res.err[j.P - 2]);
+                beside.other_value = arcsec(j.f.model.coef[j.P - 1]);
+                beside.other_error = arcsec(j.f.res.err[j.P - 1]);
+                for (const Alternative &a : alts)
+                    beside.close = beside.close || (a.effect == other && !a.smooth);
+            }
+        }
+    }
     int step_no = 1; // one step for both members of a pair
     for (const std::vector<Finding> *v : {&ex.findings, &ex.withdrawn})
         for (const Finding &f : *v)
@@ -1534,6 +1560,7 @@ void record(const Run &run, State &st, const Candidate &c, const std::vector<Can
                            w, (long)st.use.size() - w);
         }
         fd.alternatives = alts;
+        fd.beside = beside;
         ex.findings.push_back(fd);
     }
     st.order = c.order;

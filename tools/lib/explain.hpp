@@ -79,6 +79,15 @@ struct Interpretation {
 };
 
 struct Finding {
+    // A refraction or tube-flexure finding fitted at its step with the
+    // other of the two beside it (they share their shape over a run's
+    // elevations): the finding's value and error then, the other's
+    // (arcsec); beside empty where not fitted (explain.cpp, record)
+    struct Beside {
+        std::string effect;
+        double value = 0, error = 0, other_value = 0, other_error = 0;
+        bool close = false;   // the other is an as-good alternative of the finding
+    } beside;
     std::string effect;       // vocabulary: ha_periodic, dec_periodic, pier_side, refraction,
                               // tube_flexure, temperature, time_drift, hysteresis,
                               // higher_order, outlier
@@ -196,6 +205,9 @@ std::vector<std::string> not_tried(const Run &run);
 std::vector<std::pair<std::string, std::string>> not_tried_why(const Run &run);
 // "significant, not modelled" in words: its sizes and what would fit it.
 std::string unmodelled_text(const Unmodelled &u);
+// A refraction or tube-flexure finding with the other fitted beside it
+// (Finding::beside): "with E beside it: ..."; "" where not fitted.
+std::string beside_text(const Finding &f);
 // A candidate whose fit did not converge, in words.
 std::string unfitted_text(const Explanation::Unfitted &u);
 // A family significant at a step but not separable from its harmonics, in words.

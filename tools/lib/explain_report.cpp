@@ -31,7 +31,8 @@ std::string alternatives_json(const std::vector<Alternative> &alts)
              ", \"delta_bic\": " + num(a.delta_bic) + ", \"log10_likelihood_ratio\": " +
              num(a.log10_lr) + ", \"kind\": " +
              str(a.smooth ? "smooth" : a.final_model ? "final" : "close") +
-             ", \"separate_by\": " + str(a.separate_by) + "}";
+             ", \"separate_by\": " + str(a.separate_by);
+        j += "}";
     }
     return j + "]";
 }
@@ -76,6 +77,11 @@ std::string finding_json(const Finding &f, int mount)
     if (!f.with.empty())
         j += ", \"with\": " + str(f.with);
     j += ", \"alternatives\": " + alternatives_json(f.alternatives);
+    if (!f.beside.effect.empty())
+        j += ", \"beside\": {\"effect\": " + str(f.beside.effect) + ", \"value_arcsec\": " +
+             num(f.beside.value) + ", \"error_arcsec\": " + num(f.beside.error) +
+             ", \"other_value_arcsec\": " + num(f.beside.other_value) +
+             ", \"other_error_arcsec\": " + num(f.beside.other_error) + "}";
     return j + ", \"text\": " + str(f.text) + ", \"where\": " + str(f.where) + "}";
 }
 
@@ -318,6 +324,8 @@ void print_findings(const Explanation &ex, double alpha, int mount)
                             a.log10_lr >= 0 ? W(f.effect).c_str() : W(a.effect).c_str(),
                             W(a.separate_by).c_str());
         }
+        if (!f.beside.effect.empty())
+            std::printf("     %s\n", W(beside_text(f)).c_str());
     }
     for (size_t i = 0; i < ex.withdrawn.size(); i++)
         std::printf("  withdrawn: %s; the findings above are those of the search without it\n",
@@ -346,6 +354,23 @@ std::string blurred_text(const Explanation::Blurred &b)
                "%.4g\" there, %.4g\" beside order 1's): on this sky those terms hold nearly its "
                "shape, so its fitted size is a balance between them, not a measurement",
                b.effect.c_str(), b.step, b.order, b.error_arcsec, b.error_order1_arcsec);
+}
+
+std::string beside_text(const Finding &f)
+{
+    const Finding::Beside &b = f.beside;
+    if (b.effect.empty())
+        return "";
+    const bool one = std::fabs(b.value) >= 3 * b.error, other = std::fabs(b.other_value) >= 3 * b.other_error;
+    return fmt("with %s beside it (at its step): %s %.2f\" +- %.2f\", %s %.2f\" +- %.2f\": %s",
+               b.effect.c_str(), f.effect.c_str(), b.value, b.error, b.effect.c_str(), b.other_value,
+               b.other_error,
+               !one && !other ? "each within 3 sigma of zero beside the other, so this run cannot tell "
+                                "the two apart, and the size above is one reading's"
+               : other        ? "both are measured, and the size above holds part of the other"
+               : b.close      ? "this run hardly tells the two apart, and the size above is one "
+                                "reading's"
+                              : "the other is not measured");
 }
 
 std::string unmodelled_text(const Unmodelled &u)

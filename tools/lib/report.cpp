@@ -687,6 +687,8 @@ void explain_findings(Page &p, const Data &d)
                          a.smooth ? ": it holds all that the periodic term explains, so this run cannot "
                                     "tell a periodic error from a smooth distortion" : "") +
                      h(W(a.separate_by)) + "</li>";
+        if (!f.beside.effect.empty())
+            extra += "<li>" + h(W(beside_text(f))) + ".</li>";
         p.body += fmt("<h3 id=\"finding%zu\">Finding %zu: ", k + 1, k + 1) + h(W(f.effect)) + "</h3>\n";
         para(p, h(W(f.text)) + ". <i>Where:</i> " + h(W(f.where)) + ".");
         if (!extra.empty())
