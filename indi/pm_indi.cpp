@@ -220,6 +220,11 @@ pm_status pm_indi_fit(int mount, long n, const double *enc1, const double *enc2,
     r.kind = n > 0 ? PM_INDI_OFFSET : PM_INDI_NONE;
     r.n_par = n > 0 ? (near_pole ? 1 : 2) : 0;
     r.altaz = mount == PM_MOUNT_ALTAZ;
+    for (long i = 0; i < n && !r.altaz; i++) {
+        const double h = wrap_pi(enc1[i]);
+        r.east += h < -PM_INDI_MERIDIAN_GAP;
+        r.west += h > PM_INDI_MERIDIAN_GAP;
+    }
     if (near_pole) {
         r.axis1_unset = 1;
         r.axis1_read = wrap_pi(c);
@@ -368,8 +373,20 @@ void pm_indi_describe(const pm_indi_result *r, long n, long skipped, char *buf, 
                           "the lowest one; %s correlated %.4f): add sync points over more of the sky",
                           r->gain, r->corr_pair, r->corr);
         }
-        if (others >= 0 && r->worst_loo > PM_INDI_WORST_RATIO * others &&
-                r->worst_loo * arcsec > 10.0) {
+        const bool wrong_sync = others >= 0 && r->worst_loo > PM_INDI_WORST_RATIO * others &&
+                                r->worst_loo * arcsec > 10.0;
+        if (!wrong_sync && !r->altaz && r->east >= 2 && r->west >= 2 &&
+                r->sigma > PM_INDI_SIDES_SIGMA) { /* (a wrong sync is said below instead) */
+            size_t k = std::strlen(buf);
+            std::snprintf(buf + k, len - k,
+                          "; the sync points are on both sides of the meridian (%ld east, %ld "
+                          "west): on a German mount INDI does not record the pier side, so "
+                          "errors that change sign across the flip (collimation, "
+                          "non-perpendicularity) cannot be fitted and are averaged: sync on "
+                          "the side you observe",
+                          r->east, r->west);
+        }
+        if (wrong_sync) {
             size_t k = std::strlen(buf);
             std::snprintf(buf + k, len - k,
                           "; the others' fit misses sync point %ld by %.1f arcsec, %.1f times "

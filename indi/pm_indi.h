@@ -68,7 +68,19 @@ typedef struct pm_indi_result {
     double axis1_read; /* then the axis-1 offset the points read (radians) */
     double axis1_sec;  /* and the least 1 / cos(axis 2) of them */
     int altaz;         /* the mount is alt-az (the words of the description) */
+    long east, west;   /* equatorial: sync points more than PM_INDI_MERIDIAN_GAP
+                          east and west of the meridian (a German mount's two
+                          pier sides, which INDI does not record) */
 } pm_indi_result;
+
+/* A fit of a German mount's sync points on both sides of the meridian
+** (two or more more than this hour angle from it on each) with sigma above
+** PM_INDI_SIDES_SIGMA (radians) is told that INDI does not record the pier
+** side (docs/indi.md, quirk 7): an outside probe's 2' collimation and 1'
+** non-perpendicularity, synced on both sides, gave GOTOs 150-470" off and a
+** sigma of 126" with no word of why. */
+#define PM_INDI_MERIDIAN_GAP (0.5 * 3.14159265358979323846 / 180.0)
+#define PM_INDI_SIDES_SIGMA (10.0 / 206264.80624709636)
 
 /* Index offsets only, every sync point within this of the pole (zenith):
 ** the axis-1 (hour-angle, azimuth) index is not read from them (Note 3). */

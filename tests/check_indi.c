@@ -323,6 +323,39 @@ START_TEST(test_pm_indi_fit_offsets_only_near_pole)
 }
 END_TEST
 
+START_TEST(test_pm_indi_describe_both_sides_of_meridian)
+{
+    /* A German mount's 2' collimation changes sign with the pier side,
+    ** which INDI's sync points do not record: synced on both sides of the
+    ** meridian no model holds it, and the line says why (an outside probe:
+    ** GOTOs 150-470" off, sigma 126", no word); on one side it fits, no
+    ** word; an alt-az mount: never said. */
+    const double ci = 2.0 / 60 * D2R;
+    for (int c = 0; c < 3; c++) {
+        pm_model m;
+        pm_indi_result r;
+        char line[1024];
+        long n = 0;
+        for (int i = 0; i < 6; i++)
+            for (int j = 0; j < 5; j++) {
+                double h = (c == 1 ? 5.0 + 14.0 * i : -75.0 + 30.0 * i) * D2R; /* 1: west only */
+                e1[n] = h;
+                e2[n] = (-10.0 + 18.0 * j) * D2R;
+                a1[n] = h + (h < 0 ? -ci : ci) / cos(e2[n]);
+                a2[n] = e2[n];
+                n++;
+            }
+        ck_assert_int_eq(pm_indi_fit(c == 2 ? PM_MOUNT_ALTAZ : PM_MOUNT_EQUATORIAL, n, e1, e2, a1,
+                                     a2, &fit, &m, &r),
+                         PM_OK);
+        pm_indi_describe(&r, n, 0, line, sizeof line);
+        ck_assert_msg((strstr(line, "the sync points are on both sides of the meridian (15 east, "
+                                    "15 west)") != NULL) == (c == 0),
+                      "case %d: %s", c, line);
+    }
+}
+END_TEST
+
 START_TEST(test_pm_indi_fit_small_grid_correlated_said)
 {
     /* nine syncs on a 3 x 3 grid, 16 x 16 deg, of a mount with flexure:
@@ -781,6 +814,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_pm_indi_fit_few_points_offsets);
     tcase_add_test(tc, test_pm_indi_fit_offsets_sync_near_pole);
     tcase_add_test(tc, test_pm_indi_fit_offsets_only_near_pole);
+    tcase_add_test(tc, test_pm_indi_describe_both_sides_of_meridian);
     tcase_add_test(tc, test_pm_indi_fit_small_grid_correlated_said);
     tcase_add_test(tc, test_pm_indi_fit_rotation_exact);
     tcase_add_test(tc, test_pm_indi_fit_flexure_needs_order1);
