@@ -2336,8 +2336,10 @@ std::string order0_instead(const Run &run, const Explanation &ex, const ExplainO
                "order 0 (--order 1 explains it at order 1)",
                run.obs.size(), ex.base_n_params, o0.c_str(), ex.order0_cv_rms_arcsec,
                ex.base_cv_rms_arcsec,
-               left ? fmt(", on the %zu points order 1 can predict from the others",
-                          run.obs.size() - left)
+               left ? (run.obs.size() - left == 1
+                           ? std::string(", on the one point order 1 can predict from the others")
+                           : fmt(", on the %zu points order 1 can predict from the others",
+                                 run.obs.size() - left))
                           .c_str()
                     : "");
 }
