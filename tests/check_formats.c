@@ -927,6 +927,46 @@ START_TEST(test_pmrun_read_csv_header_lacking_column)
 }
 END_TEST
 
+/* A TPOINT file whose first line is a caption with commas, naming words
+** that hold "ra" or "dec" (camera, temperature, decker), is a TPOINT file,
+** not a CSV header lacking a column (an outside probe's, misread so for one
+** commit); a header naming RA and Dec as words still is a CSV log's. */
+START_TEST(test_pmrun_read_tpoint_comma_caption)
+{
+    static const char *const caption[2] = {
+        "Camera test, Temperature 10C, Konkoly site, observer J Smith",
+        "RC8 Astrograph, Fornax mount, Decker slit, night 2"};
+    char src[4096], path[4096], err[2048], line[1024];
+    const char *dir = getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp";
+    int k;
+    data_path(src, sizeof src, "tpoint_equat.dat");
+    for (k = 0; k < 2; k++) {
+        pmrun *run = NULL;
+        FILE *in = fopen(src, "r"), *out;
+        int first = 1;
+        ck_assert(in != NULL);
+        snprintf(path, sizeof path, "%s/pm_tpcap_%d_%d.dat", dir, (int)getpid(), k);
+        out = fopen(path, "w");
+        ck_assert(out != NULL);
+        while (fgets(line, sizeof line, in)) {
+            if (line[0] == '!')
+                continue;
+            fputs(first ? caption[k] : line, out);
+            if (first)
+                fputc('\n', out);
+            first = 0;
+        }
+        fclose(in);
+        fclose(out);
+        ck_assert_msg(pmrun_read(path, NULL, &run, err, sizeof err) == PMRUN_OK, "%s: %s",
+                      caption[k], err);
+        ck_assert_int_eq(pmrun_format(run), PMRUN_FORMAT_TPOINT);
+        pmrun_free(run);
+        remove(path);
+    }
+}
+END_TEST
+
 /* A dir column's "+0" and "-0" are 0, as "0" (an outside probe's "+0" was
 ** refused); "+2" still is not a direction. */
 START_TEST(test_pmrun_read_dir_signed_zero)
@@ -1100,6 +1140,7 @@ static Suite *formats_suite(void)
     tcase_add_test(tc, test_pmrun_read_csv_second_60);
     tcase_add_test(tc, test_pmrun_read_csv_header_lacking_column);
     tcase_add_test(tc, test_pmrun_read_dir_signed_zero);
+    tcase_add_test(tc, test_pmrun_read_tpoint_comma_caption);
     tcase_add_test(tc, test_pmrun_read_skip_bad_lists_skipped);
     suite_add_tcase(s, tc);
     tc = tcase_create("realdata");

@@ -493,17 +493,51 @@ bool csv_header(const std::string &line)
 // outside probe's "Mount Dec" written twice, no "Mount RA", had been read as
 // a four-column file: "7 fields, expected 4"); read as one, its reader
 // names what is missing.
+//
+// RA and Dec as words of a name ("Mount RA", "MountRA", "RA_mount", "Solved
+// Dec", "Declination"), not inside one: a TPOINT caption "Camera test,
+// Temperature 10C, Konkoly site, observer J Smith" (camera, temperature) is
+// not a header (an outside probe's, read as a CSV log when any name holding
+// "ra" counted).  Words: split at what is not a letter or digit and where a
+// lower-case letter is followed by a capital.
 bool csv_header_like(const std::string &line)
 {
     if (line.find(',') == std::string::npos && line.find(';') == std::string::npos) return false;
-    std::vector<std::string> names = csv_header_names(line);
-    if (names.size() < 4) return false;
-    int radec = 0;
-    for (const std::string &n : names) {
-        if (n.empty() || is_number(n)) return false;
-        radec += n.find("ra") != std::string::npos || n.find("dec") != std::string::npos ? 1 : 0;
+    const char delim = line.find(',') != std::string::npos ? ',' : ';';
+    int fields = 0, ra = 0, dec = 0;
+    size_t b = 0;
+    for (;;) {
+        size_t e = line.find(delim, b);
+        const std::string f = trim(line.substr(b, e == std::string::npos ? std::string::npos : e - b));
+        std::string bare;
+        for (char c : f)
+            if (c != '"' && c != '\'') bare += c;
+        if (bare.empty() || is_number(bare)) return false;
+        ++fields;
+        std::string w;
+        bool has_ra = false, has_dec = false;
+        auto word = [&]() {
+            has_ra = has_ra || w == "ra";
+            has_dec = has_dec || w == "dec" || w == "declination";
+            w.clear();
+        };
+        for (size_t i = 0; i < bare.size(); ++i) {
+            const char c = bare[i];
+            const bool alnum = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9');
+            if (!alnum) {
+                word();
+                continue;
+            }
+            if (c >= 'A' && c <= 'Z' && i > 0 && bare[i - 1] >= 'a' && bare[i - 1] <= 'z') word();
+            w += static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);
+        }
+        word();
+        ra += has_ra;
+        dec += has_dec;
+        if (e == std::string::npos) break;
+        b = e + 1;
     }
-    return radec >= 2;
+    return fields >= 4 && ra >= 1 && dec >= 1;
 }
 
 // The first '#' line of an RTS2 gpoint file names its columns
