@@ -579,25 +579,15 @@ class Run:
         if bad.size:  # (as invert; the fit refused it later as a bare PM_ERR_ARG)
             raise ArgumentError("app_dec: point %d is %r, beyond +-pi/2 (an apparent "
                                 "declination or elevation)" % (bad[0], float(arrays[3][1][bad[0]])))
-        # the angles' ranges in radians (a value in degrees or hours is
-        # caught where it leaves them; a probe's encoder dec of 10 rad had
-        # been fitted as a 50 deg outlier, sigma 18089", where pmfit refused
-        # the file): an encoder dec within +-3pi/2 (beyond the pole either
-        # way), an hour angle within +-2pi, an alt-az mount's azimuth count
-        # within +-4pi (a cable wrap beyond one turn)
-        lim = {"enc_ha": 4 * _np.pi if m == _MOUNTS["altaz"] else 2 * _np.pi,
-               "enc_dec": 1.5 * _np.pi, "app_ha": 2 * _np.pi}
-        what = {"enc_ha": "an encoder hour angle or azimuth", "enc_dec":
-                "an encoder declination or elevation, beyond the pole either way",
-                "app_ha": "an apparent hour angle or azimuth"}
-        for n, a in arrays[:3]:
-            bad = _np.flatnonzero(_np.abs(a) > lim[n] * (1 + 1e-12))
-            if bad.size:
-                raise ArgumentError("%s: point %d is %r, beyond +-%s (%s, in radians: degrees or "
-                                    "hours? np.radians converts degrees)" % (
-                                        n, bad[0], float(a[bad[0]]),
-                                        {"enc_dec": "3pi/2"}.get(n, "4pi" if lim[n] > 7 else "2pi"),
-                                        what[n]))
+        # an apparent hour angle beyond a turn is a unit slip (hours, degrees);
+        # the encoder angles are modular, as a file's (docs/formats.md:
+        # controllers write 0..360 deg or count past a turn), and checked
+        # against the pier side where it is given, below
+        bad = _np.flatnonzero(_np.abs(arrays[2][1]) > 2 * _np.pi * (1 + 1e-12))
+        if bad.size:
+            raise ArgumentError("app_ha: point %d is %r, beyond +-2pi (an apparent hour angle or "
+                                "azimuth, in radians: hours or degrees? np.radians converts "
+                                "degrees)" % (bad[0], float(arrays[2][1][bad[0]])))
         extra = []
         if pier is not None:
             extra.append(("pier", _as_int("pier", pier, (-1, 0, 1))))
@@ -634,6 +624,8 @@ class Run:
                     n, a.shape, arrays[0][1].shape))
         shape, flat = _broadcast(arrays + extra)
         cols = dict(zip([n for n, _ in arrays + extra], flat))
+        if pier is not None and m == _MOUNTS["equatorial"]:
+            _check_pier_convention(cols["enc_dec"], cols["pier"])
         aux_arr = (_np.ascontiguousarray(_np.stack([cols["aux[%r]" % k] for k in names], axis=1))
                    if names else None)
         lat = float("nan")
@@ -666,6 +658,39 @@ class Run:
     def explain(self, **kw):
         """explain(self, **kw)."""
         return explain(self, **kw)
+
+
+def _check_pier_convention(enc_dec, pier):
+    """One encoder convention per run, as pmfit's readers check it (docs/
+    formats.md, "Beyond the pole"): the records of a side (pier 1: normal,
+    -1: beyond the pole) all have their encoder dec, reduced into one turn,
+    within +-pi/2 or all beyond, and not both sides beyond (an outside
+    probe's encoder dec of 10 rad among 200 points of pier 1 was fitted as a
+    50 deg outlier, sigma 18089", where pmfit refused the same file)."""
+    ed = _np.remainder(_np.asarray(enc_dec, dtype=float) + _np.pi, 2 * _np.pi) - _np.pi
+    beyond = _np.abs(ed) > _np.pi / 2
+    first_beyond = {}
+    for side, word in ((1, "1 (normal side)"), (-1, "-1 (beyond the pole)")):
+        idx = _np.flatnonzero(_np.asarray(pier).reshape(-1) == side)
+        if not idx.size:
+            continue
+        b = beyond.reshape(-1)[idx]
+        odd = _np.flatnonzero(b != b[0])
+        if odd.size:
+            i0, j = int(idx[0]), int(idx[odd[0]])
+            raise ArgumentError(
+                "enc_dec: point %d, pier %s, has its encoder dec %s (%r rad) but point %d of "
+                "the same side %s (%r rad): mixed encoder conventions, or a value in degrees? "
+                "expected one convention (beyond the pole: an encoder dec beyond +-pi/2 in one "
+                "turn)" % (j, word, "beyond the pole" if b[odd[0]] else "within +-pi/2",
+                           float(_np.asarray(enc_dec).reshape(-1)[j]), i0,
+                           "beyond" if b[0] else "within +-pi/2",
+                           float(_np.asarray(enc_dec).reshape(-1)[i0])))
+        first_beyond[side] = bool(b[0])
+    if first_beyond.get(1) and first_beyond.get(-1):
+        raise ArgumentError("pier: the points of both sides have their encoder dec beyond the "
+                            "pole: the pier does not follow the encoder (1: the normal side, "
+                            "-1: beyond the pole)")
 
 
 _WEATHER_RANGE = {"pressure_hpa": (400, 1100, "hPa"), "temp_c": (-60, 50, "deg C"),

@@ -193,26 +193,43 @@ def test_non_finite_inputs_are_named():
 
 
 def test_angles_beyond_their_range_are_named():
-    """Arrays are radians: an encoder dec beyond +-3pi/2, an hour angle
-    beyond +-2pi (an alt-az azimuth count beyond +-4pi) is a unit slip, named
-    with its point (an outside probe's encoder dec of 10 rad among 200 had
-    been fitted as a 50 deg outlier, sigma 18089"; pmfit refused the file)."""
+    """Arrays are radians.  An apparent hour angle beyond +-2pi is a unit
+    slip, named with its point.  Encoder angles are modular, as a file's
+    (another probe's round trip of tests/data through enc_raw, 0..360 deg and
+    counts past a turn), and with ``pier`` given they follow one convention
+    as pmfit checks a file's: an outside probe's encoder dec of 10 rad among
+    200 points of the normal side had been fitted as a 50 deg outlier, sigma
+    18089", where pmfit refused the same file."""
     ha = np.linspace(-1.2, 1.2, 40)
     dec = np.linspace(-0.3, 1.3, 40)
     bad = dec.copy()
     bad[7] = 10.0
-    with pytest.raises(pm.ArgumentError, match=r"enc_dec: point 7 is 10.0, beyond \+-3pi/2"):
-        pm.fit(ha, bad, ha, dec, order=0)
+    with pytest.raises(pm.ArgumentError, match=r"enc_dec: point 7, pier 1 \(normal side\), has its "
+                                               r"encoder dec beyond the pole"):
+        pm.fit(ha, bad, ha, dec, order=0, pier=np.ones(40, int))
+    with pytest.raises(pm.ArgumentError, match=r"both sides have their encoder dec beyond"):
+        pm.fit(ha, np.pi - dec, ha, dec, order=0, pier=np.where(ha < 0, 1, -1))
     hours = np.linspace(-7.5, 7.5, 40)
-    with pytest.raises(pm.ArgumentError, match=r"enc_ha: point 0 is -7.5, beyond \+-2pi .*hours"):
-        pm.fit(hours, dec, ha, dec, order=0)
-    with pytest.raises(pm.ArgumentError, match=r"app_ha: point 0 is -7.5"):
+    with pytest.raises(pm.ArgumentError, match=r"app_ha: point 0 is -7.5, beyond \+-2pi"):
         pm.fit(ha, dec, hours, dec, order=0)
-    # within the ranges: beyond the pole (pi - dec), a wrapped count
-    pm.Run.from_arrays(ha, np.pi - dec, ha + np.pi, dec)
-    pm.Run.from_arrays(ha + 3 * np.pi, dec, ha, dec, mount="altaz")
-    with pytest.raises(pm.ArgumentError, match=r"enc_ha: point \d+ is .*beyond \+-4pi"):
-        pm.Run.from_arrays(ha + 4 * np.pi, dec, ha, dec, mount="altaz")
+    # modular: beyond the pole (pi - dec, its 0..2pi form), counts past a turn
+    pm.Run.from_arrays(ha, np.pi - dec, ha + np.pi, dec, pier=-np.ones(40, int))
+    pm.Run.from_arrays(ha + 2 * np.pi, 2 * np.pi + dec, ha, dec, pier=np.ones(40, int))
+    pm.Run.from_arrays(ha + 4 * np.pi, dec + 2 * np.pi, ha, dec, mount="altaz")
+    # every run of tests/data as its file wrote the encoder angles, pier as read
+    d = os.path.join(TOP, "tests", "data")
+    n = 0
+    for name in sorted(os.listdir(d)):
+        if name.startswith("bad_") or not name.endswith((".dat", ".csv", ".json")):
+            continue
+        try:
+            r = pm.read_run(os.path.join(d, name))
+        except pm.Error:
+            continue
+        pm.Run.from_arrays(r.enc_raw[:, 0], r.enc_raw[:, 1], r.app_ha, r.app_dec,
+                           mount=r.mount, pier=r.pier)
+        n += 1
+    assert n > 50, n
 
 
 def test_context_inputs_the_model_needs(sim_dir):
