@@ -68,6 +68,87 @@ pm_status start_model(pm_model *m, int mount, int order, const pm_model *src, do
     return pm_model_prepare(m);
 }
 
+/* Near the pole: the tilt of the polar (azimuth) axis, a and b, that puts
+** the n points where they belong (least squares; Gauss-Newton with the
+** derivatives by differences, from the model m, which holds the rest).
+** There a sky error is what a tilt gives, the same shift everywhere near the
+** pole, where an index offset gives none (Note 3).  False where a step is
+** not finite or the 2 x 2 system is singular (m then unchanged). */
+bool fit_tilt(pm_model *m, long n, const double *e1, const double *e2, const double *a1,
+              const double *a2)
+{
+    int ia, ib;
+    if (pm_model_find(m, PM_BASE_A, 0, 0, &ia) != PM_OK || pm_model_find(m, PM_BASE_B, 0, 0, &ib) != PM_OK)
+        return false;
+    const pm_model start = *m;
+    const int idx[2] = {ia, ib};
+    const double h = 1e-7;
+    /* the sum of squared residuals, and (J) its Gauss-Newton system */
+    auto ssr = [&](pm_model *q, double A[3], double g[2]) -> double {
+        double s = 0;
+        if (A) {
+            A[0] = A[1] = A[2] = g[0] = g[1] = 0;
+        }
+        for (long i = 0; i < n; i++) {
+            double r0[2], rk[2][2];
+            if (pm_model_residual(q, nullptr, e1[i], e2[i], a1[i], a2[i], r0) != PM_OK)
+                return NAN;
+            s += r0[0] * r0[0] + r0[1] * r0[1];
+            if (!A)
+                continue;
+            for (int k = 0; k < 2; k++) {
+                q->coef[idx[k]] += h;
+                pm_status st = pm_model_prepare(q);
+                if (st == PM_OK)
+                    st = pm_model_residual(q, nullptr, e1[i], e2[i], a1[i], a2[i], rk[k]);
+                q->coef[idx[k]] -= h;
+                if (st != PM_OK || pm_model_prepare(q) != PM_OK)
+                    return NAN;
+            }
+            for (int c = 0; c < 2; c++) {
+                const double j0 = (rk[0][c] - r0[c]) / h, j1 = (rk[1][c] - r0[c]) / h;
+                A[0] += j0 * j0;
+                A[1] += j0 * j1;
+                A[2] += j1 * j1;
+                g[0] += j0 * r0[c];
+                g[1] += j1 * r0[c];
+            }
+        }
+        return s;
+    };
+    /* damped: a step that does not lower the sum is halved (near the pole
+    ** the residual's frame turns with the position) */
+    for (int it = 0; it < 30; it++) {
+        double A[3], g[2];
+        const double s0 = ssr(m, A, g);
+        const double det = A[0] * A[2] - A[1] * A[1];
+        if (!std::isfinite(s0) || !(A[0] > 0) || !(det > 1e-12 * (A[0] * A[2]))) {
+            *m = start;
+            pm_model_prepare(m);
+            return false;
+        }
+        if (s0 < 1e-26 * (double)n) /* (1e-13 rad per point) */
+            break;
+        double d0 = (A[2] * g[0] - A[1] * g[1]) / det, d1 = (A[0] * g[1] - A[1] * g[0]) / det;
+        const pm_model before = *m;
+        bool lower = false;
+        for (int half = 0; half < 30 && !lower; half++, d0 /= 2, d1 /= 2) {
+            *m = before;
+            m->coef[ia] -= d0;
+            m->coef[ib] -= d1;
+            lower = pm_model_prepare(m) == PM_OK && ssr(m, nullptr, nullptr) < s0;
+        }
+        if (!lower) {
+            *m = before;
+            pm_model_prepare(m);
+            break;
+        }
+        if (std::fabs(d0) + std::fabs(d1) < 1e-14)
+            break;
+    }
+    return true;
+}
+
 /* The most correlated pair of the fit's terms (after a solve): the signed
 ** correlation, their names into pair; 0 where none is available. */
 double worst_corr(const pm_fit *fit, const pm_fit_result *fr, const pm_model *m, char *pair, size_t len)
@@ -214,11 +295,17 @@ pm_status pm_indi_fit(int mount, long n, const double *enc1, const double *enc2,
         near_pole = near_pole && ca < std::sin(PM_INDI_POLE_CAP);
         sec_min = std::min(sec_min, ca > 0 ? 1.0 / ca : HUGE_VAL);
     }
-    pm_status st = start_model(&best, mount, 0, nullptr, near_pole ? 0.0 : wrap_pi(c), e);
+    pm_status st = start_model(&best, mount, 0, nullptr, near_pole ? 0.0 : wrap_pi(c), near_pole ? 0.0 : e);
     if (st != PM_OK)
         return st;
+    if (near_pole && !fit_tilt(&best, n, enc1, enc2, app1, app2)) { /* (the offsets then) */
+        near_pole = false;
+        st = start_model(&best, mount, 0, nullptr, wrap_pi(c), e);
+        if (st != PM_OK)
+            return st;
+    }
     r.kind = n > 0 ? PM_INDI_OFFSET : PM_INDI_NONE;
-    r.n_par = n > 0 ? (near_pole ? 1 : 2) : 0;
+    r.n_par = n > 0 ? 2 : 0;
     r.altaz = mount == PM_MOUNT_ALTAZ;
     for (long i = 0; i < n && !r.altaz; i++) {
         const double h = wrap_pi(enc1[i]);
@@ -229,6 +316,10 @@ pm_status pm_indi_fit(int mount, long n, const double *enc1, const double *enc2,
         r.axis1_unset = 1;
         r.axis1_read = wrap_pi(c);
         r.axis1_sec = sec_min;
+        int ia, ib;
+        if (pm_model_find(&best, PM_BASE_A, 0, 0, &ia) == PM_OK &&
+                pm_model_find(&best, PM_BASE_B, 0, 0, &ib) == PM_OK)
+            r.tilt = std::hypot(best.coef[ia], best.coef[ib]);
     }
 
     r.chosen_order = n > 0 ? pm_indi_choose_order(n, r.spread) : -1;
@@ -330,13 +421,14 @@ void pm_indi_describe(const pm_indi_result *r, long n, long skipped, char *buf, 
         if (r->axis1_unset) {
             size_t k = std::strlen(buf);
             std::snprintf(buf + k, len - k,
-                          "; the %s index is left at 0: every sync point is within %.0f deg of "
-                          "the %s, where 1 arcmin on the sky reads as %.0f arcmin or more of it "
-                          "(these read %.2f deg); sync on a star farther from the %s to set it",
-                          r->altaz ? "azimuth" : "hour-angle", PM_INDI_POLE_CAP * 180.0 / kPi,
-                          r->altaz ? "zenith" : "pole",
-                          r->axis1_sec < 1e6 ? r->axis1_sec : 1e6, r->axis1_read * 180.0 / kPi,
-                          r->altaz ? "zenith" : "pole");
+                          "; every sync point is within %.0f deg of the %s, where 1 arcmin on the "
+                          "sky reads as %.1f arcmin or more of the %s index (these would read "
+                          "%.2f deg): read instead as a tilt of the %s axis, %.2f arcmin, the "
+                          "indices left at 0; sync on a star farther from the %s to set them",
+                          PM_INDI_POLE_CAP * 180.0 / kPi, r->altaz ? "zenith" : "pole",
+                          r->axis1_sec < 1e6 ? r->axis1_sec : 1e6, r->altaz ? "azimuth" : "hour-angle",
+                          r->axis1_read * 180.0 / kPi, r->altaz ? "azimuth" : "polar",
+                          r->tilt * 180.0 / kPi * 60.0, r->altaz ? "zenith" : "pole");
         }
         break;
     default: {

@@ -67,6 +67,8 @@ typedef struct pm_indi_result {
                           zenith): the axis-1 index is left at 0 (Note 3) */
     double axis1_read; /* then the axis-1 offset the points read (radians) */
     double axis1_sec;  /* and the least 1 / cos(axis 2) of them */
+    double tilt;       /* then the tilt of the polar (azimuth) axis fitted instead
+                          (radians; Note 3) */
     int altaz;         /* the mount is alt-az (the words of the description) */
     long east, west;   /* equatorial: sync points more than PM_INDI_MERIDIAN_GAP
                           east and west of the meridian (a German mount's two
@@ -157,11 +159,16 @@ int pm_indi_choose_order(long n, double spread);
 **     at Polaris (b = 89.4 deg), is an hour-angle index of 7.6 deg, and
 **     every GOTO away from the pole moved by that made GOTOs 8-14 times
 **     worse than no correction (an outside probe; INDI's own plugins did
-**     the same).  So where only offsets are allowed and every point is
-**     within PM_INDI_POLE_CAP of the pole (zenith), the axis-1 index stays
-**     0 and the axis-2 one is applied; res->axis1_unset says so, with what
-**     was read (res->axis1_read, res->axis1_sec), and pm_indi_describe
-**     asks for a sync farther from the pole.
+**     the same).  There a sky error is what a tilt of the polar (azimuth)
+**     axis gives, the same shift everywhere near the pole, where an index
+**     offset gives none.  So where only offsets are allowed and every
+**     point is within PM_INDI_POLE_CAP of the pole (zenith), the model is
+**     that tilt (a, b; least squares, exact for one point), not index
+**     offsets; res->axis1_unset says so, with the axis-1 offset the points
+**     would have read (res->axis1_read, res->axis1_sec) and the tilt
+**     (res->tilt), and pm_indi_describe asks for a sync farther from the
+**     pole for the indices.  A mount whose index is off by degrees keeps
+**     that error until then (the offsets had set it from one sync there).
 */
 pm_status pm_indi_fit(int mount, long n, const double *enc1, const double *enc2,
                       const double *app1, const double *app2, pm_fit *fit,

@@ -275,51 +275,62 @@ END_TEST
 START_TEST(test_pm_indi_fit_offsets_only_near_pole)
 {
     /* One sync on Polaris (Dec 89.37 deg) or sigma Octantis (-88.9 deg),
-    ** and the alt-az analogue at the zenith, on a mount with index errors
-    ** 10' / 5' and a polar (zenith) tilt of 5' (an outside probe's case):
-    ** the tilt read there was an hour-angle index of 7.6 deg, and GOTOs
-    ** elsewhere missed by 8-14 times what no correction misses.  Now the
-    ** axis-1 index is left at 0, the axis-2 one applied, GOTOs no worse
-    ** than uncorrected on worst_apply's grid, and the line says why.  A
-    ** sync 15 deg from the pole still sets both. */
-    const double k[6] = {10.0 / 60 * D2R, 5.0 / 60 * D2R, 5.0 / 60 * D2R, 0, 0, 0};
+    ** and the alt-az analogue at the zenith.  An index offset read there is
+    ** the sky's error times sec(Dec): on a mount with index errors 10' / 5'
+    ** and a polar (zenith) tilt of 5' (an outside probe's case) the offsets
+    ** read an hour-angle index of 7.6 deg, and GOTOs elsewhere missed by
+    ** 8-14 times what no correction misses.  Near the pole a sky error is
+    ** what a tilt gives, so it is read as the tilt (Note 3): a mount with
+    ** only the tilt is then exact everywhere, to 1" (a probe found the Dec offset
+    ** applied alone 501" off where no correction is 300"), the mixed one no
+    ** worse than uncorrected; the line says so.  A sync 15 deg from the pole
+    ** still sets the offsets, exact at the point. */
+    const double mixed[6] = {10.0 / 60 * D2R, 5.0 / 60 * D2R, 5.0 / 60 * D2R, 0, 0, 0};
+    const double tilt[6] = {0, 0, 3.0 / 60 * D2R, 4.0 / 60 * D2R, 0, 0};
     static const double at[4] = {89.37, -88.9, 89.9, 75.0};
     pm_model id;
     ck_assert_int_eq(pm_model_init(&id, PM_MOUNT_EQUATORIAL, 0), PM_OK);
     ck_assert_int_eq(pm_model_prepare(&id), PM_OK);
-    const double none = worst_apply(&id, k);
-    for (int mount = 0; mount < 2; mount++)
-        for (int j = 0; j < 4; j++) {
-            pm_model m;
-            pm_indi_result r;
-            char line[512];
-            e1[0] = 0.7;
-            e2[0] = at[j] * D2R;
-            mount_fwd(e1[0], e2[0], k, &a1[0], &a2[0]);
-            ck_assert_int_eq(pm_indi_fit(mount ? PM_MOUNT_ALTAZ : PM_MOUNT_EQUATORIAL, 1, e1, e2,
-                                         a1, a2, &fit, &m, &r),
-                             PM_OK);
-            ck_assert_int_eq(r.kind, PM_INDI_OFFSET);
-            pm_indi_describe(&r, 1, 0, line, sizeof line);
-            const double w = worst_apply(&m, k);
-            if (j < 3) {
-                ck_assert_msg(w <= none, "mount %d, %g deg: worst %.1f\" against %.1f\" "
-                              "uncorrected", mount, at[j], w / D2R * 3600, none / D2R * 3600);
-                ck_assert_int_eq(r.axis1_unset, 1);
-                ck_assert_msg(strstr(line, mount ? "the azimuth index is left at 0"
-                                                 : "the hour-angle index is left at 0") &&
-                                  strstr(line, mount ? "farther from the zenith"
-                                                     : "farther from the pole"),
-                              "%s", line);
-            } else {
-                ck_assert_int_eq(r.axis1_unset, 0);
-                ck_assert_msg(!strstr(line, "left at 0"), "%s", line);
-                /* the point itself exactly */
+    for (int t = 0; t < 2; t++) {
+        const double *k = t ? tilt : mixed;
+        const double none = worst_apply(&id, k);
+        for (int mount = 0; mount < 2; mount++)
+            for (int j = 0; j < 4; j++) {
+                pm_model m;
+                pm_indi_result r;
+                char line[1024];
                 double x, y;
+                e1[0] = 0.7;
+                e2[0] = at[j] * D2R;
+                mount_fwd(e1[0], e2[0], k, &a1[0], &a2[0]);
+                ck_assert_int_eq(pm_indi_fit(mount ? PM_MOUNT_ALTAZ : PM_MOUNT_EQUATORIAL, 1, e1,
+                                             e2, a1, a2, &fit, &m, &r),
+                                 PM_OK);
+                ck_assert_int_eq(r.kind, PM_INDI_OFFSET);
+                pm_indi_describe(&r, 1, 0, line, sizeof line);
+                const double w = worst_apply(&m, k);
+                /* the point itself exactly, either way */
                 ck_assert_int_eq(pm_model_apply(&m, NULL, e1[0], e2[0], &x, &y), PM_OK);
-                ck_assert_double_eq_tol(sep(x, y, a1[0], a2[0]), 0.0, TOL_EXACT_RAD);
+                ck_assert_msg(sep(x, y, a1[0], a2[0]) < 1e-11, "t %d mount %d at %g: %g rad at the point: %s", t, mount, at[j], sep(x, y, a1[0], a2[0]), line);
+                if (j < 3) {
+                    /* (the tilted mount to the second order of its two
+                    ** rotations, 3' x 4' = 0.2": pm composes the tilt
+                    ** otherwise than mount_fwd) */
+                    ck_assert_msg(t ? w < 1.0 / 3600 * D2R : w <= none,
+                                  "%s mount %d, %g deg: worst %.3f\" against %.1f\" uncorrected",
+                                  t ? "tilted" : "mixed", mount, at[j], w / D2R * 3600,
+                                  none / D2R * 3600);
+                    ck_assert_int_eq(r.axis1_unset, 1);
+                    ck_assert_msg(strstr(line, mount ? "of the azimuth index" : "of the hour-angle index") &&
+                                      strstr(line, mount ? "a tilt of the azimuth axis" : "a tilt of the polar axis") &&
+                                      strstr(line, mount ? "farther from the zenith" : "farther from the pole"),
+                                  "%s", line);
+                } else {
+                    ck_assert_int_eq(r.axis1_unset, 0);
+                    ck_assert_msg(!strstr(line, "a tilt of"), "%s", line);
+                }
             }
-        }
+    }
 }
 END_TEST
 
