@@ -320,6 +320,25 @@ START_TEST(test_report_plan_sky)
     ck_assert_msg(one < both && map < both, "both sides %g, normal side %g, map %g", both, one, map);
     free(html);
     free(fork);
+    /* all beyond the pole (a German mount seen on one side): the other
+    ** side's sky said, no --fork offered; with --fork, the normal side's
+    ** sky, unobserved, said (a second probe's: no word) */
+    snprintf(path, sizeof path, "%s/onesideW.dat", tmp);
+    snprintf(cmd, sizeof cmd,
+             "awk '/^#/ {print; next} $5 == \"W\" && c++ %% 15 == 0 && n < 8 {print; n++}' "
+             "'%s/examples/sim_gem.dat' > '%s'", top(), path);
+    ck_assert_int_eq(system(cmd), 0);
+    html = checked_report(path, "--order 0 --next 3", "onesideW.html", "beyond-the-pole page", 8, 0);
+    ck_assert_msg(strstr(html, "this run's stars are all beyond the pole, so it counts the sky of the "
+                               "other side") && !strstr(html, "For a mount that does not flip"),
+                  "beyond the pole");
+    free(html);
+    html = checked_report(path, "--order 0 --next 3 --fork", "onesideW_fork.html",
+                          "beyond-the-pole page, --fork", 8, 0);
+    ck_assert_msg(strstr(html, "this run's stars are all beyond the pole, so it counts the sky of the "
+                               "normal side, which the run has not observed") != NULL,
+                  "beyond the pole, --fork");
+    free(html);
     snprintf(path, sizeof path, "%s/tests/data/indep_ho_altaz_n90_unmodelled.dat", top());
     ck_assert_int_eq(report(path, "--fork", "altaz_fork.html"), 1);
     ck_assert_msg(strstr(out, "--fork is for an equatorial mount") != NULL, "%s", out);

@@ -801,14 +801,17 @@ void section_plan(Page &p, const Data &d)
                                         "it (beyond the pole on the one side of the meridian, normal on the other)"
                                       : "The sky of this prediction is that of a mount that does not flip (all "
                                         "on the normal side)";
-        if (pl.sides == 2 && (beyond == 0 || normal == 0))
-            s += fmt(": this run's stars are all %s, so it counts the sky of the other side, which the run has "
+        // (a run all beyond the pole is of a German mount: planned as one
+        // that does not flip (--fork), its sky is the normal side it has not
+        // observed, and --fork is not offered to it; a second probe)
+        if ((pl.sides == 2 && (beyond == 0 || normal == 0)) || (pl.sides == 1 && normal == 0 && beyond > 0))
+            s += fmt(": this run's stars are all %s, so it counts the sky of %s side, which the run has "
                      "not observed; the map of the model above (each place on the side of the run's nearest "
-                     "star) says %s over the sky above %s %.0f&deg;. For a mount that does not flip: "
-                     "<code>--fork</code>",
-                     beyond ? "beyond the pole" : "on the normal side",
+                     "star) says %s over the sky above %s %.0f&deg;%s",
+                     beyond ? "beyond the pole" : "on the normal side", pl.sides == 2 ? "the other" : "the normal",
                      arcsec_text(d.emap.mean_arcsec).c_str(), d.emap.elevation ? "elevation" : "declination",
-                     d.emap.limit_deg);
+                     d.emap.limit_deg,
+                     pl.sides == 2 && beyond == 0 ? ". For a mount that does not flip: <code>--fork</code>" : "");
         para(p, s + ".");
     }
     if (!pl.note.empty())
