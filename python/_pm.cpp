@@ -1131,6 +1131,9 @@ std::string plan_run(const std::shared_ptr<RunData> &d, const std::string &mount
         po.max_el_deg = in_range("max_el", max_el, 10, 90, "degrees");
     po.grid_deg = in_range("grid", grid, 1, 30, "degrees");
     po.gem = !fork;
+    if (fork && po.mount == PM_MOUNT_ALTAZ) // (as pmfit plan --fork)
+        fail(K_ARGUMENT, "fork: an equatorial mount that does not flip; the plan is of an alt-az "
+                         "mount");
     po.d_optimal = criterion == "D" || criterion == "d";
     po.sides = sides == "both" ? SIDES_BOTH : sides == "meridian" ? SIDES_MERIDIAN : SIDES_RUN;
     po.meridian_limit_deg = in_range("meridian_limit", meridian_limit, 0, 90, "degrees");

@@ -529,6 +529,9 @@ START_TEST(test_plan_max_el)
     ck_assert(highest_target() <= 60 + 1e-9);
     ck_assert_int_ne(plan_cli("--lat 47 --next 5 --min-el 30 --max-el 20"), 0);
     ck_assert_msg(strstr(out, "--max-el must be above --min-el") != NULL, "%s", out);
+    /* --fork is of an equatorial mount (an alt-az plan ignored it; a probe) */
+    ck_assert_int_ne(plan_cli("--lat 47 --mount altaz --next 5 --fork"), 0);
+    ck_assert_msg(strstr(out, "--fork is for an equatorial mount") != NULL, "%s", out);
 }
 END_TEST
 

@@ -1108,6 +1108,9 @@ int cmd_plan(const Options &o)
     po.max_el_deg = o.max_el;
     po.grid_deg = o.grid;
     po.gem = !o.fork;
+    if (o.fork && po.mount == PM_MOUNT_ALTAZ) /* (as pmfit report; it had been ignored) */
+        die("plan: --fork is for an equatorial mount that does not flip; the plan is of an alt-az "
+            "mount");
     po.noise_arcsec = o.noise;
     if (!o.noise_given) // the run's own sigma, when it can be fitted
         po.noise_arcsec = run_noise_arcsec(run, o.order, o.adds, o.noise);

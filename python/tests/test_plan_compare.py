@@ -71,6 +71,9 @@ def test_plan_errors(tmp_path):
     with pytest.raises(pm.ArgumentError, match="mount: 'altaz', but the run is of an equatorial"):
         pm.plan(SIM, mount="altaz")                      # the run's own mount decides
     assert pm.plan(SIM, mount="equatorial", next=1) == pm.plan(SIM, next=1)
+    # fork is of an equatorial mount (an alt-az plan had ignored it, as pmfit plan)
+    with pytest.raises(pm.ArgumentError, match="fork: an equatorial mount"):
+        pm.plan(mount="altaz", latitude=40, next=2, fork=True)
     with pytest.raises(pm.FileError, match="nowhere.hrz"):
         pm.plan(SIM, horizon=tmp_path / "nowhere.hrz")
     bad = tmp_path / "bad.hrz"
