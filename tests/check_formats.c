@@ -967,6 +967,41 @@ START_TEST(test_pmrun_read_tpoint_comma_caption)
 }
 END_TEST
 
+/* Within 2 deg of the pole the encoder cannot show the pier side: a star at
+** Dec 89.37 on the flipped side with a 0.69 deg Dec index reads 89.94 deg,
+** pier W, beside W records beyond 90 (an outside probe's run was refused as
+** "mixed encoder conventions?"); 5 deg from it still is refused. */
+START_TEST(test_pmrun_read_pier_near_pole)
+{
+    static const char *const rec[2] = {"150 89.94 150.01 89.93 W", "150 85.00 150.01 85.01 W"};
+    char path[4096], err[2048];
+    const char *dir = getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp";
+    int k;
+    for (k = 0; k < 2; k++) {
+        pmrun *run = NULL;
+        FILE *f;
+        int st;
+        snprintf(path, sizeof path, "%s/pm_pole_%d_%d.dat", dir, (int)getpid(), k);
+        f = fopen(path, "w");
+        ck_assert(f != NULL);
+        fprintf(f, "# latitude: 47\n# tau delta T D pier\n-30 40 -29.99 40.01 E\n"
+                   "150 120 -29.99 60.01 W\n%s\n-40 20 -39.99 20.01 E\n", rec[k]);
+        fclose(f);
+        st = pmrun_read(path, NULL, &run, err, sizeof err);
+        if (k == 0) {
+            ck_assert_msg(st == PMRUN_OK, "%s: %s", rec[k], err);
+            ck_assert_uint_eq(pmrun_count(run), 4);
+            pmrun_free(run);
+        } else {
+            ck_assert_msg(st == PMRUN_ERR_FORMAT && strstr(err, ":5: ") &&
+                              strstr(err, "mixed encoder conventions?"),
+                          "%s: status %d: %s", rec[k], st, err);
+        }
+        remove(path);
+    }
+}
+END_TEST
+
 /* A dir column's "+0" and "-0" are 0, as "0" (an outside probe's "+0" was
 ** refused); "+2" still is not a direction. */
 START_TEST(test_pmrun_read_dir_signed_zero)
@@ -1141,6 +1176,7 @@ static Suite *formats_suite(void)
     tcase_add_test(tc, test_pmrun_read_csv_header_lacking_column);
     tcase_add_test(tc, test_pmrun_read_dir_signed_zero);
     tcase_add_test(tc, test_pmrun_read_tpoint_comma_caption);
+    tcase_add_test(tc, test_pmrun_read_pier_near_pole);
     tcase_add_test(tc, test_pmrun_read_skip_bad_lists_skipped);
     suite_add_tcase(s, tc);
     tc = tcase_create("realdata");

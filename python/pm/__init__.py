@@ -669,9 +669,12 @@ def _check_pier_convention(enc_dec, pier):
     50 deg outlier, sigma 18089", where pmfit refused the same file)."""
     ed = _np.remainder(_np.asarray(enc_dec, dtype=float) + _np.pi, 2 * _np.pi) - _np.pi
     beyond = _np.abs(ed) > _np.pi / 2
+    # within 2 deg of the pole the encoder cannot show the side (an index
+    # error moves a record across pi/2), as pmfit's readers
+    clear = (_np.abs(_np.abs(ed) - _np.pi / 2) >= _np.radians(2.0)).reshape(-1)
     first_beyond = {}
     for side, word in ((1, "1 (normal side)"), (-1, "-1 (beyond the pole)")):
-        idx = _np.flatnonzero(_np.asarray(pier).reshape(-1) == side)
+        idx = _np.flatnonzero((_np.asarray(pier).reshape(-1) == side) & clear)
         if not idx.size:
             continue
         b = beyond.reshape(-1)[idx]

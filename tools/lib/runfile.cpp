@@ -844,6 +844,8 @@ bool cut_short(const std::string &last, const std::string &prev)
 // pier column must relate to the encoder declination the same way for all
 // records of a side, and the encoder axis 1 (beyond the pole turned back by
 // 180 deg) must be near the apparent one for every record as for the run.
+const double kNearPoleSide = 2.0 * kPi / 180.0;
+
 bool check_conventions(Context &ctx)
 {
     const pmrun *run = ctx.run();
@@ -854,6 +856,11 @@ bool check_conventions(Context &ctx)
         const pmrun_obs *side[2] = {nullptr, nullptr};   // first E, first W record
         for (const pmrun_obs &o : obs) {
             if (o.pier == PMRUN_PIER_UNKNOWN) continue;
+            // within 2 deg of the pole the encoder cannot show the side: an
+            // index error moves a record across 90 deg (an outside probe's
+            // star at Dec 89.37 on the flipped side with a 0.69 deg Dec index
+            // reads 89.94 deg, pier W; the run had been refused)
+            if (std::fabs(std::fabs(o.enc_dec) - half) < kNearPoleSide) continue;
             const pmrun_obs *&f = side[o.pier == PMRUN_PIER_WEST ? 1 : 0];
             if (!f) {
                 f = &o;
