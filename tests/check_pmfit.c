@@ -1038,6 +1038,19 @@ START_TEST(test_pmfit_explain_refraction_beside_sag)
     ck_assert_msg(strstr(out, "with tube_flexure beside it (at its step): refraction ") != NULL &&
                       strstr(out, "both are measured, and the size above holds part of the other"),
                   "%.3000s", out);
+    /* What the order-1 baseline holds, with the two tried together: another
+    ** seed's 24" refraction beside a 14.16" sag (read -14.16") had been read
+    ** "order 0 + refraction (17.98" +- 0.89")", 6.8 sigma off; now both,
+    ** each within 3 sigma. */
+    snprintf(path, sizeof path, "%s/tests/data/gem20_refr_sag22.dat",
+             getenv("PM_TOP") ? getenv("PM_TOP") : ".");
+    ck_assert_msg(run("%s explain %s --order 1 --json%s", path, "") == 0, "%.2000s", out);
+    p = strstr(out, "\"physical_reading\": \"");
+    ck_assert_msg(p != NULL, "%.2000s", out);
+    v = reading_value(p, "tube_flexure (", &e);
+    ov = reading_value(p, "refraction (", &oe);
+    ck_assert_msg(fabs(v + 14.16) <= 3 * e && fabs(ov - 24.0) <= 3 * oe,
+                  "sag %g +- %g (-14.16), refraction %g +- %g (24): %.600s", v, e, ov, oe, p);
 }
 END_TEST
 

@@ -1527,6 +1527,8 @@ void record(const Run &run, State &st, const Candidate &c, const std::vector<Can
                 beside.error = arcsec(j.f.res.err[j.P - 2]);
                 beside.other_value = arcsec(j.f.model.coef[j.P - 1]);
                 beside.other_error = arcsec(j.f.res.err[j.P - 1]);
+                beside.alone = arcsec(c.fit.f.model.coef[c.fit.P - 1]);
+                beside.alone_error = arcsec(c.fit.f.res.err[c.fit.P - 1]);
                 for (const Alternative &a : alts)
                     beside.close = beside.close || (a.effect == other && !a.smooth);
             }
@@ -1832,6 +1834,8 @@ std::string physical_reading(const Run &run, const Explanation &ex, const Explai
         tries.push_back({"tube_flexure"});
     if (sky && !has("refraction"))
         tries.push_back({"refraction"});
+    if (tf && !has("refraction")) // (both: an outside probe's 24.3" sag beside a -25.3" refraction)
+        tries.push_back({"tube_flexure", "refraction"});
     if (run.mount == PM_MOUNT_EQUATORIAL && pier && both_sides(run, all)) {
         tries.push_back({"e'@W", "i@W"});
         if (tf)
@@ -1839,16 +1843,30 @@ std::string physical_reading(const Run &run, const Explanation &ex, const Explai
     }
     if (tries.empty())
         return "";
+    // order 0 alone (with the findings' terms): an effect that does not
+    // predict better than it is not what the harmonics hold (an outside
+    // probe's 20 stars with 43" of generic order-1 terms were read "order 0 +
+    // pier_side (e'@W -74.72" +- 9.41" ...)", order 1 being more than they
+    // determine)
+    Fit f0 = fit_spec(run, all, 0, with);
+    const double cv0 = f0.ok ? arcsec(cv_of(run, all, 0, with, opt, f0, skip)) : NAN;
     std::vector<std::string> best;
     Fit best_fit;
     double best_cv = ref_cv;
     bool weak = false; /* a term set that predicts as well is consistent with zero */
+    /* the one-term sets (tube flexure, refraction) that predict as well and
+    ** are measured: term, cv, value, error */
+    struct One {
+        std::string term;
+        double cv, value, error;
+    };
+    std::vector<One> ones;
     for (const std::vector<std::string> &t : tries) {
         std::vector<std::string> adds(t);
         adds.insert(adds.end(), with.begin(), with.end());
         Fit f = fit_spec(run, all, 0, adds);
         double cv = arcsec(cv_of(run, all, 0, adds, opt, f, skip));
-        if (!f.ok || !(cv <= best_cv))
+        if (!f.ok || !(cv <= best_cv) || (std::isfinite(cv0) && !(cv < cv0)))
             continue;
         // every effect of the set significant: the pier pair together, a
         // single term at 3 sigma
@@ -1877,6 +1895,8 @@ std::string physical_reading(const Run &run, const Explanation &ex, const Explai
             weak = true;
             continue;
         }
+        if (t.size() == 1)
+            ones.push_back({t[0], cv, arcsec(f.f.model.coef[6]), arcsec(f.f.res.err[6])});
         best = t;
         best_cv = cv;
         best_fit = f;
@@ -1887,15 +1907,13 @@ std::string physical_reading(const Run &run, const Explanation &ex, const Explai
     // terms are that one term" of 0.44" +- 3.07").
     const char *fw = with.empty() ? "" : ", with the findings' terms,";
     const char *fw2 = with.empty() ? "" : " with them";
-    if (best.empty() && weak) {
-        Fit f0 = fit_spec(run, all, 0, with);
-        double cv0 = arcsec(cv_of(run, all, 0, with, opt, f0, skip));
+    if (best.empty() && (weak || (std::isfinite(cv0) && cv0 <= ref_cv))) {
         if (f0.ok && cv0 <= ref_cv) {
             char buf[512];
             std::snprintf(buf, sizeof buf,
                           "order 0%s predicts %s the order-1 baseline%s (cross-validated "
-                          "RMS %.3f\" vs %.3f\"): the %d harmonic terms of order 1 are more than "
-                          "these %zu points determine, and effects may hide in them; explain with "
+                          "RMS %.3f\" vs %.3f\"): the %d harmonic terms of order 1 add nothing "
+                          "these %zu points confirm, and effects may hide in them; explain with "
                           "--order 0",
                           with.empty() ? " alone" : fw, cv0 < ref_cv ? "better than" : "as well as",
                           fw2, cv0, ref_cv, ex.base_n_params - 6, all.size());
@@ -1930,7 +1948,42 @@ std::string physical_reading(const Run &run, const Explanation &ex, const Explai
                   what.c_str(), fw, fw2, best_cv, ref_cv, ex.base_n_params - 6,
                   best.size() == 1 ? "that one term" : "these terms",
                   best.size() == 1 && with.empty() ? "it" : "them", adds.c_str());
-    return buf;
+    std::string out = buf;
+    // Tube flexure and refraction share their shape over a run's elevations:
+    // where the other also predicts as well and is measured, the reading is
+    // not that one (an outside probe's pure 18.2" sag on 30 stars was read
+    // "order 0 + refraction (7.86" +- 0.57")", the sag not named); the two
+    // fitted together say how far the run tells them apart
+    if (best.size() == 1 && (best[0] == "tube_flexure" || best[0] == "refraction")) {
+        std::vector<std::string> both = {"tube_flexure", "refraction"};
+        both.insert(both.end(), with.begin(), with.end());
+        Fit j = fit_spec(run, all, 0, both);
+        const bool is_tf = best[0] == "tube_flexure";
+        if (ones.size() == 2) {
+            const One &o = ones[0].term == best[0] ? ones[1] : ones[0];
+            out += fmt("; so does order 0 + %s (%.2f\" +- %.2f\", cross-validated RMS %.3f\"): "
+                       "the run does not tell a sag from refraction",
+                       o.term.c_str(), o.value, o.error, o.cv);
+        }
+        if (j.ok && j.P >= 8) {
+            // (the one's value beside the other, and how far it moved, in
+            // its own error: a probe's -17.21" +- 0.74" of refraction beside
+            // a 24.3" sag it held, -25.3" the truth)
+            const double v = arcsec(j.f.model.coef[is_tf ? 6 : 7]), e = arcsec(j.f.res.err[is_tf ? 6 : 7]);
+            const double ov = arcsec(j.f.model.coef[is_tf ? 7 : 6]), oe = arcsec(j.f.res.err[is_tf ? 7 : 6]);
+            const double a = arcsec(best_fit.f.model.coef[6]), ae = arcsec(best_fit.f.res.err[6]);
+            const double moved = ae > 0 ? std::fabs(v - a) / ae : 0;
+            out += fmt("; beside each other: %s %.2f\" +- %.2f\", %s %.2f\" +- %.2f\"%s",
+                       best[0].c_str(), v, e, is_tf ? "refraction" : "tube_flexure", ov, oe,
+                       std::fabs(ov) >= 3 * oe ? ": both measured, and the one term holds part of "
+                                                 "the other"
+                       : moved > 3 ? fmt(": the one term moves by %.1f of its sigmas beside the "
+                                         "other, which it holds part of",
+                                         moved).c_str()
+                                   : "");
+        }
+    }
+    return out;
 }
 
 } // namespace

@@ -86,6 +86,7 @@ struct Finding {
     struct Beside {
         std::string effect;
         double value = 0, error = 0, other_value = 0, other_error = 0;
+        double alone = 0, alone_error = 0; // the finding's own at its step, without the other
         bool close = false;   // the other is an as-good alternative of the finding
     } beside;
     std::string effect;       // vocabulary: ha_periodic, dec_periodic, pier_side, refraction,
