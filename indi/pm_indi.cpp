@@ -132,11 +132,15 @@ bool fit_tilt(pm_model *m, long n, const double *e1, const double *e2, const dou
         double d0 = (A[2] * g[0] - A[1] * g[1]) / det, d1 = (A[0] * g[1] - A[1] * g[0]) / det;
         const pm_model before = *m;
         bool lower = false;
-        for (int half = 0; half < 30 && !lower; half++, d0 /= 2, d1 /= 2) {
+        for (int half = 0; half < 30; half++) {
             *m = before;
             m->coef[ia] -= d0;
             m->coef[ib] -= d1;
             lower = pm_model_prepare(m) == PM_OK && ssr(m, nullptr, nullptr) < s0;
+            if (lower)
+                break;
+            d0 /= 2;
+            d1 /= 2;
         }
         if (!lower) {
             *m = before;
