@@ -841,6 +841,18 @@ START_TEST(test_pmrun_read_bad_csv)
 }
 END_TEST
 
+/* A temporary file for one case k of a test (its name from tag and the
+** process), open for writing; the caller closes and removes it. */
+static FILE *tmp_case(char *path, size_t len, const char *tag, const char *ext, int k)
+{
+    const char *dir = getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp";
+    FILE *f;
+    snprintf(path, len, "%s/pm_%s_%d_%d.%s", dir, tag, (int)getpid(), k, ext);
+    f = fopen(path, "w");
+    ck_assert_msg(f != NULL, "%s", path);
+    return f;
+}
+
 /* Second 60 of a CSV log's time: the leap second only, 23:59:60 UTC at the
 ** end of a day that has one (2016-12-31; the same instant written with a
 ** zone, +01:00); on an ordinary day (2023-12-31 22:46:60, an outside probe's,
@@ -857,16 +869,13 @@ START_TEST(test_pmrun_read_csv_second_60)
               {"2023-12-31T22:46:60.000Z", 0},
               {"2023-12-31T23:59:60Z", 0}};
     char path[4096], err[2048];
-    const char *dir = getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp";
     int k;
     double t[3] = {0, 0, 0};
     for (k = 0; k < 5; k++) {
         pmrun *run = NULL;
         FILE *f;
         int st;
-        snprintf(path, sizeof path, "%s/pm_sec60_%d_%d.csv", dir, (int)getpid(), k);
-        f = fopen(path, "w");
-        ck_assert(f != NULL);
+        f = tmp_case(path, sizeof path, "sec60", "csv", k);
         fprintf(f, "# equinox: J2000\n# latitude: 47.0\n# longitude: 19.0\n"
                    "Time,Mount RA,Mount Dec,Solved RA,Solved Dec,Pier Side\n"
                    "%s,02:43:35.8170,+63:52:06.753,02:43:16.7290,+63:51:42.749,pierWest\n",
@@ -904,15 +913,12 @@ START_TEST(test_pmrun_read_csv_header_lacking_column)
               {"Time (UTC),Target,Mount Dec,Solved RA,Solved Dec,Pier Side",
                "no mount RA column"}};
     char path[4096], err[2048];
-    const char *dir = getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp";
     int k;
     for (k = 0; k < 2; k++) {
         pmrun *run = NULL;
         FILE *f;
         int st;
-        snprintf(path, sizeof path, "%s/pm_csvhdr_%d_%d.csv", dir, (int)getpid(), k);
-        f = fopen(path, "w");
-        ck_assert(f != NULL);
+        f = tmp_case(path, sizeof path, "csvhdr", "csv", k);
         fprintf(f, "# equinox: J2000\n# latitude: 39.5\n# longitude: -105.2\n%s\n"
                    "2023-12-31T22:30:00.000Z,\"Star 1, field\",+24.9244310,+24.9,22.08027576,"
                    "+24.8652908,pierEast\n",
@@ -937,7 +943,6 @@ START_TEST(test_pmrun_read_tpoint_comma_caption)
         "Camera test, Temperature 10C, Konkoly site, observer J Smith",
         "RC8 Astrograph, Fornax mount, Decker slit, night 2"};
     char src[4096], path[4096], err[2048], line[1024];
-    const char *dir = getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp";
     int k;
     data_path(src, sizeof src, "tpoint_equat.dat");
     for (k = 0; k < 2; k++) {
@@ -945,9 +950,7 @@ START_TEST(test_pmrun_read_tpoint_comma_caption)
         FILE *in = fopen(src, "r"), *out;
         int first = 1;
         ck_assert(in != NULL);
-        snprintf(path, sizeof path, "%s/pm_tpcap_%d_%d.dat", dir, (int)getpid(), k);
-        out = fopen(path, "w");
-        ck_assert(out != NULL);
+        out = tmp_case(path, sizeof path, "tpcap", "dat", k);
         while (fgets(line, sizeof line, in)) {
             if (line[0] == '!')
                 continue;
@@ -975,15 +978,12 @@ START_TEST(test_pmrun_read_pier_near_pole)
 {
     static const char *const rec[2] = {"150 89.94 150.01 89.93 W", "150 85.00 150.01 85.01 W"};
     char path[4096], err[2048];
-    const char *dir = getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp";
     int k;
     for (k = 0; k < 2; k++) {
         pmrun *run = NULL;
         FILE *f;
         int st;
-        snprintf(path, sizeof path, "%s/pm_pole_%d_%d.dat", dir, (int)getpid(), k);
-        f = fopen(path, "w");
-        ck_assert(f != NULL);
+        f = tmp_case(path, sizeof path, "pole", "dat", k);
         fprintf(f, "# latitude: 47\n# tau delta T D pier\n-30 40 -29.99 40.01 E\n"
                    "150 120 -29.99 60.01 W\n%s\n-40 20 -39.99 20.01 E\n", rec[k]);
         fclose(f);
@@ -1008,15 +1008,12 @@ START_TEST(test_pmrun_read_dir_signed_zero)
 {
     static const char *const tok[3] = {"+0", "-0", "+2"};
     char path[4096], err[2048];
-    const char *dir = getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp";
     int k;
     for (k = 0; k < 3; k++) {
         pmrun *run = NULL;
         FILE *f;
         int st;
-        snprintf(path, sizeof path, "%s/pm_dir0_%d_%d.dat", dir, (int)getpid(), k);
-        f = fopen(path, "w");
-        ck_assert(f != NULL);
+        f = tmp_case(path, sizeof path, "dir0", "dat", k);
         fprintf(f, "# latitude: 47\n# tau delta T D dir\n10 20 10.01 20.01 %s\n"
                    "20 30 20.01 30.01 -1\n", tok[k]);
         fclose(f);
