@@ -64,7 +64,8 @@ typedef struct pm_indi_result {
                           unit residual sigma (RMS; Note 2); 0 if none */
     int axis1_unset;   /* PM_INDI_OFFSET with every sync point within
                           PM_INDI_POLE_CAP of the pole (an alt-az mount's
-                          zenith): the axis-1 index is left at 0 (Note 3) */
+                          zenith): the index offsets are left at 0 and
+                          the tilt fitted instead (Note 3) */
     double axis1_read; /* then the axis-1 offset the points read (radians) */
     double axis1_sec;  /* and the least 1 / cos(axis 2) of them */
     double tilt;       /* then the tilt of the polar (azimuth) axis fitted instead
