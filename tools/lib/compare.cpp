@@ -104,37 +104,6 @@ void cross_validate(const pm_model &old_model, const Run &run, double cv[3])
         cv[w] = n[w] ? std::sqrt(ss[w] / (double)n[w]) : NAN;
 }
 
-// d^T C^-1 d over the terms `s` (C row-major, n x n), by Cholesky; NaN
-// where C restricted to them is not positive definite.
-double quad_form(const std::vector<double> &d, const std::vector<double> &C, int n,
-                 const std::vector<int> &s)
-{
-    const size_t m = s.size();
-    std::vector<double> L(m * m, 0.0), y(m, 0.0);
-    for (size_t i = 0; i < m; i++)
-        for (size_t j = 0; j <= i; j++) {
-            double v = C[(size_t)s[i] * (size_t)n + (size_t)s[j]];
-            for (size_t k = 0; k < j; k++)
-                v -= L[i * m + k] * L[j * m + k];
-            if (i == j) {
-                if (!(v > 0))
-                    return NAN;
-                L[i * m + i] = std::sqrt(v);
-            } else {
-                L[i * m + j] = v / L[j * m + j];
-            }
-        }
-    double q = 0;
-    for (size_t i = 0; i < m; i++) {
-        double v = d[(size_t)s[i]];
-        for (size_t k = 0; k < i; k++)
-            v -= L[i * m + k] * y[k];
-        y[i] = v / L[i * m + i];
-        q += y[i] * y[i];
-    }
-    return q;
-}
-
 // The changes of all terms together, and of all but c' and e' (what a
 // re-zero leaves): T = d^T (C_old + C_new)^-1 d, with C from the fits'
 // estimated sigma, so T / k against F(k, nu) (Hotelling's T^2 read as F),

@@ -1761,47 +1761,19 @@ bool step(const Run &run, State &st, const ExplainOptions &opt, Explanation &ex)
     return true;
 }
 
-// The significance of a fitted term set (adds, at coefficients 6..): the
-// chi^2 of its coefficients against zero with their covariance block, and
-// the degrees of freedom (the number of coefficients); the test is that of
-// 3 sigma for one (chi^2 >= 9), its 99.73% quantile beyond.
-bool terms_significant(const Fit &f)
+// An effect's k coefficients (at, at + 1, ...) measured: their chi^2
+// against zero with their covariance block beyond its 99.73% quantile for
+// k degrees of freedom (3 sigma for one).
+bool effect_measured(const Fit &f, int at, int k)
 {
-    const int P = f.P, k = P - 6;
-    if (k <= 0 || (long)f.f.cov.size() < (long)P * P)
-        return false;
-    // the k x k block, Cholesky, chi^2 = c^T C^-1 c
-    std::vector<double> c((size_t)k * k), b((size_t)k);
-    for (int i = 0; i < k; i++) {
-        b[(size_t)i] = f.f.model.coef[6 + i];
-        for (int j = 0; j < k; j++)
-            c[(size_t)i * k + j] = f.f.cov[(size_t)(6 + i) * P + 6 + j];
-    }
-    for (int j = 0; j < k; j++) {
-        double d = c[(size_t)j * k + j];
-        for (int q = 0; q < j; q++)
-            d -= c[(size_t)j * k + q] * c[(size_t)j * k + q];
-        if (!(d > 0))
-            return false;
-        d = std::sqrt(d);
-        c[(size_t)j * k + j] = d;
-        for (int i = j + 1; i < k; i++) {
-            double e = c[(size_t)i * k + j];
-            for (int q = 0; q < j; q++)
-                e -= c[(size_t)i * k + q] * c[(size_t)j * k + q];
-            c[(size_t)i * k + j] = e / d;
-        }
-    }
-    double chi2 = 0;
-    for (int i = 0; i < k; i++) { /* forward substitution, L y = b */
-        double e = b[(size_t)i];
-        for (int q = 0; q < i; q++)
-            e -= c[(size_t)i * k + q] * b[(size_t)q];
-        b[(size_t)i] = e / c[(size_t)i * k + i];
-        chi2 += b[(size_t)i] * b[(size_t)i];
-    }
     static const double q9973[] = {9.0, 11.83, 14.16, 16.25};
-    return chi2 >= q9973[k <= 4 ? k - 1 : 3];
+    if (k < 1 || (long)f.f.cov.size() < (long)f.P * f.P)
+        return false;
+    const std::vector<double> d(f.f.model.coef, f.f.model.coef + f.P);
+    std::vector<int> s;
+    for (int i = 0; i < k; i++)
+        s.push_back(at + i);
+    return quad_form(d, f.f.cov, f.P, s) >= q9973[std::min(k, 4) - 1]; /* (NaN: not) */
 }
 
 // Order 0 plus one physical effect (or two) against the order-1 baseline:
@@ -1871,25 +1843,10 @@ std::string physical_reading(const Run &run, const Explanation &ex, const Explai
         // every effect of the set significant: the pier pair together, a
         // single term at 3 sigma
         bool sig = true;
-        for (size_t i = 0, j = 6; i < t.size() && sig; j++, i++) {
-            Fit one = f;
-            const bool pair = t[i] == "e'@W";
-            int at = (int)j, k = pair ? 2 : 1;
-            // the block of this effect alone: move it to 6.. by a sub-fit
-            // view (coefficients and covariance of rows at..at+k-1)
-            one.P = 6 + k;
-            one.f.cov.assign((size_t)one.P * one.P, 0.0);
-            for (int r = 0; r < k; r++) {
-                one.f.model.coef[6 + r] = f.f.model.coef[at + r];
-                for (int q = 0; q < k; q++)
-                    one.f.cov[(size_t)(6 + r) * one.P + 6 + q] =
-                        f.f.cov[(size_t)(at + r) * f.P + at + q];
-            }
-            sig = terms_significant(one);
-            if (pair) {
-                i++;
-                j++;
-            }
+        for (size_t i = 0; i < t.size() && sig;) {
+            const int k = t[i] == "e'@W" ? 2 : 1; /* (e'@W, i@W: one effect) */
+            sig = effect_measured(f, 6 + (int)i, k);
+            i += (size_t)k;
         }
         if (!sig) {
             weak = true;

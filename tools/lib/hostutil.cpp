@@ -2,6 +2,7 @@
 #include "hostutil.hpp"
 
 #include <cctype>
+#include <cmath>
 #include <cerrno>
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -313,6 +314,37 @@ bool valid_column_name(const std::string &s)
         if (!(std::isalnum((unsigned char)c) || c == '_' || c == '.' || c == '-'))
             return false;
     return true;
+}
+
+// d^T C^-1 d over the terms `s` (C row-major, n x n), by Cholesky; NaN
+// where C restricted to them is not positive definite.
+double quad_form(const std::vector<double> &d, const std::vector<double> &C, int n,
+                 const std::vector<int> &s)
+{
+    const size_t m = s.size();
+    std::vector<double> L(m * m, 0.0), y(m, 0.0);
+    for (size_t i = 0; i < m; i++)
+        for (size_t j = 0; j <= i; j++) {
+            double v = C[(size_t)s[i] * (size_t)n + (size_t)s[j]];
+            for (size_t k = 0; k < j; k++)
+                v -= L[i * m + k] * L[j * m + k];
+            if (i == j) {
+                if (!(v > 0))
+                    return NAN;
+                L[i * m + i] = std::sqrt(v);
+            } else {
+                L[i * m + j] = v / L[j * m + j];
+            }
+        }
+    double q = 0;
+    for (size_t i = 0; i < m; i++) {
+        double v = d[(size_t)s[i]];
+        for (size_t k = 0; k < i; k++)
+            v -= L[i * m + k] * y[k];
+        y[i] = v / L[i * m + i];
+        q += y[i] * y[i];
+    }
+    return q;
 }
 
 } // namespace pmhost

@@ -63,6 +63,12 @@ void parallel_for(size_t n, const std::function<void(size_t)> &f);
 // else the machine's hardware threads, at most 8.
 unsigned host_threads();
 
+// d^T C^-1 d over the terms `s` (C row-major, n x n), by Cholesky; NaN
+// where C restricted to them is not positive definite (compare's tests of
+// moved terms, explain's measured effects).
+double quad_form(const std::vector<double> &d, const std::vector<double> &C, int n,
+                 const std::vector<int> &s);
+
 } // namespace pmhost
 
 #endif
