@@ -295,16 +295,24 @@ END_TEST
 ** beside it (an outside probe's 5 stars: 0.450" in the map, 1.510" in the
 ** plan, nothing to tell them apart); --fork plans the normal side only,
 ** smaller, and says so; --fork on an alt-az run is refused. */
+/* 8 stars of one pier side of the example run (every 15th of side E or W)
+** in tmp/onesideE.dat or onesideW.dat; its path in path. */
+static void one_side(char *path, size_t len, char side)
+{
+    char cmd[4096];
+    snprintf(path, len, "%s/oneside%c.dat", tmp, side);
+    snprintf(cmd, sizeof cmd,
+             "awk '/^#/ {print; next} $5 == \"%c\" && c++ %% 15 == 0 && n < 8 {print; n++}' "
+             "'%s/examples/sim_gem.dat' > '%s'", side, top(), path);
+    ck_assert_int_eq(system(cmd), 0);
+}
+
 START_TEST(test_report_plan_sky)
 {
-    char path[512], cmd[4096];
+    char path[512];
     char *html, *fork;
     double both, one, map;
-    snprintf(path, sizeof path, "%s/oneside.dat", tmp);
-    snprintf(cmd, sizeof cmd,
-             "awk '/^#/ {print; next} $5 == \"E\" && c++ %% 15 == 0 && n < 8 {print; n++}' "
-             "'%s/examples/sim_gem.dat' > '%s'", top(), path);
-    ck_assert_int_eq(system(cmd), 0);
+    one_side(path, sizeof path, 'E');
     html = checked_report(path, "--order 0 --next 3", "oneside.html", "one-side page", 8, 0);
     ck_assert_msg(strstr(html, "The sky of this prediction is both pier sides") &&
                       strstr(html, "this run's stars are all on the normal side"),
@@ -323,11 +331,7 @@ START_TEST(test_report_plan_sky)
     /* all beyond the pole (a German mount seen on one side): the other
     ** side's sky said, no --fork offered; with --fork, the normal side's
     ** sky, unobserved, said (a second probe's: no word) */
-    snprintf(path, sizeof path, "%s/onesideW.dat", tmp);
-    snprintf(cmd, sizeof cmd,
-             "awk '/^#/ {print; next} $5 == \"W\" && c++ %% 15 == 0 && n < 8 {print; n++}' "
-             "'%s/examples/sim_gem.dat' > '%s'", top(), path);
-    ck_assert_int_eq(system(cmd), 0);
+    one_side(path, sizeof path, 'W');
     html = checked_report(path, "--order 0 --next 3", "onesideW.html", "beyond-the-pole page", 8, 0);
     ck_assert_msg(strstr(html, "this run's stars are all beyond the pole, so it counts the sky of the "
                                "other side") && !strstr(html, "For a mount that does not flip"),
