@@ -488,8 +488,8 @@ bool csv_header(const std::string &line)
     return ra >= 2 && dec >= 2;   // the mount's and the solved position
 }
 
-// A delimited line of four or more names, none a number, two or more of
-// them naming an RA or a Dec: a CSV log's header that lacks a column (an
+// A delimited line of four or more names, none a number, one naming an RA
+// and one a Dec: a CSV log's header that lacks a column (an
 // outside probe's "Mount Dec" written twice, no "Mount RA", had been read as
 // a four-column file: "7 fields, expected 4"); read as one, its reader
 // names what is missing.
